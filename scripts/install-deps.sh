@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages envgi builds and tests with. Idempotent: packages already
+# installed are skipped, and apt is not touched when nothing is missing.
+# Usage: scripts/install-deps.sh [--viewer]   (--viewer adds GLFW + Dear ImGui)
+set -euo pipefail
+
+PKGS=(
+  build-essential cmake ninja-build pkg-config git ca-certificates
+  libembree-dev libtbb-dev libopenimageio-dev openimageio-tools
+  libassimp-dev libpugixml-dev libcli11-dev nlohmann-json3-dev
+  libfmt-dev libspdlog-dev libnanoflann-dev
+  libgtest-dev libbenchmark-dev
+  python3 python3-matplotlib python3-numpy
+)
+if [[ "${1:-}" == "--viewer" ]]; then
+  PKGS+=(libglfw3-dev libimgui-dev)
+fi
+
+missing=()
+for p in "${PKGS[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if ((${#missing[@]} == 0)); then
+  echo "install-deps: all ${#PKGS[@]} packages present"
+  exit 0
+fi
+
+SUDO=""
+if [[ $(id -u) -ne 0 ]]; then SUDO="sudo"; fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+echo "install-deps: done"

@@ -1,0 +1,158 @@
+// `envgi envmap info|samples|plot`: look at a map and at what each strategy draws from it.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <memory>
+#include <stdexcept>
+
+#include "cli/Commands.h"
+#include "core/Files.h"
+#include "envmap/EnvironmentMap.h"
+#include "sampling/Sampler.h"
+
+namespace envgi::cli {
+
+int parseStrategyName(const std::string& name) {
+  if (name == "uniform") return int(EnvStrategy::Uniform);
+  if (name == "cosine") return int(EnvStrategy::Cosine);
+  if (name == "importance") return int(EnvStrategy::Importance);
+  if (name == "alias") return int(EnvStrategy::Alias);
+  if (name == "adaptive") return int(EnvStrategy::Adaptive);
+  throw std::runtime_error("unknown strategy '" + name + "' (uniform, cosine, importance, alias, adaptive)");
+}
+
+namespace {
+
+struct SampleArgs {
+  std::string map, out, strategy = "importance", sampler = "independent";
+  int count = 1000;
+  uint32_t seed = 0;
+  bool misCompensation = false;
+};
+
+std::vector<EnvSample> drawSamples(const EnvironmentMap& env, const SampleArgs& a) {
+  if (a.count <= 0) throw std::runtime_error("--count must be positive");
+  EnvStrategy s = EnvStrategy(parseStrategyName(a.strategy));
+  EnvironmentMapView v = env.view();
+  Sampler smp;
+  smp.type = a.sampler == "independent" ? SamplerType::Independent
+             : a.sampler == "stratified" ? SamplerType::Stratified
+             : a.sampler == "sobol"      ? SamplerType::Sobol
+                                         : throw std::runtime_error("unknown sampler '" + a.sampler + "'");
+  smp.spp = uint32_t(a.count);
+  smp.seed = a.seed;
+  std::vector<EnvSample> out(a.count);
+  for (int i = 0; i < a.count; ++i) {
+    smp.start(0, uint32_t(i));
+    out[i] = v.sample(s, smp.get2D(), Vec3f(0.f, 1.f, 0.f));
+  }
+  return out;
+}
+
+void addSampleOptions(CLI::App* c, SampleArgs& a) {
+  c->add_option("map", a.map, "Lat-long map (.hdr, .exr, .pfm)")->required();
+  c->add_option("--count,-n", a.count, "Number of samples")->check(CLI::PositiveNumber);
+  c->add_option("--strategy,-s", a.strategy, "uniform|cosine|importance|alias|adaptive (cosine is about +Y)");
+  c->add_option("--sampler", a.sampler, "independent|stratified|sobol");
+  c->add_option("--seed", a.seed, "Seed");
+  c->add_flag("--mis-compensation", a.misCompensation, "Sample max(L - mean, 0) (Karlik et al. 2019)");
+}
+
+EnvironmentMapOptions mapOptions(const SampleArgs& a) {
+  EnvironmentMapOptions o;
+  o.misCompensation = a.misCompensation;
+  return o;
+}
+
+void runInfo(const std::string& path) {
+  EnvironmentMap env = EnvironmentMap::load(path);
+  EnvironmentMapStats s = env.stats();
+  fmt::print("map:            {}\n", path);
+  fmt::print("size:           {} x {}\n", s.width, s.height);
+  fmt::print("channel min:    {:.6g} {:.6g} {:.6g}\n", s.channelMin.x, s.channelMin.y, s.channelMin.z);
+  fmt::print("channel max:    {:.6g} {:.6g} {:.6g}\n", s.channelMax.x, s.channelMax.y, s.channelMax.z);
+  fmt::print("power (RGB):    {:.6g} {:.6g} {:.6g}   (integral of L over the sphere)\n", s.power.x, s.power.y, s.power.z);
+  fmt::print("power (Y):      {:.6g}\n", env.luminancePower());
+  fmt::print("luminance:      min {:.6g}  max {:.6g}  median {:.6g}  mean (solid angle) {:.6g}\n", s.lumMin, s.lumMax,
+             s.lumMedian, s.lumMeanSolidAngle);
+  fmt::print("brightest 1%:   {:.2f}% of the energy\n", 100.f * s.top1PercentEnergy);
+  fmt::print("invalid values: {}\n", s.invalidPixels);
+}
+
+void runSamples(const SampleArgs& a) {
+  EnvironmentMap env = EnvironmentMap::load(a.map, mapOptions(a));
+  std::vector<EnvSample> samples = drawSamples(env, a);
+  std::string csv = "u,v,x,y,z,pdf\n";
+  csv.reserve(samples.size() * 80);
+  EnvironmentMapView v = env.view();
+  for (const EnvSample& s : samples) {
+    Vec3f d = v.toLocal(s.dir);
+    csv += fmt::format("{:.7g},{:.7g},{:.7g},{:.7g},{:.7g},{:.7g}\n", s.uv.x, s.uv.y, d.x, d.y, d.z, s.pdf);
+  }
+  writeFileAtomically(a.out, csv);
+  spdlog::info("wrote {} {} samples to {}", samples.size(), a.strategy, a.out);
+}
+
+void runPlot(const SampleArgs& a, float exposure) {
+  EnvironmentMap env = EnvironmentMap::load(a.map, mapOptions(a));
+  std::vector<EnvSample> samples = drawSamples(env, a);
+  Image img = env.image();
+  SaveOptions so;
+  if (std::isnan(exposure)) {
+    // Auto exposure: the 97th percentile of luminance lands at 0.8, so windows and suns saturate
+    // but the rest of the map stays readable.
+    std::vector<float> lum(size_t(img.width) * img.height);
+    for (size_t i = 0; i < lum.size(); ++i) lum[i] = luminance(img.rgb[i * 3], img.rgb[i * 3 + 1], img.rgb[i * 3 + 2]);
+    size_t k = lum.size() * 97 / 100;
+    std::nth_element(lum.begin(), lum.begin() + k, lum.end());
+    so.exposure = lum[k] > 0.f ? std::log2(0.8f / lum[k]) : 0.f;
+  } else {
+    so.exposure = exposure;
+  }
+  // Dots as in the paper's Figure 2: a dark ring around a bright centre; colours are written
+  // after tone mapping, so they are set to values that survive it (1/exposure scaled).
+  float inv = std::exp2(-so.exposure);
+  int rOuter = std::max(1, img.width / 512 + 1), rInner = std::max(0, rOuter - 1);
+  for (const EnvSample& s : samples) {
+    int cx = std::clamp(int(s.uv.x * img.width), 0, img.width - 1);
+    int cy = std::clamp(int(s.uv.y * img.height), 0, img.height - 1);
+    for (int dy = -rOuter; dy <= rOuter; ++dy)
+      for (int dx = -rOuter; dx <= rOuter; ++dx) {
+        int x = (cx + dx + img.width) % img.width, y = cy + dy;
+        if (y < 0 || y >= img.height) continue;
+        bool inner = std::abs(dx) <= rInner && std::abs(dy) <= rInner;
+        img.set(x, y, inner ? Color(inv, 0.f, 0.f) : Color(0.f));
+      }
+  }
+  saveImage(img, a.out, so);
+  spdlog::info("wrote {} with {} {} samples", a.out, samples.size(), a.strategy);
+}
+
+}  // namespace
+
+void addEnvmapCommands(CLI::App& app) {
+  CLI::App* env = app.add_subcommand("envmap", "Inspect and sample environment maps");
+  env->require_subcommand(1);
+
+  auto path = std::make_shared<std::string>();
+  CLI::App* info = env->add_subcommand("info", "Size, channel ranges, power and luminance statistics");
+  info->add_option("map", *path, "Lat-long map")->required();
+  info->callback([path] { runInfo(*path); });
+
+  auto sa = std::make_shared<SampleArgs>();
+  CLI::App* samples = env->add_subcommand("samples", "Write samples as CSV: u,v,x,y,z,pdf (map frame, solid angle)");
+  addSampleOptions(samples, *sa);
+  samples->add_option("-o,--output", sa->out, "CSV file")->required();
+  samples->callback([sa] { runSamples(*sa); });
+
+  auto pa = std::make_shared<SampleArgs>();
+  auto exposure = std::make_shared<float>(NAN);
+  CLI::App* plot = env->add_subcommand("plot", "The paper's Figure 2: the map with its samples drawn on it");
+  addSampleOptions(plot, *pa);
+  plot->add_option("-o,--output", pa->out, "Image (.png)")->required();
+  plot->add_option("--exposure", *exposure, "Exposure in stops (default: automatic)");
+  plot->callback([pa, exposure] { runPlot(*pa, *exposure); });
+}
+
+}  // namespace envgi::cli

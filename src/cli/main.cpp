@@ -1,0 +1,30 @@
+// envgi: physically based rendering lit by HDR environment maps.
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+
+#include "cli/Commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"envgi: global illumination from HDR environment maps"};
+  app.require_subcommand(1);
+  bool verbose = false, quiet = false;
+  app.add_flag("-v,--verbose", verbose, "Debug logging");
+  app.add_flag("-q,--quiet", quiet, "Warnings and errors only");
+  app.parse_complete_callback([&] {
+    spdlog::set_pattern("[%^%l%$] %v");
+    spdlog::set_level(verbose ? spdlog::level::debug : (quiet ? spdlog::level::warn : spdlog::level::info));
+  });
+  envgi::cli::addEnvmapCommands(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "envgi: error: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,36 @@
+#include "core/Files.h"
+
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace envgi {
+
+namespace fs = std::filesystem;
+
+void writeFileAtomically(const std::string& path, const std::string& content) {
+  fs::path p(path);
+  fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir)) throw std::runtime_error("cannot write '" + path + "': directory does not exist");
+  fs::path tmp = dir / ("." + p.filename().string() + ".tmp" + std::to_string(::getpid()));
+  {
+    std::ofstream f(tmp, std::ios::binary);
+    if (!f) throw std::runtime_error("cannot write '" + path + "'");
+    f << content;
+    f.flush();
+    if (!f) {
+      f.close();
+      fs::remove(tmp);
+      throw std::runtime_error("cannot write '" + path + "': write failed");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, p, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw std::runtime_error("cannot write '" + path + "': rename failed");
+  }
+}
+
+}  // namespace envgi

@@ -1,0 +1,11 @@
+// File helpers for outputs that must never be left half-written.
+#pragma once
+
+#include <string>
+
+namespace envgi {
+
+// Writes `content` to a hidden temporary file beside `path`, then renames it into place.
+void writeFileAtomically(const std::string& path, const std::string& content);
+
+}  // namespace envgi

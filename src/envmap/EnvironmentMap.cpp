@@ -1,0 +1,175 @@
+#include "envmap/EnvironmentMap.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+
+namespace envgi {
+
+namespace {
+
+float rowSinTheta(int y, int height) { return std::sin(kPi * (float(y) + 0.5f) / float(height)); }
+
+// Exact solid angle of one pixel of row y: (2 pi / width) (cos theta0 - cos theta1).
+double pixelSolidAngle(int y, int width, int height) {
+  return (2.0 * M_PI / width) * (std::cos(M_PI * y / height) - std::cos(M_PI * (y + 1) / height));
+}
+
+}  // namespace
+
+EnvironmentMap EnvironmentMap::load(const std::string& path, const EnvironmentMapOptions& opts) {
+  Image img = loadImage(path);
+  if (img.width < 2 || img.height < 1)
+    throw std::runtime_error("environment map '" + path + "' is too small (" + std::to_string(img.width) + "x" +
+                             std::to_string(img.height) + ")");
+  if (img.width != 2 * img.height)
+    spdlog::warn("environment map '{}' is {}x{}, not 2:1; it is still read as lat-long", path, img.width, img.height);
+  return EnvironmentMap(std::move(img), opts, path);
+}
+
+EnvironmentMap EnvironmentMap::constant(Color radiance, const EnvironmentMapOptions& opts) {
+  Image img(32, 16);
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) img.set(x, y, radiance);
+  return EnvironmentMap(std::move(img), opts, "constant");
+}
+
+std::vector<float> EnvironmentMap::samplingWeights(const Image& img, bool bilinear, bool misCompensation) {
+  int w = img.width, h = img.height;
+  std::vector<float> lum(size_t(w) * h);
+  for (size_t i = 0; i < lum.size(); ++i) lum[i] = luminance(img.rgb[i * 3], img.rgb[i * 3 + 1], img.rgb[i * 3 + 2]);
+  std::vector<float> weight(lum.size());
+  if (bilinear) {
+    // The average of a bilinear lookup over one pixel is the separable [1/8, 3/4, 1/8] filter of
+    // the pixels (wrapping in u, clamped in v): the density follows what eval() returns and is
+    // positive wherever the lookup is.
+    std::vector<float> tmp(lum.size());
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        int xl = (x + w - 1) % w, xr = (x + 1) % w;
+        const float* row = &lum[size_t(y) * w];
+        tmp[size_t(y) * w + x] = 0.125f * row[xl] + 0.75f * row[x] + 0.125f * row[xr];
+      }
+    for (int y = 0; y < h; ++y) {
+      int yu = std::max(y - 1, 0), yd = std::min(y + 1, h - 1);
+      for (int x = 0; x < w; ++x)
+        weight[size_t(y) * w + x] =
+            0.125f * tmp[size_t(yu) * w + x] + 0.75f * tmp[size_t(y) * w + x] + 0.125f * tmp[size_t(yd) * w + x];
+    }
+  } else {
+    weight = lum;
+  }
+  if (misCompensation) {
+    double sum = 0.0, sa = 0.0;
+    for (int y = 0; y < h; ++y) {
+      double s = rowSinTheta(y, h);
+      for (int x = 0; x < w; ++x) sum += weight[size_t(y) * w + x] * s;
+      sa += s * w;
+    }
+    float mean = sa > 0.0 ? float(sum / sa) : 0.f;
+    std::vector<float> comp(weight.size());
+    bool any = false;
+    for (size_t i = 0; i < weight.size(); ++i) {
+      comp[i] = std::max(weight[i] - mean, 0.f);
+      any = any || comp[i] > 0.f;
+    }
+    // A constant map compensates to nothing; keep the plain density then (Karlik et al. do too).
+    if (any) weight.swap(comp);
+  }
+  for (int y = 0; y < h; ++y) {
+    float s = rowSinTheta(y, h);
+    for (int x = 0; x < w; ++x) weight[size_t(y) * w + x] *= s;  // Algorithm 1's row weighting by sin(theta)
+  }
+  return weight;
+}
+
+EnvironmentMap::EnvironmentMap(Image img, const EnvironmentMapOptions& opts, const std::string& name)
+    : image_(std::move(img)), opts_(opts) {
+  if (!(opts.scale >= 0.f) || !std::isfinite(opts.scale))
+    throw std::runtime_error("environment map '" + name + "': scale must be a finite number >= 0");
+  for (float& v : image_.rgb) {
+    if (!std::isfinite(v) || v < 0.f) {
+      v = 0.f;
+      ++invalid_;
+    }
+  }
+  if (invalid_ > 0)
+    spdlog::warn("environment map '{}': {} NaN, infinite or negative channel values replaced with 0", name, invalid_);
+  std::vector<float> weight = samplingWeights(image_, opts.bilinear, opts.misCompensation);
+  dist_ = PiecewiseConstant2D(weight.data(), image_.width, image_.height);
+  alias_ = AliasTable(weight.data(), weight.size());
+  // The quadtree baseline balances plain map power, never compensated power.
+  std::vector<float> plain = opts.misCompensation ? samplingWeights(image_, opts.bilinear, false) : weight;
+  adaptive_ = AdaptiveQuadtree(plain.data(), image_.width, image_.height, opts.adaptiveLeaves);
+  if (dist_.integral() <= 0.f) spdlog::warn("environment map '{}' is black everywhere: a light of zero power", name);
+}
+
+EnvironmentMapView EnvironmentMap::view() const {
+  EnvironmentMapView v;
+  v.rgb = image_.rgb.data();
+  v.width = image_.width;
+  v.height = image_.height;
+  v.scale = opts_.scale;
+  v.bilinear = opts_.bilinear;
+  v.toWorld = opts_.toWorld;
+  v.dist = dist_.view();
+  v.alias = alias_.view();
+  v.adaptive = adaptive_.view();
+  return v;
+}
+
+float EnvironmentMap::luminancePower() const {
+  double sum = 0.0;
+  int w = image_.width, h = image_.height;
+  for (int y = 0; y < h; ++y) {
+    double dA = pixelSolidAngle(y, w, h);
+    for (int x = 0; x < w; ++x) sum += luminance(image_.at(x, y)) * dA;
+  }
+  return float(sum * opts_.scale);
+}
+
+EnvironmentMapStats EnvironmentMap::stats() const {
+  EnvironmentMapStats st;
+  int w = image_.width, h = image_.height;
+  st.width = w;
+  st.height = h;
+  st.invalidPixels = invalid_;
+  st.channelMin = Color(INFINITY);
+  st.channelMax = Color(-INFINITY);
+  std::vector<float> lum(size_t(w) * h), energy(size_t(w) * h);
+  double power[3] = {0, 0, 0}, lumSum = 0.0, saSum = 0.0;
+  for (int y = 0; y < h; ++y) {
+    double dA = pixelSolidAngle(y, w, h), s = dA;
+    for (int x = 0; x < w; ++x) {
+      Color c = image_.at(x, y) * opts_.scale;
+      st.channelMin = vmin(st.channelMin, c);
+      st.channelMax = vmax(st.channelMax, c);
+      for (int k = 0; k < 3; ++k) power[k] += c[k] * dA;
+      float l = luminance(c);
+      lum[size_t(y) * w + x] = l;
+      energy[size_t(y) * w + x] = float(l * s);
+      lumSum += l * s;
+      saSum += s;
+    }
+  }
+  st.power = Color(float(power[0]), float(power[1]), float(power[2]));
+  st.lumMeanSolidAngle = float(lumSum / saSum);
+  std::vector<float> sorted = lum;
+  std::sort(sorted.begin(), sorted.end());
+  st.lumMin = sorted.front();
+  st.lumMax = sorted.back();
+  st.lumMedian = sorted[sorted.size() / 2];
+  // Brightest 1% by luminance; their share of the solid-angle-weighted power.
+  std::vector<size_t> idx(lum.size());
+  std::iota(idx.begin(), idx.end(), size_t(0));
+  size_t top = std::max<size_t>(1, lum.size() / 100);
+  std::nth_element(idx.begin(), idx.begin() + top, idx.end(), [&](size_t a, size_t b) { return lum[a] > lum[b]; });
+  double topSum = 0.0;
+  for (size_t i = 0; i < top; ++i) topSum += energy[idx[i]];
+  st.top1PercentEnergy = lumSum > 0.0 ? float(topSum / lumSum) : 0.f;
+  return st;
+}
+
+}  // namespace envgi

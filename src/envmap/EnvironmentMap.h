@@ -1,0 +1,64 @@
+// Host side of the environment light: loads and sanitises a lat-long map and builds the
+// sampling structures that EnvironmentMapView reads.
+#pragma once
+
+#include <string>
+
+#include "envmap/EnvironmentMapView.h"
+#include "image/Image.h"
+
+namespace envgi {
+
+struct EnvironmentMapOptions {
+  float scale = 1.f;
+  Transform toWorld;
+  bool bilinear = true;
+  // Karlik et al. 2019: sample max(L - mean, 0), leaving the flat part to BSDF sampling.
+  bool misCompensation = false;
+  int adaptiveLeaves = 256;
+};
+
+struct EnvironmentMapStats {
+  int width = 0, height = 0;
+  Color channelMin, channelMax;
+  Color power;             // integral of L over the sphere, per channel (W/m^2 for unit area)
+  float lumMin = 0, lumMax = 0, lumMeanSolidAngle = 0, lumMedian = 0;
+  float top1PercentEnergy = 0;  // fraction of solid-angle-weighted luminance in the brightest 1% of pixels
+  size_t invalidPixels = 0;
+};
+
+class EnvironmentMap {
+ public:
+  // Throws std::runtime_error for an unreadable file or a negative scale.
+  static EnvironmentMap load(const std::string& path, const EnvironmentMapOptions& opts = {});
+  // A map of constant radiance (small, so that the sin-theta weighting still applies).
+  static EnvironmentMap constant(Color radiance, const EnvironmentMapOptions& opts = {});
+
+  EnvironmentMap(Image img, const EnvironmentMapOptions& opts, const std::string& name = "map");
+  EnvironmentMap(const EnvironmentMap&) = delete;
+  EnvironmentMap& operator=(const EnvironmentMap&) = delete;
+  EnvironmentMap(EnvironmentMap&&) = default;
+  EnvironmentMap& operator=(EnvironmentMap&&) = default;
+
+  EnvironmentMapView view() const;
+  const Image& image() const { return image_; }
+  const EnvironmentMapOptions& options() const { return opts_; }
+  size_t invalidPixels() const { return invalid_; }
+  EnvironmentMapStats stats() const;
+  // Luminance power, integral of Y(L) over the sphere (zero for an all-black map).
+  float luminancePower() const;
+  size_t samplingBytes() const { return dist_.bytes() + alias_.bytes(); }
+
+  // Per-pixel sampling weight: luminance of the lookup's average over the pixel, times sin theta.
+  static std::vector<float> samplingWeights(const Image& img, bool bilinear, bool misCompensation);
+
+ private:
+  Image image_;
+  EnvironmentMapOptions opts_;
+  PiecewiseConstant2D dist_;
+  AliasTable alias_;
+  AdaptiveQuadtree adaptive_;
+  size_t invalid_ = 0;
+};
+
+}  // namespace envgi

@@ -1,0 +1,158 @@
+// An HDR lat-long environment map as plain data: radiance lookup by direction and the
+// sampling strategies the paper compares. Host and device share this code.
+//
+// Direction convention (the same as Mitsuba 3's `envmap` emitter): in the map's own frame
+// +Y is up; u = atan2(x, -z) / 2pi (wrapped to [0,1)), v = acos(y) / pi, so row 0 is the
+// zenith, the centre column (u = 0.5) looks along +Z and u = 0.25 along +X. to_world
+// rotates that frame into the scene.
+#pragma once
+
+#include "core/Frame.h"
+#include "core/Transform.h"
+#include "envmap/AdaptiveQuadtree.h"
+#include "sampling/AliasTable.h"
+#include "sampling/PiecewiseConstant2D.h"
+#include "sampling/Warp.h"
+
+namespace envgi {
+
+enum class EnvStrategy : int {
+  Uniform = 0,     // uniform over the sphere
+  Cosine = 1,      // cosine-weighted about a normal
+  Importance = 2,  // Algorithm 1: marginal/conditional CDFs, binary search
+  Alias = 3,       // the same density through an alias table
+  Adaptive = 4,    // energy-balanced quadtree baseline
+};
+
+struct EnvSample {
+  Vec3f dir;       // world space, pointing away from the scene
+  Color radiance;  // scaled radiance arriving from dir
+  float pdf = 0.f; // solid angle
+  Vec2f uv;
+};
+
+struct EnvironmentMapView {
+  const float* rgb = nullptr;  // width * height * 3, sanitised (finite, >= 0)
+  int width = 0, height = 0;
+  float scale = 1.f;
+  bool bilinear = true;
+  Transform toWorld;
+  PiecewiseConstant2DView dist;  // func = luminance x sin(theta) per pixel
+  AliasTableView alias;          // over all pixels, same weights as dist
+  AdaptiveQuadtreeView adaptive;
+
+  ENVGI_HD static Vec2f dirToUV(Vec3f d) {
+    float u = std::atan2(d.x, -d.z) * kInv2Pi;
+    if (u < 0.f) u += 1.f;
+    if (!(u < 1.f)) u = 0.f;
+    // atan2 rather than acos: acos loses half its digits near the poles.
+    float v = std::atan2(std::sqrt(d.x * d.x + d.z * d.z), d.y) * kInvPi;
+    return {u, v};
+  }
+  ENVGI_HD static Vec3f uvToDir(Vec2f uv) {
+    float phi = 2.f * kPi * uv.x, theta = kPi * uv.y;
+    float st = std::sin(theta);
+    return {st * std::sin(phi), std::cos(theta), -st * std::cos(phi)};
+  }
+
+  ENVGI_HD Color texel(int x, int y) const {
+    const float* p = rgb + (size_t(y) * width + x) * 3;
+    return {p[0], p[1], p[2]};
+  }
+
+  // Bilinear between pixel centres, wrapping across the phi seam and clamping at the poles.
+  ENVGI_HD Color lookupUV(Vec2f uv) const {
+    if (!bilinear) {
+      int x = clampi(int(uv.x * width), 0, width - 1), y = clampi(int(uv.y * height), 0, height - 1);
+      return texel(x, y) * scale;
+    }
+    float fx = uv.x * width - 0.5f, fy = uv.y * height - 0.5f;
+    float x0f = std::floor(fx), y0f = std::floor(fy);
+    float tx = fx - x0f, ty = fy - y0f;
+    int x0 = int(x0f), y0 = int(y0f);
+    int xa = ((x0 % width) + width) % width, xb = (xa + 1) % width;
+    int ya = clampi(y0, 0, height - 1), yb = clampi(y0 + 1, 0, height - 1);
+    Color c = (texel(xa, ya) * (1.f - tx) + texel(xb, ya) * tx) * (1.f - ty) +
+              (texel(xa, yb) * (1.f - tx) + texel(xb, yb) * tx) * ty;
+    return c * scale;
+  }
+
+  ENVGI_HD Vec3f toLocal(Vec3f worldDir) const { return normalize(toWorld.inverseVector(worldDir)); }
+  ENVGI_HD Vec3f fromLocal(Vec3f localDir) const { return normalize(toWorld.vector(localDir)); }
+
+  // Radiance arriving from world direction d.
+  ENVGI_HD Color eval(Vec3f d) const { return lookupUV(dirToUV(toLocal(d))); }
+
+  // Density in solid angle of the importance density at (u, v): p(u,v) / (2 pi^2 sin theta).
+  ENVGI_HD float importancePdfUV(Vec2f uv) const {
+    float st = std::sin(kPi * uv.y);
+    if (st <= 0.f) return 0.f;
+    return dist.pdf(uv) / (2.f * kPi * kPi * st);
+  }
+
+  // Draws a direction; `normal` (world space) is used by the cosine strategy only.
+  ENVGI_HD EnvSample sample(EnvStrategy s, Vec2f u, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
+    EnvSample out;
+    Vec3f local;
+    switch (s) {
+      case EnvStrategy::Uniform: {
+        local = sampleUniformSphere(u);
+        out.pdf = uniformSpherePdf();
+        out.uv = dirToUV(local);
+        break;
+      }
+      case EnvStrategy::Cosine: {
+        Frame f = Frame::fromNormal(normal);
+        Vec3f w = f.toWorld(sampleCosineHemisphere(u));
+        out.dir = normalize(w);
+        out.pdf = cosineHemispherePdf(dot(out.dir, normal));
+        out.uv = dirToUV(toLocal(out.dir));
+        out.radiance = out.pdf > 0.f ? lookupUV(out.uv) : Color(0.f);
+        return out;
+      }
+      case EnvStrategy::Importance: {
+        float pdf2;
+        out.uv = dist.sample(u, &pdf2);
+        local = uvToDir(out.uv);
+        out.pdf = importancePdfUV(out.uv);
+        break;
+      }
+      case EnvStrategy::Alias: {
+        // The position inside the pixel reuses u.x's low bits across the column and the
+        // remapped u.y down the row: for maps of 2^k pixels, u.x keeps 24 - k bits of jitter.
+        float pmf, uy;
+        int i = alias.sample(u.x, u.y, &pmf, &uy);
+        int px = i % width, py = i / width;
+        // Centred on its quantisation step, so a sample never sits exactly on a pixel edge.
+        float step = fminf(float(alias.n) * 0x1p-24f, 1.f);
+        float ux = fminf(u.x * float(alias.n) - std::floor(u.x * float(alias.n)) + 0.5f * step, kOneMinusEpsilon);
+        out.uv = {(float(px) + ux) / float(width), (float(py) + uy) / float(height)};
+        local = uvToDir(out.uv);
+        out.pdf = importancePdfUV(out.uv);
+        break;
+      }
+      case EnvStrategy::Adaptive:
+      default: {
+        out.uv = adaptive.sample(u, &out.pdf);
+        local = uvToDir(out.uv);
+        break;
+      }
+    }
+    out.dir = fromLocal(local);
+    out.radiance = out.pdf > 0.f ? lookupUV(out.uv) : Color(0.f);
+    return out;
+  }
+
+  ENVGI_HD float pdf(EnvStrategy s, Vec3f worldDir, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
+    switch (s) {
+      case EnvStrategy::Uniform: return uniformSpherePdf();
+      case EnvStrategy::Cosine: return cosineHemispherePdf(dot(normalize(worldDir), normal));
+      case EnvStrategy::Importance:
+      case EnvStrategy::Alias: return importancePdfUV(dirToUV(toLocal(worldDir)));
+      case EnvStrategy::Adaptive:
+      default: return adaptive.pdf(dirToUV(toLocal(worldDir)));
+    }
+  }
+};
+
+}  // namespace envgi

@@ -1,0 +1,47 @@
+// Linear RGB float images and their file formats (OpenImageIO underneath).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/Vec.h"
+
+namespace envgi {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<float> rgb;  // row-major, row 0 at the top, 3 floats a pixel
+
+  Image() = default;
+  Image(int w, int h) : width(w), height(h), rgb(size_t(w) * h * 3, 0.f) {}
+  Color at(int x, int y) const {
+    const float* p = &rgb[(size_t(y) * width + x) * 3];
+    return {p[0], p[1], p[2]};
+  }
+  void set(int x, int y, Color c) {
+    float* p = &rgb[(size_t(y) * width + x) * 3];
+    p[0] = c.x;
+    p[1] = c.y;
+    p[2] = c.z;
+  }
+};
+
+enum class ToneMap { Clamp, Aces };
+
+struct SaveOptions {
+  float exposure = 0.f;  // stops, applied before the tone curve (8-bit outputs only)
+  ToneMap toneMap = ToneMap::Clamp;
+};
+
+// Reads .hdr, .exr, .pfm (and anything else OpenImageIO reads) into linear RGB; throws
+// std::runtime_error naming the file on a missing, unreadable or truncated file.
+Image loadImage(const std::string& path);
+
+// Writes by extension: .exr and .pfm as linear float, .png/.jpg/.tif as 8-bit sRGB after
+// exposure and tone curve. The file appears atomically (a temporary file, then rename).
+void saveImage(const Image& img, const std::string& path, const SaveOptions& opts = {});
+
+// Exposure, tone curve and sRGB encoding of one linear value, in [0,1].
+float toneMapChannel(float v, const SaveOptions& opts);
+
+}  // namespace envgi

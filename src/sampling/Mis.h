@@ -1,0 +1,32 @@
+// Multiple importance sampling weights (the paper's Eq. 3 to 6 and Veach's power heuristic).
+#pragma once
+
+#include "core/Common.h"
+
+namespace envgi {
+
+// Two strategies: weight of the one that drew the sample (nf samples with density fPdf).
+ENVGI_INLINE float balanceHeuristic(float nf, float fPdf, float ng, float gPdf) {
+  float f = nf * fPdf, g = ng * gPdf;
+  return f + g > 0.f ? f / (f + g) : 0.f;
+}
+ENVGI_INLINE float powerHeuristic(float nf, float fPdf, float ng, float gPdf) {
+  float f = nf * fPdf, g = ng * gPdf;
+  if (std::isinf(f * f)) return 1.f;
+  return f * f + g * g > 0.f ? (f * f) / (f * f + g * g) : 0.f;
+}
+
+// Any number of strategies: w_i = (c_i p_i)^beta / sum_k (c_k p_k)^beta. beta = 1 is the
+// balance heuristic of Eq. 5-6 (c_i = n_i / n), beta = 2 the power heuristic.
+ENVGI_INLINE float misWeight(int i, const float* counts, const float* pdfs, int k, float beta) {
+  float denom = 0.f, num = 0.f;
+  for (int j = 0; j < k; ++j) {
+    float t = counts[j] * pdfs[j];
+    float tb = beta == 1.f ? t : (beta == 2.f ? t * t : std::pow(t, beta));
+    denom += tb;
+    if (j == i) num = tb;
+  }
+  return denom > 0.f ? num / denom : 0.f;
+}
+
+}  // namespace envgi

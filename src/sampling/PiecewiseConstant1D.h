@@ -1,0 +1,79 @@
+// A piecewise-constant density on [0,1] sampled by inverting its CDF with binary search
+// (steps 3, 5 and 7-8 of the paper's Algorithm 1).
+#pragma once
+
+#include <vector>
+
+#include "core/Common.h"
+
+namespace envgi {
+
+// Index i in [0, size-2] with cdf[i] <= u < cdf[i+1], for a non-decreasing cdf.
+ENVGI_INLINE int findInterval(const float* cdf, int size, float u) {
+  int lo = 0, hi = size - 2;
+  while (lo < hi) {
+    int mid = (lo + hi + 1) >> 1;
+    if (cdf[mid] <= u) lo = mid;
+    else hi = mid - 1;
+  }
+  return lo;
+}
+
+// Plain view over storage owned elsewhere (host vectors now, device buffers on the GPU).
+// A function that is zero everywhere degenerates to the uniform density, so sampling a
+// zero-power light never divides by zero.
+struct PiecewiseConstant1DView {
+  const float* func = nullptr;  // n values, non-negative
+  const float* cdf = nullptr;   // n + 1 values, cdf[0] = 0, cdf[n] = 1
+  int n = 0;
+  float funcInt = 0.f;  // integral of func over [0,1]
+
+  ENVGI_HD float pdf(float x) const {
+    int i = clampi(int(x * n), 0, n - 1);
+    return funcInt > 0.f ? func[i] / funcInt : 1.f;
+  }
+  ENVGI_HD float discretePmf(int i) const { return cdf[i + 1] - cdf[i]; }
+
+  // Returns x in [0,1); *pdf is the continuous density there, *offset the cell index.
+  ENVGI_HD float sample(float u, float* pdfOut, int* offset) const {
+    int i = findInterval(cdf, n + 1, u);
+    float width = cdf[i + 1] - cdf[i];
+    float du = width > 0.f ? (u - cdf[i]) / width : 0.5f;
+    if (pdfOut) *pdfOut = funcInt > 0.f ? func[i] / funcInt : 1.f;
+    if (offset) *offset = i;
+    float x = (float(i) + du) / float(n);
+    return x < kOneMinusEpsilon ? x : kOneMinusEpsilon;
+  }
+
+  // Inverse of sample(): the u that maps to x.
+  ENVGI_HD float invert(float x) const {
+    int i = clampi(int(x * n), 0, n - 1);
+    float t = x * n - float(i);
+    return lerpf(t, cdf[i], cdf[i + 1]);
+  }
+};
+
+class PiecewiseConstant1D {
+ public:
+  PiecewiseConstant1D() = default;
+  explicit PiecewiseConstant1D(const float* f, int n) { build(f, n, func_, cdf_, funcInt_); }
+  explicit PiecewiseConstant1D(const std::vector<float>& f) : PiecewiseConstant1D(f.data(), int(f.size())) {}
+
+  PiecewiseConstant1DView view() const { return {func_.data(), cdf_.data(), int(func_.size()), funcInt_}; }
+  float integral() const { return funcInt_; }
+  int size() const { return int(func_.size()); }
+
+  // Builds func/cdf into the given arrays; shared with PiecewiseConstant2D's flat storage.
+  static void build(const float* f, int n, float* funcOut, float* cdfOut, float* intOut);
+  static void build(const float* f, int n, std::vector<float>& funcOut, std::vector<float>& cdfOut, float& intOut) {
+    funcOut.resize(n);
+    cdfOut.resize(n + 1);
+    build(f, n, funcOut.data(), cdfOut.data(), &intOut);
+  }
+
+ private:
+  std::vector<float> func_, cdf_;
+  float funcInt_ = 0.f;
+};
+
+}  // namespace envgi

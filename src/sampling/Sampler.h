@@ -1,0 +1,125 @@
+// Per-pixel sample sequences: independent (PCG32), stratified (jittered) and Sobol with
+// Owen scrambling. Plain data; a sample is addressed by (pixel, index, dimension), so the
+// same seed gives the same image whatever the thread count.
+#pragma once
+
+#include "sampling/Pcg32.h"
+#include "core/Vec.h"
+
+namespace envgi {
+
+enum class SamplerType : int { Independent = 0, Stratified = 1, Sobol = 2 };
+
+ENVGI_INLINE uint32_t reverseBits32(uint32_t v) {
+  v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
+  v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
+  v = ((v >> 4) & 0x0F0F0F0Fu) | ((v & 0x0F0F0F0Fu) << 4);
+  v = ((v >> 8) & 0x00FF00FFu) | ((v & 0x00FF00FFu) << 8);
+  return (v >> 16) | (v << 16);
+}
+
+// First two dimensions of Sobol': van der Corput and the Pascal-matrix dimension.
+ENVGI_INLINE uint32_t sobolDim0(uint32_t i) { return reverseBits32(i); }
+ENVGI_INLINE uint32_t sobolDim1(uint32_t i) {
+  uint32_t r = 0;
+  for (uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1)
+    if (i & 1u) r ^= v;
+  return r;
+}
+
+// Nested uniform (Owen) scrambling through a hash on reversed bits (Laine-Karras style).
+ENVGI_INLINE uint32_t owenScramble(uint32_t v, uint32_t seed) {
+  v = reverseBits32(v);
+  v += seed;
+  v ^= v * 0x6c50b47cu;
+  v ^= v * 0xb82f1e52u;
+  v ^= v * 0xc7afe638u;
+  v ^= v * 0x8d22f6e6u;
+  return reverseBits32(v);
+}
+
+// Kensler's hashed permutation: element i of a pseudo-random permutation of [0, n).
+ENVGI_INLINE uint32_t permutationElement(uint32_t i, uint32_t l, uint32_t p) {
+  uint32_t w = l - 1;
+  w |= w >> 1; w |= w >> 2; w |= w >> 4; w |= w >> 8; w |= w >> 16;
+  do {
+    i ^= p; i *= 0xe170893d; i ^= p >> 16; i ^= (i & w) >> 4; i ^= p >> 8; i *= 0x0929eb3f;
+    i ^= p >> 23; i ^= (i & w) >> 1; i *= 1 | p >> 27; i *= 0x6935fa69; i ^= (i & w) >> 11;
+    i *= 0x74dcb303; i ^= (i & w) >> 2; i *= 0x9e501cc3; i ^= (i & w) >> 2; i *= 0xc860a3df;
+    i &= w; i ^= i >> 5;
+  } while (i >= l);
+  return (i + p) % l;
+}
+
+ENVGI_INLINE float bitsToFloat01(uint32_t v) {
+  float f = float(v >> 8) * 0x1p-24f;
+  return f;
+}
+
+struct Sampler {
+  SamplerType type = SamplerType::Independent;
+  uint32_t spp = 1;
+  uint32_t seed = 0;
+  uint64_t pixelHash = 0;
+  uint32_t index = 0;
+  uint32_t dim = 0;
+  Pcg32 rng;
+
+  // Begin sample `sampleIndex` of a pixel (a pixel id, or any stream id for non-image work).
+  ENVGI_HD void start(uint64_t pixel, uint32_t sampleIndex) {
+    pixelHash = hashCombine(mixBits(pixel), seed);
+    index = sampleIndex;
+    dim = 0;
+    rng.setSeed(pixelHash, uint64_t(sampleIndex) + 1u);
+  }
+
+  ENVGI_HD float get1D() {
+    uint32_t d = dim++;
+    switch (type) {
+      case SamplerType::Stratified: {
+        uint32_t h = uint32_t(hashCombine(pixelHash, d));
+        uint32_t s = permutationElement(index % spp, spp, h);
+        return (float(s) + rng.nextFloat()) / float(spp) * kOneMinusEpsilon;
+      }
+      case SamplerType::Sobol: {
+        uint32_t h = uint32_t(hashCombine(pixelHash, d));
+        uint32_t i = permutationElement(index % spp, spp, h ^ 0x5bd1e995u);
+        return bitsToFloat01(owenScramble(sobolDim0(i), h));
+      }
+      default:
+        return rng.nextFloat();
+    }
+  }
+
+  ENVGI_HD Vec2f get2D() {
+    uint32_t d = dim;
+    dim += 2;
+    switch (type) {
+      case SamplerType::Stratified: {
+        // Jittered grid of nx * ny strata; a sample count that is not a square still fills
+        // every stratum of the largest grid that fits, then jitters the rest independently.
+        uint32_t nx = uint32_t(std::sqrt(float(spp)));
+        while ((nx + 1) * (nx + 1) <= spp) ++nx;
+        uint32_t n = nx * nx;
+        uint32_t h = uint32_t(hashCombine(pixelHash, d));
+        if (index >= n) return {rng.nextFloat(), rng.nextFloat()};
+        uint32_t s = permutationElement(index, n, h);
+        float jx = rng.nextFloat(), jy = rng.nextFloat();
+        return {(float(s % nx) + jx) / float(nx) * kOneMinusEpsilon, (float(s / nx) + jy) / float(nx) * kOneMinusEpsilon};
+      }
+      case SamplerType::Sobol: {
+        // Independent shuffles per dimension pair decorrelate the pairs (Burley 2020).
+        uint32_t h = uint32_t(hashCombine(pixelHash, d));
+        uint32_t i = permutationElement(index % spp, spp, h ^ 0x68e31da4u);
+        uint32_t s0 = uint32_t(mixBits(h ^ 0x1234567u)), s1 = uint32_t(mixBits(h ^ 0x89abcdeu));
+        return {bitsToFloat01(owenScramble(sobolDim0(i), s0)), bitsToFloat01(owenScramble(sobolDim1(i), s1))};
+      }
+      default: {
+        float a = rng.nextFloat();
+        return {a, rng.nextFloat()};
+      }
+    }
+  }
+};
+
+}  // namespace envgi

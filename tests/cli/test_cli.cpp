@@ -1,0 +1,86 @@
+// End-to-end tests of the envgi command line: outputs, exit codes and error lines.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cli/CliRunner.h"
+
+using namespace envgi::test;
+namespace fs = std::filesystem;
+
+namespace {
+std::string bundledMap() { return std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/studio.hdr"; }
+}  // namespace
+
+TEST(CliEnvmap, InfoPrintsStatistics) {
+  CliResult r = runCli("envmap info " + bundledMap());
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("size:           1024 x 512"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("brightest 1%"), std::string::npos);
+}
+
+TEST(CliEnvmap, SamplesCsvContract) {
+  TempDir d;
+  std::string out = d.file("s.csv");
+  CliResult r = runCli("envmap samples " + bundledMap() + " --count 500 --strategy importance --seed 3 -o " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream f(out);
+  std::string line;
+  std::getline(f, line);
+  EXPECT_EQ(line, "u,v,x,y,z,pdf");
+  int rows = 0;
+  while (std::getline(f, line)) {
+    float u, v, x, y, z, pdf;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%f,%f,%f,%f,%f,%f", &u, &v, &x, &y, &z, &pdf), 6) << line;
+    EXPECT_GE(u, 0.f);
+    EXPECT_LT(u, 1.f);
+    EXPECT_NEAR(x * x + y * y + z * z, 1.f, 1e-4f);
+    EXPECT_GT(pdf, 0.f);
+    ++rows;
+  }
+  EXPECT_EQ(rows, 500);
+  // Same seed, same file.
+  std::string out2 = d.file("s2.csv");
+  ASSERT_EQ(runCli("envmap samples " + bundledMap() + " --count 500 --strategy importance --seed 3 -o " + out2).code, 0);
+  std::ifstream a(out), b(out2);
+  std::stringstream sa, sb;
+  sa << a.rdbuf();
+  sb << b.rdbuf();
+  EXPECT_EQ(sa.str(), sb.str());
+}
+
+TEST(CliEnvmap, PlotWritesPng) {
+  TempDir d;
+  std::string out = d.file("fig2.png");
+  CliResult r = runCli("envmap plot " + bundledMap() + " --count 300 -o " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_GT(fs::file_size(out), 1000u);
+}
+
+TEST(CliEnvmap, ErrorsAreOneLineAndLeaveNoFile) {
+  TempDir d;
+  std::string out = d.file("never.csv");
+  CliResult missing = runCli("envmap samples /nonexistent/map.hdr --count 5 -o " + out);
+  EXPECT_NE(missing.code, 0);
+  EXPECT_NE(missing.output.find("envgi: error: cannot open image"), std::string::npos) << missing.output;
+  EXPECT_FALSE(fs::exists(out));
+
+  std::string bad = d.file("bad.hdr");
+  { std::ofstream f(bad); f << "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 512 +X 1024\n\x02\x02"; }
+  CliResult trunc = runCli("envmap info " + bad);
+  EXPECT_NE(trunc.code, 0);
+  EXPECT_NE(trunc.output.find("envgi: error:"), std::string::npos) << trunc.output;
+
+  CliResult strat = runCli("envmap samples " + bundledMap() + " --strategy bogus -o " + out);
+  EXPECT_NE(strat.code, 0);
+  EXPECT_NE(strat.output.find("unknown strategy 'bogus'"), std::string::npos) << strat.output;
+  EXPECT_FALSE(fs::exists(out));
+
+  CliResult count = runCli("envmap samples " + bundledMap() + " --count -4 -o " + out);
+  EXPECT_NE(count.code, 0);
+  EXPECT_FALSE(fs::exists(out));
+}

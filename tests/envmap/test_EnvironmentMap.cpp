@@ -1,0 +1,134 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "envmap/EnvironmentMap.h"
+
+using namespace envgi;
+
+namespace {
+Image gradientMap(int w, int h) {
+  Image img(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) img.set(x, y, Color(float(x), float(y), 1.f));
+  return img;
+}
+std::string asset(const std::string& p) { return std::string(ENVGI_ASSETS_DIR) + "/" + p; }
+}  // namespace
+
+TEST(EnvironmentMap, MitsubaDirectionConvention) {
+  // Row 0 is +Y, the centre column looks along +Z, u = 0.25 along +X.
+  auto near = [](Vec3f a, Vec3f b) { return length(a - b) < 1e-5f; };
+  EXPECT_TRUE(near(EnvironmentMapView::uvToDir({0.5f, 0.5f}), {0, 0, 1}));
+  EXPECT_TRUE(near(EnvironmentMapView::uvToDir({0.25f, 0.5f}), {1, 0, 0}));
+  EXPECT_TRUE(near(EnvironmentMapView::uvToDir({0.f, 0.5f}), {0, 0, -1}));
+  EXPECT_TRUE(near(EnvironmentMapView::uvToDir({0.3f, 0.f}), {0, 1, 0}));
+  for (float u = 0.01f; u < 1.f; u += 0.031f)
+    for (float v = 0.01f; v < 1.f; v += 0.029f) {
+      Vec2f back = EnvironmentMapView::dirToUV(EnvironmentMapView::uvToDir({u, v}));
+      EXPECT_NEAR(back.x, u, 1e-5f);
+      EXPECT_NEAR(back.y, v, 1e-5f);
+    }
+}
+
+TEST(EnvironmentMap, BilinearIsSeamlessAndSaneAtPoles) {
+  EnvironmentMap env(gradientMap(16, 8), {});
+  auto v = env.view();
+  // Across the seam both sides blend the first and last column.
+  Color a = v.lookupUV({1e-6f, 0.4f}), b = v.lookupUV({1.f - 1e-6f, 0.4f});
+  EXPECT_NEAR(a.x, b.x, 1e-3f);
+  EXPECT_NEAR(a.x, 7.5f, 1e-3f);  // halfway between column 15 and column 0
+  for (Vec3f d : {Vec3f(0, 1, 0), Vec3f(0, -1, 0), Vec3f(0, 1e-9f, 0)}) {
+    Color c = v.eval(normalize(d));
+    EXPECT_TRUE(isFiniteVec(c));
+  }
+  // Pixel centres return pixel values.
+  Color c = v.lookupUV({(3 + 0.5f) / 16, (2 + 0.5f) / 8});
+  EXPECT_NEAR(c.x, 3.f, 1e-5f);
+  EXPECT_NEAR(c.y, 2.f, 1e-5f);
+}
+
+TEST(EnvironmentMap, RotationAndScale) {
+  EnvironmentMapOptions o;
+  o.toWorld = rotate(Vec3f(0, 1, 0), 90.f);
+  o.scale = 2.f;
+  EnvironmentMap env(gradientMap(64, 32), o);
+  auto v = env.view();
+  Vec3f local = EnvironmentMapView::uvToDir({0.3f, 0.6f});
+  Vec3f world = o.toWorld.vector(local);
+  Color expect = v.lookupUV({0.3f, 0.6f});
+  Color got = v.eval(world);
+  EXPECT_NEAR(got.x, expect.x, 1e-3f);
+  EXPECT_NEAR(got.y, expect.y, 1e-3f);
+  // scale doubles the pixel value
+  EXPECT_NEAR(v.lookupUV({(5 + 0.5f) / 64, (4 + 0.5f) / 32}).x, 10.f, 1e-4f);
+}
+
+TEST(EnvironmentMap, InvalidPixelsAreZeroedAndCounted) {
+  Image img = gradientMap(8, 4);
+  img.rgb[0] = NAN;
+  img.rgb[4] = -3.f;
+  img.rgb[8] = INFINITY;
+  EnvironmentMap env(std::move(img), {});
+  EXPECT_EQ(env.invalidPixels(), 3u);
+  EXPECT_EQ(env.image().rgb[0], 0.f);
+  EXPECT_EQ(env.image().rgb[4], 0.f);
+  EXPECT_EQ(env.image().rgb[8], 0.f);
+  EXPECT_EQ(env.stats().invalidPixels, 3u);
+}
+
+TEST(EnvironmentMap, AllBlackIsAValidLightOfZeroPower) {
+  Image img(16, 8);
+  EnvironmentMap env(std::move(img), {});
+  EXPECT_EQ(env.luminancePower(), 0.f);
+  auto v = env.view();
+  for (int s = 0; s < 5; ++s) {
+    EnvSample es = v.sample(EnvStrategy(s), {0.37f, 0.61f});
+    EXPECT_TRUE(std::isfinite(es.pdf));
+    EXPECT_TRUE(isBlack(es.radiance));
+    EXPECT_TRUE(isFiniteVec(es.dir));
+  }
+  EXPECT_EQ(env.stats().top1PercentEnergy, 0.f);
+}
+
+TEST(EnvironmentMap, ConstantMapStatistics) {
+  EnvironmentMap env = EnvironmentMap::constant(Color(1.f));
+  EnvironmentMapStats s = env.stats();
+  EXPECT_NEAR(s.power.x, 4.f * kPi, 0.02f);  // integral of 1 over the sphere
+  EXPECT_NEAR(env.luminancePower(), 4.f * kPi, 0.02f);
+  EXPECT_NEAR(s.lumMeanSolidAngle, 1.f, 1e-5f);
+  EXPECT_NEAR(s.top1PercentEnergy, 0.01f, 0.01f);
+}
+
+TEST(EnvironmentMap, NegativeScaleIsAnError) {
+  EnvironmentMapOptions o;
+  o.scale = -1.f;
+  EXPECT_THROW(EnvironmentMap(gradientMap(8, 4), o), std::runtime_error);
+}
+
+// The HDR and the PFM copy of Grace Cathedral agree: the PFM reader honours bottom-up rows,
+// and the brightest pixel lands where the asset README puts it.
+TEST(EnvironmentMap, GraceHdrAndPfmAgree) {
+  std::string hdr = asset("envmaps/grace/grace_latlong.hdr"), pfm = asset("envmaps/grace/grace_latlong.pfm");
+  if (!std::filesystem::exists(hdr) || !std::filesystem::exists(pfm)) GTEST_SKIP() << "Grace maps not in " << ENVGI_ASSETS_DIR;
+  EnvironmentMap a = EnvironmentMap::load(hdr), b = EnvironmentMap::load(pfm);
+  ASSERT_EQ(a.image().width, 1024);
+  ASSERT_EQ(b.image().height, 512);
+  double diff = 0.0, mag = 0.0;
+  for (size_t i = 0; i < a.image().rgb.size(); ++i) {
+    diff += std::fabs(a.image().rgb[i] - b.image().rgb[i]);
+    mag += std::fabs(b.image().rgb[i]);
+  }
+  EXPECT_LT(diff / mag, 0.01);
+  int bx = 0, by = 0;
+  float best = -1.f;
+  for (int y = 0; y < 512; ++y)
+    for (int x = 0; x < 1024; ++x) {
+      float l = luminance(b.image().at(x, y));
+      if (l > best) { best = l; bx = x; by = y; }
+    }
+  EXPECT_EQ(bx, 502);
+  EXPECT_EQ(by, 129);
+  EnvironmentMapStats st = b.stats();
+  EXPECT_NEAR(st.lumMeanSolidAngle, 0.0147f, 0.0005f);
+}

@@ -1,0 +1,91 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "image/Image.h"
+
+using namespace envgi;
+namespace fs = std::filesystem;
+
+namespace {
+fs::path tmpDir() {
+  static int counter = 0;
+  fs::path d = fs::temp_directory_path() /
+               ("envgi_image_test_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
+  fs::create_directories(d);
+  return d;
+}
+Image pattern() {
+  Image img(5, 3);
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 5; ++x) img.set(x, y, Color(x * 0.5f, y * 2.f, 100.f + x));
+  return img;
+}
+}  // namespace
+
+TEST(Image, FloatFormatsRoundTrip) {
+  fs::path d = tmpDir();
+  Image img = pattern();
+  for (std::string ext : {".exr", ".pfm", ".hdr"}) {
+    std::string p = (d / ("a" + ext)).string();
+    saveImage(img, p);
+    Image back = loadImage(p);
+    ASSERT_EQ(back.width, 5);
+    ASSERT_EQ(back.height, 3);
+    float tol = ext == ".hdr" ? 0.01f : 1e-6f;
+    for (int y = 0; y < 3; ++y)
+      for (int x = 0; x < 5; ++x)
+        for (int k = 0; k < 3; ++k)
+          EXPECT_NEAR(back.at(x, y)[k], img.at(x, y)[k], tol * std::max(1.f, img.at(x, y)[k])) << ext;
+  }
+  fs::remove_all(d);
+}
+
+TEST(Image, PngIsSrgbAfterExposure) {
+  EXPECT_NEAR(toneMapChannel(1.f, {}), 1.f, 1e-6f);
+  EXPECT_NEAR(toneMapChannel(0.5f, {}), 0.7353569f, 1e-4f);
+  SaveOptions o;
+  o.exposure = 1.f;
+  EXPECT_NEAR(toneMapChannel(0.25f, o), 0.7353569f, 1e-4f);
+  EXPECT_EQ(toneMapChannel(NAN, {}), 0.f);
+  o.toneMap = ToneMap::Aces;
+  EXPECT_LT(toneMapChannel(100.f, o), 1.0001f);
+  fs::path d = tmpDir();
+  saveImage(pattern(), (d / "a.png").string());
+  Image back = loadImage((d / "a.png").string());
+  EXPECT_EQ(back.width, 5);
+  fs::remove_all(d);
+}
+
+TEST(Image, MissingTruncatedAndCorruptFilesThrow) {
+  fs::path d = tmpDir();
+  EXPECT_THROW(loadImage((d / "nope.hdr").string()), std::runtime_error);
+  // Garbage with an image extension.
+  { std::ofstream f(d / "bad.exr"); f << "this is not an image"; }
+  EXPECT_THROW(loadImage((d / "bad.exr").string()), std::runtime_error);
+  // A real HDR cut in half.
+  Image big(64, 32);
+  for (size_t i = 0; i < big.rgb.size(); ++i) big.rgb[i] = float(i % 97) * 0.1f;
+  saveImage(big, (d / "full.hdr").string());
+  saveImage(big, (d / "full.pfm").string());
+  saveImage(big, (d / "full.exr").string());
+  for (std::string ext : {".hdr", ".pfm", ".exr"}) {
+    auto size = fs::file_size(d / ("full" + ext));
+    fs::copy_file(d / ("full" + ext), d / ("cut" + ext));
+    fs::resize_file(d / ("cut" + ext), size / 2);
+    EXPECT_THROW(loadImage((d / ("cut" + ext)).string()), std::runtime_error) << ext;
+  }
+  fs::remove_all(d);
+}
+
+TEST(Image, FailedWriteLeavesNoFile) {
+  fs::path d = tmpDir();
+  EXPECT_THROW(saveImage(pattern(), (d / "missing_dir" / "x.exr").string()), std::runtime_error);
+  EXPECT_THROW(saveImage(pattern(), (d / "x.unknownext").string()), std::runtime_error);
+  EXPECT_FALSE(fs::exists(d / "x.unknownext"));
+  size_t n = 0;
+  for (auto& e : fs::directory_iterator(d)) { (void)e; ++n; }
+  EXPECT_EQ(n, 0u) << "no temporary files left behind";
+  fs::remove_all(d);
+}

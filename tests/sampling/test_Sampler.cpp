@@ -1,0 +1,75 @@
+#include <gtest/gtest.h>
+
+#include <set>
+#include <vector>
+
+#include "sampling/Sampler.h"
+
+using namespace envgi;
+
+namespace {
+std::vector<Vec2f> draw(SamplerType t, uint32_t spp, uint32_t seed, uint64_t pixel) {
+  Sampler s;
+  s.type = t;
+  s.spp = spp;
+  s.seed = seed;
+  std::vector<Vec2f> out;
+  for (uint32_t i = 0; i < spp; ++i) {
+    s.start(pixel, i);
+    out.push_back(s.get2D());
+  }
+  return out;
+}
+}  // namespace
+
+class SamplerTypes : public ::testing::TestWithParam<SamplerType> {};
+
+TEST_P(SamplerTypes, ReproducibleAndInRange) {
+  auto a = draw(GetParam(), 64, 5, 17), b = draw(GetParam(), 64, 5, 17), c = draw(GetParam(), 64, 6, 17);
+  bool differs = false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].x, b[i].x);
+    EXPECT_EQ(a[i].y, b[i].y);
+    EXPECT_GE(a[i].x, 0.f);
+    EXPECT_LT(a[i].x, 1.f);
+    EXPECT_GE(a[i].y, 0.f);
+    EXPECT_LT(a[i].y, 1.f);
+    differs = differs || a[i].x != c[i].x;
+  }
+  EXPECT_TRUE(differs) << "another seed must give other samples";
+}
+
+TEST_P(SamplerTypes, MeanIsOneHalf) {
+  double sx = 0, sy = 0;
+  int n = 0;
+  for (uint64_t px = 0; px < 200; ++px)
+    for (Vec2f p : draw(GetParam(), 16, 1, px)) {
+      sx += p.x;
+      sy += p.y;
+      ++n;
+    }
+  EXPECT_NEAR(sx / n, 0.5, 0.01);
+  EXPECT_NEAR(sy / n, 0.5, 0.01);
+}
+
+INSTANTIATE_TEST_SUITE_P(All, SamplerTypes,
+                         ::testing::Values(SamplerType::Independent, SamplerType::Stratified, SamplerType::Sobol));
+
+// Stratified and Sobol put exactly one of 16 samples into each cell of a 4x4 grid.
+TEST(Sampler, StratifiedAndSobolAreStratified) {
+  for (SamplerType t : {SamplerType::Stratified, SamplerType::Sobol}) {
+    auto pts = draw(t, 16, 3, 99);
+    std::set<int> cells;
+    for (Vec2f p : pts) cells.insert(int(p.x * 4) + 4 * int(p.y * 4));
+    EXPECT_EQ(cells.size(), 16u) << int(t);
+  }
+}
+
+TEST(Sampler, PermutationIsBijective) {
+  for (uint32_t n : {1u, 7u, 16u, 100u}) {
+    std::set<uint32_t> seen;
+    for (uint32_t i = 0; i < n; ++i) seen.insert(permutationElement(i, n, 12345u));
+    EXPECT_EQ(seen.size(), n);
+    EXPECT_LT(*seen.rbegin(), n);
+  }
+}
