@@ -7,7 +7,7 @@ set -euo pipefail
 PKGS=(
   build-essential cmake ninja-build pkg-config git ca-certificates
   libembree-dev libtbb-dev libopenimageio-dev openimageio-tools
-  libassimp-dev libpugixml-dev libcli11-dev nlohmann-json3-dev
+  libtinyobjloader-dev libpugixml-dev libcli11-dev nlohmann-json3-dev
   libfmt-dev libspdlog-dev libnanoflann-dev
   libgtest-dev libbenchmark-dev
   python3 python3-matplotlib python3-numpy

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
     spdlog::set_level(verbose ? spdlog::level::debug : (quiet ? spdlog::level::warn : spdlog::level::info));
   });
   envgi::cli::addEnvmapCommands(app);
+  envgi::cli::addRenderCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -9,11 +9,20 @@ namespace envgi {
 
 namespace fs = std::filesystem;
 
+std::string temporarySibling(const std::string& path, const std::string& suffix) {
+  fs::path p(path);
+  fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  // Built with append(): GCC 12 warns falsely (-Wrestrict) on chained operator+ here.
+  std::string name(".");
+  name.append(p.filename().string()).append(".tmp").append(std::to_string(::getpid())).append(suffix);
+  return (dir / name).string();
+}
+
 void writeFileAtomically(const std::string& path, const std::string& content) {
   fs::path p(path);
   fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir)) throw std::runtime_error("cannot write '" + path + "': directory does not exist");
-  fs::path tmp = dir / ("." + p.filename().string() + ".tmp" + std::to_string(::getpid()));
+  fs::path tmp = temporarySibling(path, "");
   {
     std::ofstream f(tmp, std::ios::binary);
     if (!f) throw std::runtime_error("cannot write '" + path + "'");

@@ -5,6 +5,9 @@
 
 namespace envgi {
 
+// A hidden temporary name beside `path` ending in `suffix`, unique to this process.
+std::string temporarySibling(const std::string& path, const std::string& suffix);
+
 // Writes `content` to a hidden temporary file beside `path`, then renames it into place.
 void writeFileAtomically(const std::string& path, const std::string& content);
 

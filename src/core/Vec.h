@@ -20,6 +20,9 @@ struct Vec3f {
   ENVGI_HD float& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
 };
 
+ENVGI_INLINE Vec2f operator+(Vec2f a, Vec2f b) { return {a.x + b.x, a.y + b.y}; }
+ENVGI_INLINE Vec2f operator*(Vec2f a, float s) { return {a.x * s, a.y * s}; }
+
 ENVGI_INLINE Vec3f operator+(Vec3f a, Vec3f b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
 ENVGI_INLINE Vec3f operator-(Vec3f a, Vec3f b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
 ENVGI_INLINE Vec3f operator-(Vec3f a) { return {-a.x, -a.y, -a.z}; }

@@ -1,5 +1,7 @@
 #include "image/Image.h"
 
+#include "core/Files.h"
+
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -79,7 +81,7 @@ void saveImage(const Image& img, const std::string& path, const SaveOptions& opt
   fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir)) throw std::runtime_error("cannot write '" + path + "': directory does not exist");
   // Same extension so OpenImageIO picks the same writer; hidden so a crash leaves no look-alike.
-  fs::path tmp = dir / ("." + p.filename().string() + ".tmp" + std::to_string(::getpid()) + ext);
+  fs::path tmp = temporarySibling(path, ext);
 
   auto commit = [&] {
     std::error_code ec;

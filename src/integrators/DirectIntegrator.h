@@ -1,0 +1,78 @@
+// Direct illumination with a chosen environment strategy: emitterSamples light samples and
+// bsdfSamples BSDF samples per shading point, combined with the power heuristic weighted by
+// the sample counts (Mitsuba's `direct`). With one of the two counts at zero it is the pure
+// estimator of the other, so the paper's strategies can be compared on the same image.
+#pragma once
+
+#include "integrators/LightSampling.h"
+#include "sampling/Mis.h"
+#include "sampling/Sampler.h"
+
+namespace envgi {
+
+struct DirectParams {
+  int emitterSamples = 1;
+  int bsdfSamples = 1;
+  bool hideEmitters = false;
+  EnvStrategy envStrategy = EnvStrategy::Importance;
+};
+
+template <class Tracer>
+ENVGI_HD Color directTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& smp, const DirectParams& dp,
+                           uint64_t* rayCount) {
+  Hit h;
+  ++*rayCount;
+  if (!tracer.intersect(ray, &h))
+    return (sc.hasEnvironment && !dp.hideEmitters) ? sc.env.eval(ray.d) : Color(0.f);
+  SurfaceInteraction si = sc.interaction(ray, h);
+  Vec3f wo = -ray.d;
+  Color L = dp.hideEmitters ? Color(0.f) : sc.emitted(si, wo);
+  const Bsdf& bsdf = sc.bsdfs[si.bsdf];
+  Vec3f woLocal = si.shading.toLocal(wo);
+  Vec3f axis = cosineAxis(si, wo);
+  float nE = float(dp.emitterSamples), nB = float(dp.bsdfSamples);
+
+  for (int i = 0; i < dp.emitterSamples; ++i) {
+    float uSel = smp.get1D();
+    Vec2f uL = smp.get2D(), uL2 = smp.get2D();
+    LightSample ls;
+    if (bsdfIsDelta(bsdf) || !sampleLight(sc, si, axis, dp.envStrategy, uSel, uL, uL2, &ls)) continue;
+    Vec3f wiLocal = si.shading.toLocal(ls.dir);
+    Color f = bsdfEval(bsdf, woLocal, wiLocal);
+    if (isBlack(f) || isBlack(ls.radiance)) continue;
+    Vec3f o = offsetRayOrigin(si.p, si.ng, ls.dir, si.t);
+    float tMax = ls.environment ? INFINITY : ls.dist * (1.f - 1e-4f) - length(o - si.p);
+    ++*rayCount;
+    if (tracer.occluded(o, ls.dir, tMax)) continue;
+    float w = nB > 0.f ? powerHeuristic(nE, ls.pdf, nB, bsdfPdf(bsdf, woLocal, wiLocal)) : 1.f;
+    L += f * ls.radiance * (w / (ls.pdf * nE));
+  }
+
+  for (int j = 0; j < dp.bsdfSamples; ++j) {
+    BsdfSample bs;
+    float uc = smp.get1D();
+    Vec2f ub = smp.get2D();
+    if (!bsdfSample(bsdf, woLocal, uc, ub, &bs)) continue;
+    Vec3f wi = si.shading.toWorld(bs.wi);
+    Ray r2{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};
+    Hit h2;
+    ++*rayCount;
+    Color Le(0.f);
+    float lightPdf = 0.f;
+    if (!tracer.intersect(r2, &h2)) {
+      if (!sc.hasEnvironment) continue;
+      Le = sc.env.eval(wi);
+      lightPdf = envLightPdf(sc, dp.envStrategy, wi, axis);
+    } else {
+      SurfaceInteraction s2 = sc.interaction(r2, h2);
+      Le = sc.emitted(s2, -wi);
+      if (isBlack(Le)) continue;
+      lightPdf = areaLightPdf(sc, s2.light, si.p, s2.p, s2.ng);
+    }
+    float w = (bs.delta || nE == 0.f) ? 1.f : powerHeuristic(nB, bs.pdf, nE, lightPdf);
+    L += bs.weight * Le * (w / nB);
+  }
+  return L;
+}
+
+}  // namespace envgi

@@ -1,0 +1,72 @@
+// Next-event estimation: choosing the environment or an area light, and the densities a
+// BSDF-sampled direction would have had under that choice (for MIS).
+#pragma once
+
+#include "scene/SceneView.h"
+
+namespace envgi {
+
+struct LightSample {
+  Vec3f dir;            // from the shading point towards the light
+  float dist = INFINITY;
+  Color radiance;
+  float pdf = 0.f;      // solid angle, selection included
+  bool environment = false;
+};
+
+// The cosine strategy samples about the normal on the side the viewer is on.
+ENVGI_INLINE Vec3f cosineAxis(const SurfaceInteraction& si, Vec3f wo) {
+  return dot(si.shading.n, wo) >= 0.f ? si.shading.n : -si.shading.n;
+}
+
+ENVGI_INLINE float envLightPdf(const SceneView& sc, EnvStrategy s, Vec3f dir, Vec3f axis) {
+  if (!sc.hasEnvironment) return 0.f;
+  return sc.envSelectProb() * sc.env.pdf(s, dir, axis);
+}
+
+// Solid-angle density of reaching light primitive `light` at point lp (normal ln) from p.
+ENVGI_INLINE float areaLightPdf(const SceneView& sc, int light, Vec3f p, Vec3f lp, Vec3f ln) {
+  if (light < 0 || sc.lightCount == 0) return 0.f;
+  Vec3f d = lp - p;
+  float dist2 = lengthSq(d);
+  float cosL = std::fabs(dot(ln, d)) / std::sqrt(dist2);
+  if (cosL <= 0.f) return 0.f;
+  float sel = 1.f - sc.envSelectProb();
+  return sel * sc.lightSelect.pmf[light] / sc.lights[light].area * dist2 / cosL;
+}
+
+ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si, Vec3f axis, EnvStrategy strategy,
+                              float uSel, Vec2f u, Vec2f u2, LightSample* ls) {
+  float pe = sc.envSelectProb();
+  if (uSel < pe) {
+    EnvSample es = sc.env.sample(strategy, u, axis);
+    if (!(es.pdf > 0.f)) return false;
+    ls->dir = es.dir;
+    ls->dist = INFINITY;
+    ls->radiance = es.radiance;
+    ls->pdf = es.pdf * pe;
+    ls->environment = true;
+    return true;
+  }
+  if (sc.lightCount == 0) return false;
+  float pmf;
+  int li = sc.lightSelect.sample(u2.x, u2.y, &pmf, nullptr);
+  const LightPrim& lp = sc.lights[li];
+  Vec3f p, n;
+  sampleLightPrim(sc, lp, u, &p, &n);
+  Vec3f d = p - si.p;
+  float dist2 = lengthSq(d);
+  if (dist2 <= 0.f) return false;
+  float dist = std::sqrt(dist2);
+  d = d / dist;
+  float cosL = -dot(n, d);
+  if (cosL <= 0.f) return false;  // one-sided emitters face along their normal
+  ls->dir = d;
+  ls->dist = dist;
+  ls->radiance = lp.radiance;
+  ls->pdf = (1.f - pe) * pmf / lp.area * dist2 / cosL;
+  ls->environment = false;
+  return ls->pdf > 0.f;
+}
+
+}  // namespace envgi

@@ -1,0 +1,293 @@
+// The BSDFs of the supported Mitsuba subset as one plain struct with tagged dispatch (no
+// virtual calls), usable in CUDA kernels. All directions are in the local shading frame
+// (z = shading normal), both pointing away from the surface. As in Mitsuba, eval() returns
+// f(wo, wi) |cos theta_i| of the non-delta lobes; delta lobes are reached only by sample().
+#pragma once
+
+#include "materials/Fresnel.h"
+#include "materials/Microfacet.h"
+#include "sampling/Warp.h"
+
+namespace envgi {
+
+enum class BsdfType : int {
+  Diffuse = 0,
+  Conductor,       // smooth; perfectMirror or complex Fresnel
+  RoughConductor,  // GGX
+  Dielectric,      // smooth glass
+  ThinDielectric,  // thin sheet: reflection or straight transmission
+  RoughDielectric, // GGX glass (Walter et al. 2007)
+  Plastic,         // smooth dielectric coating over a diffuse base
+  RoughPlastic,    // GGX coating over a diffuse base
+};
+
+struct Bsdf {
+  BsdfType type = BsdfType::Diffuse;
+  bool twoSided = false;
+  bool perfectMirror = false;            // conductor material "none"
+  Color reflectance{0.5f};               // diffuse (and plastic base) albedo
+  Color specularReflectance{1.f};
+  Color specularTransmittance{1.f};
+  Color eta{0.f}, k{1.f};                // conductor complex index, per channel
+  float alpha = 0.1f;                    // GGX roughness
+  float ior = 1.5046f;                   // interior / exterior index of refraction
+  float fdrInt = 0.f;                    // plastic: diffuse Fresnel reflectance seen from inside
+  float specularSamplingWeight = 0.5f;   // plastic: share of samples given to the coating
+};
+
+struct BsdfSample {
+  Vec3f wi;
+  Color weight;      // f |cos| / pdf
+  float pdf = 0.f;   // for a delta lobe: the probability of choosing it
+  bool delta = false;
+};
+
+// True when every lobe is a delta: next-event estimation is pointless there.
+ENVGI_INLINE bool bsdfIsDelta(const Bsdf& b) {
+  return b.type == BsdfType::Conductor || b.type == BsdfType::Dielectric || b.type == BsdfType::ThinDielectric;
+}
+ENVGI_INLINE bool bsdfTransmits(const Bsdf& b) {
+  return b.type == BsdfType::Dielectric || b.type == BsdfType::ThinDielectric || b.type == BsdfType::RoughDielectric;
+}
+
+namespace detail {
+
+ENVGI_INLINE float plasticSpecularProb(const Bsdf& b, float fo) {
+  float ps = fo * b.specularSamplingWeight, pd = (1.f - fo) * (1.f - b.specularSamplingWeight);
+  return ps + pd > 0.f ? ps / (ps + pd) : 0.f;
+}
+
+// Diffuse base under a coating (Mitsuba's plastic, linear mode).
+ENVGI_INLINE Color plasticDiffuse(const Bsdf& b, Vec3f wo, Vec3f wi) {
+  float ti = 1.f - fresnelDielectric(wi.z, b.ior), to = 1.f - fresnelDielectric(wo.z, b.ior);
+  return b.reflectance * (kInvPi * wi.z * ti * to / ((1.f - b.fdrInt) * b.ior * b.ior));
+}
+
+// Rough dielectric: generalised half vector and the relative index along wo.
+ENVGI_INLINE bool roughDielectricHalf(const Bsdf& b, Vec3f wo, Vec3f wi, Vec3f* wm, float* etap) {
+  float co = wo.z, ci = wi.z;
+  if (co == 0.f || ci == 0.f) return false;
+  bool reflect = co * ci > 0.f;
+  *etap = reflect ? 1.f : (co > 0.f ? b.ior : 1.f / b.ior);
+  Vec3f m = wi * (*etap) + wo;
+  if (lengthSq(m) == 0.f) return false;
+  m = normalize(m);
+  if (m.z < 0.f) m = -m;
+  // Microfacets seen from behind contribute nothing.
+  if (dot(m, wi) * ci < 0.f || dot(m, wo) * co < 0.f) return false;
+  *wm = m;
+  return true;
+}
+
+}  // namespace detail
+
+ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
+  if (b.twoSided && wo.z < 0.f) {
+    wo.z = -wo.z;
+    wi.z = -wi.z;
+  }
+  switch (b.type) {
+    case BsdfType::Diffuse:
+      if (wo.z <= 0.f || wi.z <= 0.f) return Color(0.f);
+      return b.reflectance * (kInvPi * wi.z);
+    case BsdfType::RoughConductor: {
+      if (wo.z <= 0.f || wi.z <= 0.f) return Color(0.f);
+      Vec3f m = normalize(wo + wi);
+      GGX d{b.alpha};
+      Color F = b.perfectMirror ? Color(1.f) : fresnelConductor(dot(wi, m), b.eta, b.k);
+      return b.specularReflectance * F * (d.D(m) * d.G(wo, wi) / (4.f * wo.z));
+    }
+    case BsdfType::RoughDielectric: {
+      Vec3f m;
+      float etap;
+      if (!detail::roughDielectricHalf(b, wo, wi, &m, &etap)) return Color(0.f);
+      GGX d{b.alpha};
+      float F = fresnelDielectric(dot(wo, m), b.ior);
+      float co = std::fabs(wo.z);
+      if (wo.z * wi.z > 0.f) return b.specularReflectance * (d.D(m) * d.G(wo, wi) * F / (4.f * co));
+      float denom = sqr(dot(wi, m) + dot(wo, m) / etap) * co;
+      float ft = d.D(m) * (1.f - F) * d.G(wo, wi) * std::fabs(dot(wi, m) * dot(wo, m) / denom);
+      return b.specularTransmittance * (ft / (etap * etap));  // radiance is compressed by 1/eta^2
+    }
+    case BsdfType::Plastic:
+      if (wo.z <= 0.f || wi.z <= 0.f) return Color(0.f);
+      return detail::plasticDiffuse(b, wo, wi);
+    case BsdfType::RoughPlastic: {
+      if (wo.z <= 0.f || wi.z <= 0.f) return Color(0.f);
+      Vec3f m = normalize(wo + wi);
+      GGX d{b.alpha};
+      float F = fresnelDielectric(dot(wi, m), b.ior);
+      Color spec = b.specularReflectance * (F * d.D(m) * d.G(wo, wi) / (4.f * wo.z));
+      return spec + detail::plasticDiffuse(b, wo, wi);
+    }
+    default:
+      return Color(0.f);  // pure delta lobes
+  }
+}
+
+ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
+  if (b.twoSided && wo.z < 0.f) {
+    wo.z = -wo.z;
+    wi.z = -wi.z;
+  }
+  switch (b.type) {
+    case BsdfType::Diffuse:
+      if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
+      return cosineHemispherePdf(wi.z);
+    case BsdfType::RoughConductor: {
+      if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
+      Vec3f m = normalize(wo + wi);
+      return GGX{b.alpha}.visiblePdf(wo, m) / (4.f * std::fabs(dot(wo, m)));
+    }
+    case BsdfType::RoughDielectric: {
+      Vec3f m;
+      float etap;
+      if (!detail::roughDielectricHalf(b, wo, wi, &m, &etap)) return 0.f;
+      GGX d{b.alpha};
+      float R = fresnelDielectric(dot(wo, m), b.ior), T = 1.f - R;
+      if (wo.z * wi.z > 0.f) return d.visiblePdf(wo, m) / (4.f * std::fabs(dot(wo, m))) * R;
+      float dwmdwi = std::fabs(dot(wi, m)) / sqr(dot(wi, m) + dot(wo, m) / etap);
+      return d.visiblePdf(wo, m) * dwmdwi * T;
+    }
+    case BsdfType::Plastic: {
+      if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
+      float ps = detail::plasticSpecularProb(b, fresnelDielectric(wo.z, b.ior));
+      return (1.f - ps) * cosineHemispherePdf(wi.z);
+    }
+    case BsdfType::RoughPlastic: {
+      if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
+      float ps = detail::plasticSpecularProb(b, fresnelDielectric(wo.z, b.ior));
+      Vec3f m = normalize(wo + wi);
+      float spec = GGX{b.alpha}.visiblePdf(wo, m) / (4.f * std::fabs(dot(wo, m)));
+      return ps * spec + (1.f - ps) * cosineHemispherePdf(wi.z);
+    }
+    default:
+      return 0.f;
+  }
+}
+
+// uc picks a lobe, u the direction within it. Returns false when no direction is produced.
+ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s) {
+  bool flip = b.twoSided && wo.z < 0.f;
+  if (flip) wo.z = -wo.z;
+  bool ok = false;
+  s->delta = false;
+  switch (b.type) {
+    case BsdfType::Diffuse: {
+      if (wo.z <= 0.f) return false;
+      s->wi = sampleCosineHemisphere(u);
+      s->pdf = cosineHemispherePdf(s->wi.z);
+      s->weight = b.reflectance;
+      ok = s->pdf > 0.f;
+      break;
+    }
+    case BsdfType::Conductor: {
+      if (wo.z <= 0.f) return false;
+      s->wi = Vec3f(-wo.x, -wo.y, wo.z);
+      s->pdf = 1.f;
+      s->delta = true;
+      s->weight = b.specularReflectance * (b.perfectMirror ? Color(1.f) : fresnelConductor(wo.z, b.eta, b.k));
+      ok = true;
+      break;
+    }
+    case BsdfType::RoughConductor: {
+      if (wo.z <= 0.f) return false;
+      Vec3f m = GGX{b.alpha}.sampleVisible(wo, u);
+      s->wi = reflect(wo, m);
+      if (s->wi.z <= 0.f) return false;
+      s->pdf = bsdfPdf(b, wo, s->wi);
+      if (!(s->pdf > 0.f)) return false;
+      s->weight = bsdfEval(b, wo, s->wi) / s->pdf;
+      ok = true;
+      break;
+    }
+    case BsdfType::Dielectric: {
+      float R = fresnelDielectric(wo.z, b.ior), T = 1.f - R;
+      s->delta = true;
+      if (uc < R) {
+        s->wi = Vec3f(-wo.x, -wo.y, wo.z);
+        s->pdf = R;
+        s->weight = b.specularReflectance;
+      } else {
+        float etap = wo.z > 0.f ? b.ior : 1.f / b.ior;
+        Vec3f n = wo.z > 0.f ? Vec3f(0.f, 0.f, 1.f) : Vec3f(0.f, 0.f, -1.f);
+        if (!refractDir(wo, n, etap, &s->wi)) return false;
+        s->pdf = T;
+        s->weight = b.specularTransmittance / (etap * etap);
+      }
+      ok = true;
+      break;
+    }
+    case BsdfType::ThinDielectric: {
+      float R = fresnelDielectric(std::fabs(wo.z), b.ior), T = 1.f - R;
+      if (R < 1.f) {  // inter-reflections inside the sheet
+        R += T * T * R / (1.f - R * R);
+        T = 1.f - R;
+      }
+      s->delta = true;
+      if (uc < R) {
+        s->wi = Vec3f(-wo.x, -wo.y, wo.z);
+        s->pdf = R;
+        s->weight = b.specularReflectance;
+      } else {
+        s->wi = -wo;
+        s->pdf = T;
+        s->weight = b.specularTransmittance;
+      }
+      ok = true;
+      break;
+    }
+    case BsdfType::RoughDielectric: {
+      if (wo.z == 0.f) return false;
+      GGX d{b.alpha};
+      Vec3f m = d.sampleVisible(wo, u);
+      float R = fresnelDielectric(dot(wo, m), b.ior);
+      if (uc < R) {
+        s->wi = reflect(wo, m);
+        if (s->wi.z * wo.z <= 0.f) return false;
+      } else {
+        float c = dot(wo, m), e = b.ior;
+        Vec3f n = m;
+        if (c < 0.f) {
+          e = 1.f / b.ior;
+          n = -m;
+        }
+        if (!refractDir(wo, n, e, &s->wi) || s->wi.z * wo.z >= 0.f) return false;
+      }
+      s->pdf = bsdfPdf(b, wo, s->wi);
+      if (!(s->pdf > 0.f)) return false;
+      s->weight = bsdfEval(b, wo, s->wi) / s->pdf;
+      ok = true;
+      break;
+    }
+    case BsdfType::Plastic:
+    case BsdfType::RoughPlastic: {
+      if (wo.z <= 0.f) return false;
+      float fo = fresnelDielectric(wo.z, b.ior);
+      float ps = detail::plasticSpecularProb(b, fo);
+      if (b.type == BsdfType::Plastic && uc < ps) {
+        s->wi = Vec3f(-wo.x, -wo.y, wo.z);
+        s->pdf = ps;
+        s->delta = true;
+        s->weight = b.specularReflectance * (fo / ps);
+        ok = true;
+        break;
+      }
+      if (b.type == BsdfType::RoughPlastic && uc < ps) {
+        s->wi = reflect(wo, GGX{b.alpha}.sampleVisible(wo, u));
+      } else {
+        s->wi = sampleCosineHemisphere(u);
+      }
+      if (s->wi.z <= 0.f) return false;
+      s->pdf = bsdfPdf(b, wo, s->wi);
+      if (!(s->pdf > 0.f)) return false;
+      s->weight = bsdfEval(b, wo, s->wi) / s->pdf;
+      ok = true;
+      break;
+    }
+  }
+  if (ok && flip) s->wi.z = -s->wi.z;
+  return ok && isFiniteVec(s->weight);
+}
+
+}  // namespace envgi

@@ -1,0 +1,51 @@
+// Mitsuba's perspective sensor: looks along +z of its frame, +y up; to_world places it.
+#pragma once
+
+#include "core/Transform.h"
+#include "scene/Ray.h"
+
+namespace envgi {
+
+enum class FilterType : int { Box = 0, Tent = 1, Gaussian = 2 };
+
+struct Camera {
+  Transform toWorld;
+  int width = 512, height = 512;
+  float tanHalfX = 0.f, tanHalfY = 0.f;  // half extent of the image plane at distance 1
+  float nearClip = 1e-2f, farClip = 1e4f;
+  FilterType filter = FilterType::Gaussian;
+
+  // A ray through film position (x, y) in pixels, (0,0) the top-left corner of the image.
+  ENVGI_HD Ray generateRay(float x, float y) const {
+    float sx = 2.f * x / float(width) - 1.f, sy = 1.f - 2.f * y / float(height);
+    // Camera-space +x is the image's left (lookat builds x = up x dir), so image right is -x.
+    Vec3f d = normalize(Vec3f(-sx * tanHalfX, sy * tanHalfY, 1.f));
+    Ray r;
+    Vec3f dw = normalize(toWorld.vector(d));
+    r.o = toWorld.point(Vec3f(0.f)) + dw * (nearClip / d.z);
+    r.d = dw;
+    r.tMax = (farClip - nearClip) / d.z;
+    return r;
+  }
+};
+
+// Film offset from the pixel centre, sampled by the reconstruction filter itself, so every
+// sample has weight one (filter importance sampling). box: radius 0.5; tent: radius 1;
+// gaussian: standard deviation 0.5 (Mitsuba's default), not truncated.
+ENVGI_INLINE Vec2f sampleFilter(FilterType f, Vec2f u) {
+  switch (f) {
+    case FilterType::Box: return {u.x - 0.5f, u.y - 0.5f};
+    case FilterType::Tent: {
+      auto tent = [](float x) { return x < 0.5f ? std::sqrt(2.f * x) - 1.f : 1.f - std::sqrt(2.f - 2.f * x); };
+      return {tent(u.x), tent(u.y)};
+    }
+    case FilterType::Gaussian:
+    default: {
+      float r = 0.5f * std::sqrt(-2.f * std::log(fmaxf(1.f - u.x, 1e-12f)));
+      float phi = 2.f * kPi * u.y;
+      return {r * std::cos(phi), r * std::sin(phi)};
+    }
+  }
+}
+
+}  // namespace envgi

@@ -1,0 +1,56 @@
+#include <tiny_obj_loader.h>
+
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+
+#include "scene/TriangleMesh.h"
+
+namespace envgi {
+
+TriangleMesh loadObj(const std::string& path) {
+  if (!std::filesystem::exists(path)) throw std::runtime_error("cannot open OBJ file '" + path + "'");
+  tinyobj::ObjReaderConfig cfg;
+  cfg.triangulate = true;
+  cfg.vertex_color = false;
+  cfg.mtl_search_path = std::filesystem::path(path).parent_path().string();
+  tinyobj::ObjReader reader;
+  if (!reader.ParseFromFile(path, cfg)) {
+    std::string err = reader.Error();
+    while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
+    throw std::runtime_error("OBJ file '" + path + "': " + (err.empty() ? "cannot parse" : err));
+  }
+  const tinyobj::attrib_t& a = reader.GetAttrib();
+  TriangleMesh mesh;
+  mesh.name = path;
+  bool allNormals = true, allUVs = true;
+  for (const auto& s : reader.GetShapes())
+    for (const auto& idx : s.mesh.indices) {
+      allNormals = allNormals && idx.normal_index >= 0;
+      allUVs = allUVs && idx.texcoord_index >= 0;
+    }
+  // OBJ indexes positions, normals and uvs separately: one output vertex per distinct triple.
+  std::map<std::tuple<int, int, int>, uint32_t> remap;
+  auto vertex = [&](const tinyobj::index_t& idx) -> uint32_t {
+    int n = allNormals ? idx.normal_index : -1, t = allUVs ? idx.texcoord_index : -1;
+    auto key = std::make_tuple(idx.vertex_index, n, t);
+    auto it = remap.find(key);
+    if (it != remap.end()) return it->second;
+    if (idx.vertex_index < 0 || size_t(3 * idx.vertex_index + 2) >= a.vertices.size())
+      throw std::runtime_error("OBJ file '" + path + "': vertex index out of range");
+    uint32_t id = uint32_t(mesh.positions.size());
+    mesh.positions.push_back({a.vertices[3 * idx.vertex_index], a.vertices[3 * idx.vertex_index + 1],
+                              a.vertices[3 * idx.vertex_index + 2]});
+    if (n >= 0) mesh.normals.push_back({a.normals[3 * n], a.normals[3 * n + 1], a.normals[3 * n + 2]});
+    if (t >= 0) mesh.uvs.push_back({a.texcoords[2 * t], a.texcoords[2 * t + 1]});
+    remap.emplace(key, id);
+    return id;
+  };
+  for (const auto& s : reader.GetShapes())
+    for (const auto& idx : s.mesh.indices) mesh.indices.push_back(vertex(idx));
+  if (mesh.indices.empty()) throw std::runtime_error("OBJ file '" + path + "' has no faces");
+  mesh.validate();
+  return mesh;
+}
+
+}  // namespace envgi

@@ -1,0 +1,705 @@
+#include "scene/SceneLoader.h"
+
+#include <fmt/format.h>
+#include <pugixml.hpp>
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include "materials/BsdfFactory.h"
+
+namespace envgi {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct SourceFile {
+  std::string path;
+  std::string text;
+  int lineOf(ptrdiff_t offset) const {
+    int line = 1;
+    for (ptrdiff_t i = 0; i < offset && i < ptrdiff_t(text.size()); ++i)
+      if (text[size_t(i)] == '\n') ++line;
+    return line;
+  }
+};
+
+// A property element (<float name=... value=...>, <rgb>, <transform>, ...) of a plugin.
+struct Prop {
+  pugi::xml_node node;
+  std::string tag;
+  bool used = false;
+};
+
+class Loader {
+ public:
+  Loader(Scene& scene, const std::map<std::string, std::string>& defines) : scene_(scene), cliDefines_(defines) {
+    params_ = defines;
+  }
+
+  void loadFile(const std::string& path, int depth) {
+    if (depth > 16) throw std::runtime_error(path + ": includes nested too deeply (a cycle?)");
+    auto src = std::make_unique<SourceFile>();
+    src->path = path;
+    std::ifstream f(path, std::ios::binary);
+    if (!f) throw std::runtime_error("cannot open scene file '" + path + "'");
+    src->text.assign((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    auto doc = std::make_unique<pugi::xml_document>();
+    pugi::xml_parse_result r = doc->load_buffer(src->text.data(), src->text.size());
+    if (!r) throw std::runtime_error(fmt::format("{}:{}: XML error: {}", path, src->lineOf(r.offset), r.description()));
+    files_.push_back(std::move(src));
+    docs_.push_back(std::move(doc));
+    const SourceFile* file = files_.back().get();
+    pugi::xml_node root = docs_.back()->document_element();
+    if (std::string(root.name()) != "scene") fail(file, root, "the root element must be <scene>");
+    checkAttrs(file, root, {"version"});
+    std::string version = root.attribute("version").as_string();
+    if (version.empty()) fail(file, root, "<scene> needs a version attribute");
+    if (version[0] != '3' && version[0] != '2')
+      warnOnce(fmt::format("{}: scene version {} is not 3.x; reading it as 3.0.0", path, version));
+    for (pugi::xml_node n : root.children()) {
+      if (n.type() != pugi::node_element) continue;
+      topLevel(file, n, depth);
+    }
+  }
+
+  void finish() {
+    if (!haveSensor_) throw std::runtime_error(files_.front()->path + ": the scene has no <sensor>");
+  }
+
+ private:
+  Scene& scene_;
+  std::map<std::string, std::string> cliDefines_, params_;
+  std::vector<std::unique_ptr<SourceFile>> files_;
+  std::vector<std::unique_ptr<pugi::xml_document>> docs_;
+  std::map<std::string, int> bsdfIds_;
+  std::set<std::string> warned_;
+  bool haveSensor_ = false;
+
+  [[noreturn]] void fail(const SourceFile* f, pugi::xml_node n, const std::string& what) const {
+    throw std::runtime_error(fmt::format("{}:{}: {}", f->path, f->lineOf(n.offset_debug()), what));
+  }
+  void warnOnce(const std::string& msg) {
+    if (warned_.insert(msg).second) spdlog::warn("{}", msg);
+  }
+  void checkAttrs(const SourceFile* f, pugi::xml_node n, std::initializer_list<const char*> allowed) const {
+    for (pugi::xml_attribute a : n.attributes()) {
+      bool ok = false;
+      for (const char* x : allowed) ok = ok || std::string(a.name()) == x;
+      if (!ok) fail(f, n, fmt::format("unexpected attribute '{}' on <{}>", a.name(), n.name()));
+    }
+  }
+  // Attribute value with $name parameters substituted.
+  std::string attr(const SourceFile* f, pugi::xml_node n, const char* name, bool required = true) const {
+    pugi::xml_attribute a = n.attribute(name);
+    if (!a) {
+      if (required) fail(f, n, fmt::format("<{}> needs a '{}' attribute", n.name(), name));
+      return "";
+    }
+    std::string v = a.as_string(), out;
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (v[i] != '$') {
+        out += v[i];
+        continue;
+      }
+      size_t j = i + 1;
+      while (j < v.size() && (std::isalnum((unsigned char)v[j]) || v[j] == '_')) ++j;
+      std::string key = v.substr(i + 1, j - i - 1);
+      auto it = params_.find(key);
+      if (it == params_.end()) fail(f, n, fmt::format("undefined parameter '${}'", key));
+      out += it->second;
+      i = j - 1;
+    }
+    return out;
+  }
+
+  float parseFloat(const SourceFile* f, pugi::xml_node n, const std::string& s) const {
+    try {
+      size_t used = 0;
+      float v = std::stof(s, &used);
+      while (used < s.size() && std::isspace((unsigned char)s[used])) ++used;
+      if (used != s.size() || !std::isfinite(v)) throw std::invalid_argument("trailing");
+      return v;
+    } catch (const std::exception&) {
+      fail(f, n, fmt::format("'{}' is not a number", s));
+    }
+  }
+  std::vector<float> parseList(const SourceFile* f, pugi::xml_node n, const std::string& s) const {
+    std::vector<float> out;
+    std::string tok;
+    std::stringstream ss(s);
+    while (std::getline(ss, tok, ',')) {
+      std::stringstream ws(tok);
+      std::string w;
+      while (ws >> w) out.push_back(parseFloat(f, n, w));
+    }
+    return out;
+  }
+  Vec3f parseVec(const SourceFile* f, pugi::xml_node n, const std::string& s) const {
+    std::vector<float> v = parseList(f, n, s);
+    if (v.size() == 1) return Vec3f(v[0]);
+    if (v.size() != 3) fail(f, n, fmt::format("expected 3 numbers, got '{}'", s));
+    return {v[0], v[1], v[2]};
+  }
+
+  // ---- properties --------------------------------------------------------------------------
+  using Props = std::map<std::string, Prop>;
+
+  Props collectProps(const SourceFile* f, pugi::xml_node parent) const {
+    static const std::set<std::string> propTags = {"float", "integer", "boolean", "string", "rgb",
+                                                   "spectrum", "point", "vector", "transform"};
+    Props props;
+    for (pugi::xml_node c : parent.children()) {
+      if (c.type() != pugi::node_element) continue;
+      std::string tag = c.name();
+      if (!propTags.count(tag)) continue;
+      if (tag == "transform") checkAttrs(f, c, {"name"});
+      else if (tag == "point" || tag == "vector") checkAttrs(f, c, {"name", "value", "x", "y", "z"});
+      else checkAttrs(f, c, {"name", "value"});
+      std::string name = attr(f, c, "name");
+      if (props.count(name)) fail(f, c, fmt::format("property '{}' given twice", name));
+      props[name] = Prop{c, tag, false};
+    }
+    return props;
+  }
+  Prop* find(Props& p, const std::string& name) {
+    auto it = p.find(name);
+    if (it == p.end()) return nullptr;
+    it->second.used = true;
+    return &it->second;
+  }
+  void expectTag(const SourceFile* f, const Prop& p, std::initializer_list<const char*> tags) const {
+    for (const char* t : tags)
+      if (p.tag == t) return;
+    fail(f, p.node, fmt::format("property '{}' cannot be a <{}>", p.node.attribute("name").as_string(), p.tag));
+  }
+  float getFloat(const SourceFile* f, Props& p, const std::string& name, float def) {
+    Prop* x = find(p, name);
+    if (!x) return def;
+    expectTag(f, *x, {"float", "integer"});
+    return parseFloat(f, x->node, attr(f, x->node, "value"));
+  }
+  int getInt(const SourceFile* f, Props& p, const std::string& name, int def) {
+    Prop* x = find(p, name);
+    if (!x) return def;
+    expectTag(f, *x, {"integer"});
+    std::string s = attr(f, x->node, "value");
+    try {
+      size_t used = 0;
+      long v = std::stol(s, &used);
+      if (used != s.size()) throw std::invalid_argument("trailing");
+      return int(v);
+    } catch (const std::exception&) {
+      fail(f, x->node, fmt::format("'{}' is not an integer", s));
+    }
+  }
+  bool getBool(const SourceFile* f, Props& p, const std::string& name, bool def) {
+    Prop* x = find(p, name);
+    if (!x) return def;
+    expectTag(f, *x, {"boolean"});
+    std::string s = attr(f, x->node, "value");
+    if (s == "true" || s == "1") return true;
+    if (s == "false" || s == "0") return false;
+    fail(f, x->node, fmt::format("'{}' is not a boolean", s));
+  }
+  std::string getString(const SourceFile* f, Props& p, const std::string& name, const std::string& def) {
+    Prop* x = find(p, name);
+    if (!x) return def;
+    expectTag(f, *x, {"string"});
+    return attr(f, x->node, "value");
+  }
+  Color getColor(const SourceFile* f, Props& p, const std::string& name, Color def) {
+    Prop* x = find(p, name);
+    if (!x) return def;
+    expectTag(f, *x, {"rgb", "spectrum", "float"});
+    std::string v = attr(f, x->node, "value");
+    if (x->tag == "spectrum" && v.find(':') != std::string::npos)
+      fail(f, x->node, "spectral data (wavelength:value) is not supported; give an <rgb>");
+    Color c = parseVec(f, x->node, v);
+    if (c.x < 0.f || c.y < 0.f || c.z < 0.f) fail(f, x->node, fmt::format("'{}' must not be negative", name));
+    return c;
+  }
+  Vec3f getPoint(const SourceFile* f, Props& p, const std::string& name, Vec3f def) {
+    Prop* x = find(p, name);
+    if (!x) return def;
+    expectTag(f, *x, {"point", "vector"});
+    if (x->node.attribute("value")) return parseVec(f, x->node, attr(f, x->node, "value"));
+    return {parseFloat(f, x->node, attr(f, x->node, "x", false).empty() ? "0" : attr(f, x->node, "x")),
+            parseFloat(f, x->node, attr(f, x->node, "y", false).empty() ? "0" : attr(f, x->node, "y")),
+            parseFloat(f, x->node, attr(f, x->node, "z", false).empty() ? "0" : attr(f, x->node, "z"))};
+  }
+  float getIor(const SourceFile* f, Props& p, const std::string& name, float def) {
+    Prop* x = find(p, name);
+    if (!x) return def;
+    expectTag(f, *x, {"float", "string"});
+    std::string v = attr(f, x->node, "value");
+    static const std::map<std::string, float> named = {
+        {"vacuum", 1.f},       {"air", 1.000277f},      {"water", 1.333f},   {"bk7", 1.5046f},
+        {"glass", 1.5046f},    {"polypropylene", 1.49f}, {"acrylic glass", 1.49f}, {"diamond", 2.419f},
+        {"sapphire", 1.77f},   {"fused quartz", 1.458f}};
+    if (x->tag == "string") {
+      auto it = named.find(v);
+      if (it == named.end()) fail(f, x->node, fmt::format("unknown index of refraction '{}'", v));
+      return it->second;
+    }
+    float ior = parseFloat(f, x->node, v);
+    if (ior <= 0.f) fail(f, x->node, "an index of refraction must be positive");
+    return ior;
+  }
+  Transform getTransform(const SourceFile* f, Props& p, const std::string& name) {
+    Prop* x = find(p, name);
+    if (!x) return Transform{};
+    expectTag(f, *x, {"transform"});
+    return parseTransform(f, x->node);
+  }
+  void warnUnused(const SourceFile* f, const Props& p, const std::string& plugin) {
+    for (const auto& [name, prop] : p)
+      if (!prop.used)
+        warnOnce(fmt::format("{}:{}: property '{}' of {} is not supported and was ignored", f->path,
+                             f->lineOf(prop.node.offset_debug()), name, plugin));
+  }
+
+  // Mitsuba composes the operations in order: each one applies after the ones before it.
+  Transform parseTransform(const SourceFile* f, pugi::xml_node n) {
+    Transform t;
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element) continue;
+      std::string tag = c.name();
+      Transform op;
+      try {
+        if (tag == "translate") {
+          checkAttrs(f, c, {"value", "x", "y", "z"});
+          op = translate(xyz(f, c, 0.f));
+        } else if (tag == "scale") {
+          checkAttrs(f, c, {"value", "x", "y", "z"});
+          op = scale(xyz(f, c, 1.f));
+        } else if (tag == "rotate") {
+          checkAttrs(f, c, {"value", "x", "y", "z", "angle"});
+          op = rotate(xyz(f, c, 0.f), parseFloat(f, c, attr(f, c, "angle")));
+        } else if (tag == "matrix") {
+          checkAttrs(f, c, {"value"});
+          std::vector<float> v = parseList(f, c, attr(f, c, "value"));
+          if (v.size() != 16 && v.size() != 9) fail(f, c, "a matrix needs 16 (or 9) numbers");
+          Matrix4 m;
+          if (v.size() == 16) {
+            for (int i = 0; i < 16; ++i) m.m[i / 4][i % 4] = v[size_t(i)];
+          } else {
+            for (int i = 0; i < 9; ++i) m.m[i / 3][i % 3] = v[size_t(i)];
+          }
+          op = makeTransform(m);
+        } else if (tag == "lookat") {
+          checkAttrs(f, c, {"origin", "target", "up"});
+          Vec3f up = c.attribute("up") ? parseVec(f, c, attr(f, c, "up")) : Vec3f(0.f, 1.f, 0.f);
+          op = lookAt(parseVec(f, c, attr(f, c, "origin")), parseVec(f, c, attr(f, c, "target")), up);
+        } else {
+          fail(f, c, fmt::format("unknown transform operation <{}>", tag));
+        }
+      } catch (const std::runtime_error& e) {
+        std::string what = e.what();
+        if (what.rfind(f->path, 0) == 0) throw;
+        fail(f, c, what);
+      }
+      t = op * t;
+    }
+    return t;
+  }
+  Vec3f xyz(const SourceFile* f, pugi::xml_node c, float def) const {
+    if (c.attribute("value")) {
+      std::vector<float> v = parseList(f, c, attr(f, c, "value"));
+      if (v.size() == 1) return Vec3f(v[0]);
+      if (v.size() == 3) return {v[0], v[1], v[2]};
+      fail(f, c, "expected 1 or 3 numbers");
+    }
+    auto comp = [&](const char* k) { return c.attribute(k) ? parseFloat(f, c, attr(f, c, k)) : def; };
+    return {comp("x"), comp("y"), comp("z")};
+  }
+
+  // ---- elements ------------------------------------------------------------------------------
+  void topLevel(const SourceFile* f, pugi::xml_node n, int depth) {
+    std::string tag = n.name();
+    if (tag == "default") {
+      checkAttrs(f, n, {"name", "value"});
+      std::string name = attr(f, n, "name");
+      if (!cliDefines_.count(name)) params_[name] = attr(f, n, "value");
+    } else if (tag == "include") {
+      checkAttrs(f, n, {"filename"});
+      fs::path p = fs::path(f->path).parent_path() / attr(f, n, "filename");
+      if (!fs::exists(p)) fail(f, n, fmt::format("included file '{}' does not exist", p.string()));
+      loadFile(p.string(), depth + 1);
+    } else if (tag == "integrator") {
+      integrator(f, n);
+    } else if (tag == "sensor") {
+      sensor(f, n);
+    } else if (tag == "emitter") {
+      emitter(f, n, nullptr);
+    } else if (tag == "shape") {
+      shape(f, n);
+    } else if (tag == "bsdf") {
+      int id = bsdf(f, n);
+      std::string name = attr(f, n, "id", false);
+      if (name.empty()) warnOnce(fmt::format("{}:{}: a top-level <bsdf> without an id is never used", f->path, f->lineOf(n.offset_debug())));
+      else bsdfIds_[name] = id;
+    } else if (tag == "texture" || tag == "medium" || tag == "phase") {
+      warnOnce(fmt::format("{}:{}: <{}> is not supported and was ignored", f->path, f->lineOf(n.offset_debug()), tag));
+    } else {
+      fail(f, n, fmt::format("unknown element <{}>", tag));
+    }
+  }
+
+  void integrator(const SourceFile* f, pugi::xml_node n) {
+    checkAttrs(f, n, {"type", "id", "name"});
+    std::string type = attr(f, n, "type");
+    Props p = collectProps(f, n);
+    IntegratorSettings& s = scene_.integrator;
+    s.type = type;
+    if (type == "path") {
+      s.maxDepth = getInt(f, p, "max_depth", -1);
+      s.rrDepth = getInt(f, p, "rr_depth", 5);
+      s.hideEmitters = getBool(f, p, "hide_emitters", false);
+      s.strategy = getString(f, p, "strategy", "mis");
+    } else if (type == "direct") {
+      int shading = getInt(f, p, "shading_samples", -1);
+      s.emitterSamples = getInt(f, p, "emitter_samples", shading);
+      s.bsdfSamples = getInt(f, p, "bsdf_samples", shading);
+      s.hideEmitters = getBool(f, p, "hide_emitters", false);
+      s.strategy = getString(f, p, "strategy", "mis");
+    } else {
+      fail(f, n, fmt::format("unknown integrator type '{}' (path, direct)", type));
+    }
+    static const std::set<std::string> strategies = {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis"};
+    if (!strategies.count(s.strategy))
+      fail(f, n, fmt::format("unknown strategy '{}' (uniform, cosine, bsdf, importance, alias, adaptive, mis)", s.strategy));
+    if (s.maxDepth < -1 || s.maxDepth == 0) fail(f, n, "max_depth must be -1 or at least 1");
+    if (s.emitterSamples < -1 || s.bsdfSamples < -1) fail(f, n, "sample counts must not be negative");
+    warnUnused(f, p, "integrator '" + type + "'");
+    for (pugi::xml_node c : n.children())
+      if (c.type() == pugi::node_element && !isPropTag(c.name())) fail(f, c, fmt::format("unexpected <{}> in <integrator>", c.name()));
+  }
+
+  static bool isPropTag(const std::string& t) {
+    return t == "float" || t == "integer" || t == "boolean" || t == "string" || t == "rgb" || t == "spectrum" ||
+           t == "point" || t == "vector" || t == "transform";
+  }
+
+  void sensor(const SourceFile* f, pugi::xml_node n) {
+    checkAttrs(f, n, {"type", "id", "name"});
+    std::string type = attr(f, n, "type");
+    if (type == "thinlens")
+      warnOnce(fmt::format("{}: sensor 'thinlens' is rendered as 'perspective' (no depth of field)", f->path));
+    else if (type != "perspective")
+      fail(f, n, fmt::format("unknown sensor type '{}' (perspective)", type));
+    haveSensor_ = true;
+    Props p = collectProps(f, n);
+    Camera& cam = scene_.camera;
+    float fov = getFloat(f, p, "fov", 45.f);
+    if (!(fov > 0.f && fov < 180.f)) fail(f, n, "fov must be between 0 and 180 degrees");
+    std::string axis = getString(f, p, "fov_axis", "x");
+    cam.nearClip = getFloat(f, p, "near_clip", 0.01f);
+    cam.farClip = getFloat(f, p, "far_clip", 10000.f);
+    if (!(cam.nearClip > 0.f && cam.farClip > cam.nearClip)) fail(f, n, "need 0 < near_clip < far_clip");
+    cam.toWorld = getTransform(f, p, "to_world");
+    find(p, "aperture_radius");
+    find(p, "focus_distance");
+    warnUnused(f, p, "sensor");
+    cam.width = 768;
+    cam.height = 576;
+    cam.filter = FilterType::Gaussian;
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element) continue;
+      std::string tag = c.name();
+      if (tag == "film") film(f, c);
+      else if (tag == "sampler") sampler(f, c);
+      else if (!isPropTag(tag)) fail(f, c, fmt::format("unexpected <{}> in <sensor>", tag));
+    }
+    float aspect = float(cam.width) / float(cam.height);
+    float t = std::tan(0.5f * fov * kPi / 180.f);
+    if (axis == "x") {
+      cam.tanHalfX = t;
+      cam.tanHalfY = t / aspect;
+    } else if (axis == "y") {
+      cam.tanHalfY = t;
+      cam.tanHalfX = t * aspect;
+    } else if (axis == "diagonal") {
+      float d = std::sqrt(1.f + 1.f / (aspect * aspect));
+      cam.tanHalfX = t / d;
+      cam.tanHalfY = cam.tanHalfX / aspect;
+    } else if (axis == "smaller" || axis == "larger") {
+      bool xIsIt = (axis == "smaller") == (aspect <= 1.f);
+      cam.tanHalfX = xIsIt ? t : t * aspect;
+      cam.tanHalfY = xIsIt ? t / aspect : t;
+    } else {
+      fail(f, n, fmt::format("unknown fov_axis '{}' (x, y, diagonal, smaller, larger)", axis));
+    }
+  }
+
+  void film(const SourceFile* f, pugi::xml_node n) {
+    checkAttrs(f, n, {"type", "id", "name"});
+    std::string type = attr(f, n, "type");
+    if (type != "hdrfilm") fail(f, n, fmt::format("unknown film type '{}' (hdrfilm)", type));
+    Props p = collectProps(f, n);
+    Camera& cam = scene_.camera;
+    cam.width = getInt(f, p, "width", 768);
+    cam.height = getInt(f, p, "height", 576);
+    if (cam.width <= 0 || cam.height <= 0 || cam.width > 32768 || cam.height > 32768)
+      fail(f, n, "film width and height must be between 1 and 32768");
+    for (const char* harmless : {"pixel_format", "file_format", "component_format", "banner", "high_quality_edges"})
+      find(p, harmless);
+    warnUnused(f, p, "film");
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element) continue;
+      std::string tag = c.name();
+      if (tag == "rfilter") {
+        checkAttrs(f, c, {"type", "name", "id"});
+        std::string t = attr(f, c, "type");
+        if (t == "box") cam.filter = FilterType::Box;
+        else if (t == "tent") cam.filter = FilterType::Tent;
+        else if (t == "gaussian") cam.filter = FilterType::Gaussian;
+        else fail(f, c, fmt::format("unknown rfilter type '{}' (box, tent, gaussian)", t));
+        Props fp = collectProps(f, c);
+        warnUnused(f, fp, "rfilter");
+      } else if (!isPropTag(tag)) {
+        fail(f, c, fmt::format("unexpected <{}> in <film>", tag));
+      }
+    }
+  }
+
+  void sampler(const SourceFile* f, pugi::xml_node n) {
+    checkAttrs(f, n, {"type", "id", "name"});
+    std::string type = attr(f, n, "type");
+    SamplerSettings& s = scene_.sampler;
+    if (type == "independent") s.type = SamplerType::Independent;
+    else if (type == "stratified" || type == "multijitter") s.type = SamplerType::Stratified;
+    else if (type == "ldsampler" || type == "sobol" || type == "orthogonal") s.type = SamplerType::Sobol;
+    else fail(f, n, fmt::format("unknown sampler type '{}' (independent, stratified, ldsampler)", type));
+    Props p = collectProps(f, n);
+    s.sampleCount = getInt(f, p, "sample_count", 4);
+    s.seed = uint32_t(getInt(f, p, "seed", 0));
+    find(p, "jitter");
+    if (s.sampleCount <= 0) fail(f, n, "sample_count must be positive");
+    warnUnused(f, p, "sampler '" + type + "'");
+  }
+
+  // Returns the radiance for an area emitter; registers environment emitters directly.
+  void emitter(const SourceFile* f, pugi::xml_node n, ShapeEntry* shape) {
+    checkAttrs(f, n, {"type", "id", "name"});
+    std::string type = attr(f, n, "type");
+    Props p = collectProps(f, n);
+    if (type == "area") {
+      if (!shape) fail(f, n, "an 'area' emitter must be inside a <shape>");
+      shape->emissive = true;
+      shape->radiance = getColor(f, p, "radiance", Color(1.f));
+    } else if (shape) {
+      fail(f, n, fmt::format("only 'area' emitters can be inside a <shape>, not '{}'", type));
+    } else if (type == "envmap" || type == "constant") {
+      if (scene_.env) fail(f, n, "the scene already has an environment emitter");
+      EnvironmentMapOptions o;
+      if (type == "envmap") {
+        std::string file = getString(f, p, "filename", "");
+        if (file.empty()) fail(f, n, "envmap needs a 'filename'");
+        fs::path path = fs::path(f->path).parent_path() / file;
+        o.scale = getFloat(f, p, "scale", 1.f);
+        if (o.scale < 0.f) fail(f, n, "envmap scale must not be negative");
+        o.toWorld = getTransform(f, p, "to_world");
+        o.misCompensation = getBool(f, p, "mis_compensation", false);
+        std::string filter = getString(f, p, "filter_type", "bilinear");
+        if (filter != "bilinear" && filter != "nearest") fail(f, n, "filter_type must be bilinear or nearest");
+        o.bilinear = filter == "bilinear";
+        try {
+          scene_.env = std::make_unique<EnvironmentMap>(EnvironmentMap::load(path.string(), o));
+        } catch (const std::runtime_error& e) {
+          fail(f, n, e.what());
+        }
+      } else {
+        Color L = getColor(f, p, "radiance", Color(1.f));
+        scene_.env = std::make_unique<EnvironmentMap>(EnvironmentMap::constant(L, o));
+      }
+    } else {
+      warnOnce(fmt::format("{}:{}: emitter type '{}' is not supported and was ignored", f->path,
+                           f->lineOf(n.offset_debug()), type));
+      return;
+    }
+    warnUnused(f, p, "emitter '" + type + "'");
+  }
+
+  int bsdf(const SourceFile* f, pugi::xml_node n) {
+    checkAttrs(f, n, {"type", "id", "name"});
+    std::string type = attr(f, n, "type");
+    Props p = collectProps(f, n);
+    Bsdf b;
+    float extIor = 1.000277f;
+    if (type == "twosided") {
+      pugi::xml_node inner;
+      for (pugi::xml_node c : n.children())
+        if (c.type() == pugi::node_element && std::string(c.name()) == "bsdf") {
+          if (inner) fail(f, c, "twosided with two different BSDFs is not supported");
+          inner = c;
+        } else if (c.type() == pugi::node_element && std::string(c.name()) == "ref") {
+          checkAttrs(f, c, {"id", "name"});
+          auto it = bsdfIds_.find(attr(f, c, "id"));
+          if (it == bsdfIds_.end()) fail(f, c, fmt::format("unknown BSDF id '{}'", attr(f, c, "id")));
+          Bsdf copy = scene_.bsdfs[size_t(it->second)];
+          copy.twoSided = true;
+          scene_.bsdfs.push_back(copy);
+          return int(scene_.bsdfs.size() - 1);
+        }
+      if (!inner) fail(f, n, "twosided needs a nested <bsdf>");
+      int id = bsdf(f, inner);
+      scene_.bsdfs[size_t(id)].twoSided = true;
+      return id;
+    }
+    if (type == "diffuse") {
+      b.type = BsdfType::Diffuse;
+      b.reflectance = getColor(f, p, "reflectance", Color(0.5f));
+    } else if (type == "conductor" || type == "roughconductor") {
+      b.type = type == "conductor" ? BsdfType::Conductor : BsdfType::RoughConductor;
+      std::string material = getString(f, p, "material", "none");
+      try {
+        conductorPreset(material, &b.eta, &b.k, &b.perfectMirror);
+      } catch (const std::runtime_error& e) {
+        fail(f, n, e.what());
+      }
+      if (p.count("eta") || p.count("k")) {
+        b.eta = getColor(f, p, "eta", Color(0.f));
+        b.k = getColor(f, p, "k", Color(1.f));
+        b.perfectMirror = false;
+      }
+      b.specularReflectance = getColor(f, p, "specular_reflectance", Color(1.f));
+      roughness(f, n, p, b, type);
+    } else if (type == "dielectric" || type == "thindielectric" || type == "roughdielectric") {
+      b.type = type == "dielectric" ? BsdfType::Dielectric
+               : type == "thindielectric" ? BsdfType::ThinDielectric : BsdfType::RoughDielectric;
+      b.ior = getIor(f, p, "int_ior", 1.5046f) / getIor(f, p, "ext_ior", extIor);
+      b.specularReflectance = getColor(f, p, "specular_reflectance", Color(1.f));
+      b.specularTransmittance = getColor(f, p, "specular_transmittance", Color(1.f));
+      if (type == "roughdielectric") roughness(f, n, p, b, type);
+    } else if (type == "plastic" || type == "roughplastic") {
+      b.type = type == "plastic" ? BsdfType::Plastic : BsdfType::RoughPlastic;
+      b.ior = getIor(f, p, "int_ior", 1.49f) / getIor(f, p, "ext_ior", extIor);
+      b.reflectance = getColor(f, p, "diffuse_reflectance", Color(0.5f));
+      b.specularReflectance = getColor(f, p, "specular_reflectance", Color(1.f));
+      if (getBool(f, p, "nonlinear", false)) warnOnce(f->path + ": plastic 'nonlinear' is not supported (linear is used)");
+      if (type == "roughplastic") roughness(f, n, p, b, type);
+      finishPlastic(b);
+    } else {
+      fail(f, n, fmt::format("unknown BSDF type '{}'", type));
+    }
+    for (pugi::xml_node c : n.children())
+      if (c.type() == pugi::node_element && !isPropTag(c.name())) {
+        if (std::string(c.name()) == "texture") {
+          warnOnce(fmt::format("{}:{}: textures are not supported; the property keeps its default", f->path,
+                               f->lineOf(c.offset_debug())));
+          continue;
+        }
+        fail(f, c, fmt::format("unexpected <{}> in <bsdf>", c.name()));
+      }
+    warnUnused(f, p, "bsdf '" + type + "'");
+    scene_.bsdfs.push_back(b);
+    return int(scene_.bsdfs.size() - 1);
+  }
+
+  void roughness(const SourceFile* f, pugi::xml_node n, Props& p, Bsdf& b, const std::string& type) {
+    std::string dist = getString(f, p, "distribution", "beckmann");
+    if (dist != "ggx") warnOnce(fmt::format("{}: {} distribution '{}' is rendered as GGX", f->path, type, dist));
+    b.alpha = getFloat(f, p, "alpha", 0.1f);
+    if (!(b.alpha > 0.f && b.alpha <= 4.f)) fail(f, n, "alpha must be in (0, 4]");
+    b.alpha = std::max(b.alpha, 1e-3f);  // below this GGX sampling is numerically a mirror
+    find(p, "sample_visible");
+  }
+
+  void shape(const SourceFile* f, pugi::xml_node n) {
+    checkAttrs(f, n, {"type", "id", "name"});
+    std::string type = attr(f, n, "type");
+    Props p = collectProps(f, n);
+    ShapeEntry entry;
+    Transform toWorld = getTransform(f, p, "to_world");
+    bool flip = getBool(f, p, "flip_normals", false);
+    if (type == "sphere") {
+      Sphere s;
+      Vec3f c = getPoint(f, p, "center", Vec3f(0.f));
+      float r = getFloat(f, p, "radius", 1.f);
+      if (!(r > 0.f)) fail(f, n, "sphere radius must be positive");
+      s.center = toWorld.point(c);
+      s.radius = r * length(toWorld.vector(Vec3f(1.f, 0.f, 0.f)));
+      s.flipNormals = flip;
+      entry.isSphere = true;
+      entry.index = scene_.spheres.size();
+      scene_.spheres.push_back(s);
+    } else {
+      TriangleMesh mesh;
+      try {
+        if (type == "ply" || type == "obj") {
+          std::string file = getString(f, p, "filename", "");
+          if (file.empty()) fail(f, n, type + " shape needs a 'filename'");
+          fs::path path = fs::path(f->path).parent_path() / file;
+          if (!fs::exists(path)) fail(f, n, fmt::format("mesh file '{}' does not exist", path.string()));
+          mesh = type == "ply" ? loadPly(path.string()) : loadObj(path.string());
+        } else if (type == "rectangle") {
+          mesh = makeRectangle();
+        } else if (type == "cube") {
+          mesh = makeCube();
+        } else if (type == "disk") {
+          mesh = makeDisk();
+        } else {
+          fail(f, n, fmt::format("unknown shape type '{}' (ply, obj, sphere, rectangle, cube, disk)", type));
+        }
+      } catch (const std::runtime_error& e) {
+        std::string what = e.what();
+        if (what.rfind(f->path, 0) == 0) throw;
+        fail(f, n, what);
+      }
+      bool faceNormals = getBool(f, p, "face_normals", false);
+      mesh.transform(toWorld);
+      if (faceNormals) mesh.normals.clear();
+      else if (mesh.normals.empty() && (type == "ply" || type == "obj")) mesh.computeVertexNormals();
+      if (flip) {
+        // Mitsuba flips the normals; reversing the winding keeps geometric and shading normals together.
+        for (size_t i = 0; i < mesh.indices.size(); i += 3) std::swap(mesh.indices[i + 1], mesh.indices[i + 2]);
+        for (Vec3f& nn : mesh.normals) nn = -nn;
+      }
+      entry.index = scene_.meshes.size();
+      scene_.meshes.push_back(std::move(mesh));
+    }
+    entry.bsdf = -1;
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element) continue;
+      std::string tag = c.name();
+      if (tag == "bsdf") {
+        if (entry.bsdf >= 0) fail(f, c, "a shape has at most one BSDF");
+        entry.bsdf = bsdf(f, c);
+      } else if (tag == "ref") {
+        checkAttrs(f, c, {"id", "name"});
+        auto it = bsdfIds_.find(attr(f, c, "id"));
+        if (it == bsdfIds_.end()) fail(f, c, fmt::format("unknown BSDF id '{}'", attr(f, c, "id")));
+        if (entry.bsdf >= 0) fail(f, c, "a shape has at most one BSDF");
+        entry.bsdf = it->second;
+      } else if (tag == "emitter") {
+        emitter(f, c, &entry);
+      } else if (!isPropTag(tag)) {
+        fail(f, c, fmt::format("unexpected <{}> in <shape>", tag));
+      }
+    }
+    if (entry.bsdf < 0) {
+      scene_.bsdfs.push_back(Bsdf{});  // Mitsuba's default: diffuse, reflectance 0.5
+      entry.bsdf = int(scene_.bsdfs.size() - 1);
+    }
+    warnUnused(f, p, "shape '" + type + "'");
+    scene_.shapes.push_back(entry);
+  }
+};
+
+}  // namespace
+
+void loadScene(const std::string& path, const std::map<std::string, std::string>& defines, Scene& scene) {
+  Loader loader(scene, defines);
+  loader.loadFile(path, 0);
+  loader.finish();
+  scene.sourcePath = path;
+  scene.finalize();
+}
+
+}  // namespace envgi

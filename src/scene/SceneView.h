@@ -1,0 +1,137 @@
+// The scene as plain data that kernels read: meshes, spheres, materials, lights, camera.
+#pragma once
+
+#include "envmap/EnvironmentMapView.h"
+#include "materials/Bsdf.h"
+#include "scene/Camera.h"
+#include "scene/Ray.h"
+
+namespace envgi {
+
+struct MeshView {
+  const Vec3f* positions = nullptr;  // world space
+  const Vec3f* normals = nullptr;    // world space, may be null (face normals)
+  const Vec2f* uvs = nullptr;        // may be null
+  const uint32_t* indices = nullptr; // 3 a triangle
+  int triangleCount = 0;
+  int bsdf = 0;
+  int lightOffset = -1;  // index of triangle 0 in the light list, -1 when not emissive
+  bool flipNormals = false;
+};
+
+struct SphereView {
+  Vec3f center;
+  float radius = 1.f;
+  int bsdf = 0;
+  int light = -1;
+  bool flipNormals = false;
+};
+
+// One emitting primitive: a triangle of a mesh or a whole sphere.
+struct LightPrim {
+  int geomId;    // scene geometry numbering (meshes, then spheres)
+  int primId;
+  Color radiance;
+  float area;
+};
+
+struct SurfaceInteraction {
+  Vec3f p;
+  Vec3f ng;  // geometric normal (after flip_normals)
+  Frame shading;
+  Vec2f uv;
+  int bsdf = 0;
+  int light = -1;
+  float t = 0.f;
+};
+
+struct SceneView {
+  const MeshView* meshes = nullptr;
+  int meshCount = 0;
+  const SphereView* spheres = nullptr;
+  int sphereCount = 0;
+  const Bsdf* bsdfs = nullptr;
+  const LightPrim* lights = nullptr;
+  int lightCount = 0;
+  AliasTableView lightSelect;  // area lights by power
+  bool hasEnvironment = false;
+  EnvironmentMapView env;
+  Camera camera;
+  Vec3f boundsMin, boundsMax;
+
+  // Probability of choosing the environment over the area lights in next-event estimation.
+  ENVGI_HD float envSelectProb() const {
+    if (!hasEnvironment) return 0.f;
+    return lightCount > 0 ? 0.5f : 1.f;
+  }
+
+  ENVGI_HD SurfaceInteraction interaction(const Ray& ray, const Hit& h) const {
+    SurfaceInteraction si;
+    si.t = h.t;
+    if (h.geomId < meshCount) {
+      const MeshView& m = meshes[h.geomId];
+      uint32_t i0 = m.indices[3 * h.primId], i1 = m.indices[3 * h.primId + 1], i2 = m.indices[3 * h.primId + 2];
+      Vec3f p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
+      float b1 = h.u, b2 = h.v, b0 = 1.f - b1 - b2;
+      si.p = p0 * b0 + p1 * b1 + p2 * b2;
+      Vec3f ng = normalize(cross(p1 - p0, p2 - p0));
+      Vec3f ns = ng;
+      if (m.normals) {
+        Vec3f n = m.normals[i0] * b0 + m.normals[i1] * b1 + m.normals[i2] * b2;
+        if (lengthSq(n) > 0.f) ns = normalize(n);
+        if (dot(ns, ng) < 0.f) ng = -ng;  // geometric normal agrees with the mesh's own normals
+      }
+      if (m.flipNormals) {
+        ng = -ng;
+        ns = -ns;
+      }
+      si.ng = ng;
+      si.shading = Frame::fromNormal(ns);
+      si.uv = m.uvs ? m.uvs[i0] * b0 + m.uvs[i1] * b1 + m.uvs[i2] * b2 : Vec2f(b1, b2);
+      si.bsdf = m.bsdf;
+      si.light = m.lightOffset >= 0 ? m.lightOffset + h.primId : -1;
+    } else {
+      const SphereView& s = spheres[h.geomId - meshCount];
+      Vec3f p = ray.o + ray.d * h.t;
+      Vec3f n = normalize(p - s.center);
+      si.p = s.center + n * s.radius;  // re-projected: removes the hit point's float error
+      if (s.flipNormals) n = -n;
+      si.ng = n;
+      si.shading = Frame::fromNormal(n);
+      si.uv = Vec2f(0.f, 0.f);
+      si.bsdf = s.bsdf;
+      si.light = s.light;
+    }
+    return si;
+  }
+
+  // Emitted radiance leaving a light primitive towards w (one-sided, like Mitsuba's area).
+  ENVGI_HD Color emitted(const SurfaceInteraction& si, Vec3f w) const {
+    if (si.light < 0 || dot(si.ng, w) <= 0.f) return Color(0.f);
+    return lights[si.light].radiance;
+  }
+};
+
+// Uniform point on a light primitive; returns position, normal and area pdf.
+ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2f u, Vec3f* p, Vec3f* n) {
+  if (lp.geomId < sc.meshCount) {
+    const MeshView& m = sc.meshes[lp.geomId];
+    uint32_t i0 = m.indices[3 * lp.primId], i1 = m.indices[3 * lp.primId + 1], i2 = m.indices[3 * lp.primId + 2];
+    Vec3f p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
+    Vec2f b = sampleUniformTriangle(u);
+    *p = p0 * (1.f - b.x - b.y) + p1 * b.x + p2 * b.y;
+    Vec3f ng = normalize(cross(p1 - p0, p2 - p0));
+    if (m.normals) {
+      Vec3f ns = m.normals[i0] + m.normals[i1] + m.normals[i2];
+      if (dot(ns, ng) < 0.f) ng = -ng;
+    }
+    *n = m.flipNormals ? -ng : ng;
+  } else {
+    const SphereView& s = sc.spheres[lp.geomId - sc.meshCount];
+    Vec3f d = sampleUniformSphere(u);
+    *p = s.center + d * s.radius;
+    *n = s.flipNormals ? -d : d;
+  }
+}
+
+}  // namespace envgi

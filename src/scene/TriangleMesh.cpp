@@ -1,0 +1,82 @@
+#include "scene/TriangleMesh.h"
+
+#include <stdexcept>
+
+namespace envgi {
+
+void TriangleMesh::transform(const Transform& t) {
+  for (Vec3f& p : positions) p = t.point(p);
+  for (Vec3f& n : normals) n = normalize(t.normal(n));
+}
+
+void TriangleMesh::computeVertexNormals() {
+  normals.assign(positions.size(), Vec3f(0.f));
+  for (size_t i = 0; i + 2 < indices.size(); i += 3) {
+    Vec3f p0 = positions[indices[i]], p1 = positions[indices[i + 1]], p2 = positions[indices[i + 2]];
+    Vec3f n = cross(p1 - p0, p2 - p0);  // length = twice the area: area weighting for free
+    for (int k = 0; k < 3; ++k) normals[indices[i + k]] += n;
+  }
+  for (Vec3f& n : normals) {
+    float l = length(n);
+    n = l > 0.f ? n / l : Vec3f(0.f);
+  }
+}
+
+void TriangleMesh::validate() const {
+  if (indices.empty() || indices.size() % 3 != 0) throw std::runtime_error("mesh '" + name + "' has no triangles");
+  for (uint32_t i : indices)
+    if (i >= positions.size())
+      throw std::runtime_error("mesh '" + name + "': vertex index " + std::to_string(i) + " out of range (" +
+                               std::to_string(positions.size()) + " vertices)");
+  for (const Vec3f& p : positions)
+    if (!isFiniteVec(p)) throw std::runtime_error("mesh '" + name + "' has a non-finite vertex position");
+}
+
+TriangleMesh makeRectangle() {
+  TriangleMesh m;
+  m.name = "rectangle";
+  m.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
+  m.normals.assign(4, Vec3f(0, 0, 1));
+  m.uvs = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  m.indices = {0, 1, 2, 0, 2, 3};
+  return m;
+}
+
+TriangleMesh makeCube() {
+  TriangleMesh m;
+  m.name = "cube";
+  // Six faces with their own vertices, so each face keeps a flat normal.
+  const Vec3f axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  for (int a = 0; a < 3; ++a)
+    for (float s : {-1.f, 1.f}) {
+      Vec3f n = axes[a] * s, u = axes[(a + 1) % 3], v = axes[(a + 2) % 3];
+      if (s < 0.f) std::swap(u, v);  // keep counter-clockwise seen from outside
+      uint32_t base = uint32_t(m.positions.size());
+      m.positions.push_back(n - u - v);
+      m.positions.push_back(n + u - v);
+      m.positions.push_back(n + u + v);
+      m.positions.push_back(n - u + v);
+      for (int k = 0; k < 4; ++k) m.normals.push_back(n);
+      for (uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + k);
+    }
+  return m;
+}
+
+TriangleMesh makeDisk(int segments) {
+  TriangleMesh m;
+  m.name = "disk";
+  m.positions.push_back({0, 0, 0});
+  for (int i = 0; i < segments; ++i) {
+    float phi = 2.f * kPi * float(i) / float(segments);
+    m.positions.push_back({std::cos(phi), std::sin(phi), 0.f});
+  }
+  m.normals.assign(m.positions.size(), Vec3f(0, 0, 1));
+  for (int i = 0; i < segments; ++i) {
+    m.indices.push_back(0);
+    m.indices.push_back(uint32_t(1 + i));
+    m.indices.push_back(uint32_t(1 + (i + 1) % segments));
+  }
+  return m;
+}
+
+}  // namespace envgi
