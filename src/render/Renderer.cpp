@@ -83,6 +83,7 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
   int tilesX = (W + opts.tileSize - 1) / opts.tileSize, tilesY = (H + opts.tileSize - 1) / opts.tileSize;
   int tiles = tilesX * tilesY;
   std::vector<Color> sum(size_t(W) * H, Color(0.f));
+  std::vector<double> sumSqLum(opts.varianceOut ? size_t(W) * H : 0, 0.0);
   std::atomic<uint64_t> rays{0}, nonFinite{0};
 
   // Passes double in size (1, 1, 2, 4, ...) up to 64 samples, so a checkpoint comes early.
@@ -126,6 +127,7 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
           for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) {
               Color acc(0.f);
+              double accSq = 0.0;
               for (int s = s0; s < s1; ++s) {
                 smp.start(uint64_t(y) * W + x, uint32_t(s));
                 Vec2f off = sampleFilter(cam.filter, smp.get2D());
@@ -137,8 +139,10 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
                   continue;
                 }
                 acc += L;
+                accSq += double(luminance(L)) * luminance(L);
               }
               sum[size_t(y) * W + x] += acc;
+              if (!sumSqLum.empty()) sumSqLum[size_t(y) * W + x] += accSq;
             }
           progress.add(size_t(s1 - s0));
         }
@@ -159,6 +163,14 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
     stats->rays = rays.load();
     stats->nonFiniteSamples = nonFinite.load();
     stats->cancelled = cancelled;
+  }
+  if (opts.varianceOut && sppDone > 0) {
+    opts.varianceOut->assign(size_t(W) * H, 0.f);
+    for (size_t i = 0; i < sum.size(); ++i) {
+      double mean = luminance(sum[i]) / sppDone;
+      double var = std::max(0.0, sumSqLum[i] / sppDone - mean * mean);
+      (*opts.varianceOut)[i] = float(var / std::max(1, sppDone - 1));
+    }
   }
   if (nonFinite.load() > 0) spdlog::warn("{} samples were NaN, infinite or negative and were dropped", nonFinite.load());
   return meanImage(std::max(sppDone, 1));

@@ -21,6 +21,9 @@ struct RenderOptions {
   // Called with the mean image of the passes done so far (checkpoints).
   std::function<void(const Image&, int sppDone)> checkpoint;
   const std::atomic<bool>* cancel = nullptr;  // stop after the current pass when set
+  // When set, receives the variance of each pixel's mean luminance (for Z-tests between
+  // estimators, as Mitsuba's render tests use).
+  std::vector<float>* varianceOut = nullptr;
 };
 
 struct RenderStats {

@@ -38,6 +38,8 @@ struct Case {
   bool compensation;
 };
 
+void PrintTo(const Case& c, std::ostream* os) { *os << c.map << " strategy " << int(c.strategy); }
+
 std::string caseName(const ::testing::TestParamInfo<Case>& info) {
   static const char* names[] = {"Uniform", "Cosine", "Importance", "Alias", "Adaptive"};
   return info.param.map + names[int(info.param.strategy)] + (info.param.compensation ? "Compensated" : "");

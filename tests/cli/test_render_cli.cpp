@@ -1,0 +1,117 @@
+// `envgi render` end to end: outputs, determinism across thread counts, errors, and that an
+// interrupted render still writes the samples it finished.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "cli/CliRunner.h"
+#include "image/Image.h"
+
+using namespace envgi::test;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string tinyScene(const TempDir& d, int res, int spp) {
+  std::string path = d.file("tiny.xml");
+  std::ofstream(path) << R"(<scene version="3.0.0">
+  <default name="spp" value=")" << spp << R"("/>
+  <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+  <sensor type="perspective"><float name="fov" value="45"/>
+    <transform name="to_world"><lookat origin="0,1,4" target="0,0.5,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value=")" << res << R"("/><integer name="height" value=")" << res << R"("/></film>
+    <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler></sensor>
+  <emitter type="envmap"><string name="filename" value=")" << ENVGI_SOURCE_DIR << R"(/scenes/envmaps/studio.hdr"/></emitter>
+  <shape type="sphere"><point name="center" value="0,0.5,0"/><float name="radius" value="0.5"/>
+    <bsdf type="roughconductor"><string name="material" value="Cu"/><float name="alpha" value="0.2"/></bsdf></shape>
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform></shape>
+</scene>)";
+  return path;
+}
+
+std::string slurp(const std::string& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+TEST(CliRender, WritesExrAndPngAndReportsRate) {
+  TempDir d;
+  std::string scene = tinyScene(d, 24, 4);
+  CliResult r = runCli("render " + scene + " -o " + d.file("a.exr") + " --png --no-progress");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(d.file("a.exr")));
+  EXPECT_TRUE(fs::exists(d.file("a.png")));
+  EXPECT_NE(r.output.find("Mrays/s"), std::string::npos) << r.output;
+  envgi::Image img = envgi::loadImage(d.file("a.exr"));
+  EXPECT_EQ(img.width, 24);
+  double mean = 0;
+  for (float v : img.rgb) mean += v;
+  EXPECT_GT(mean, 0.0);
+}
+
+TEST(CliRender, SameSeedSameImageWhateverTheThreadCount) {
+  TempDir d;
+  std::string scene = tinyScene(d, 20, 3);
+  ASSERT_EQ(runCli("render " + scene + " -o " + d.file("t1.pfm") + " --threads 1 --seed 9 --no-progress").code, 0);
+  ASSERT_EQ(runCli("render " + scene + " -o " + d.file("t2.pfm") + " --threads 2 --seed 9 --no-progress").code, 0);
+  ASSERT_EQ(runCli("render " + scene + " -o " + d.file("t3.pfm") + " --threads 2 --seed 10 --no-progress").code, 0);
+  EXPECT_EQ(slurp(d.file("t1.pfm")), slurp(d.file("t2.pfm")));
+  EXPECT_NE(slurp(d.file("t1.pfm")), slurp(d.file("t3.pfm")));
+}
+
+TEST(CliRender, DefinesAndOverrides) {
+  TempDir d;
+  std::string scene = tinyScene(d, 8, 1);
+  CliResult r = runCli("render " + scene + " -o " + d.file("o.exr") +
+                       " -D spp=2 --integrator direct --strategy adaptive --no-progress");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("'direct' (strategy adaptive), 2 spp"), std::string::npos) << r.output;
+}
+
+TEST(CliRender, ErrorsLeaveNoOutput) {
+  TempDir d;
+  std::string out = d.file("never.exr");
+  std::ofstream(d.file("broken.xml")) << "<scene version=\"3.0.0\">\n<shape type=\"sphere\">\n</scene>";
+  CliResult r = runCli("render " + d.file("broken.xml") + " -o " + out);
+  EXPECT_NE(r.code, 0);
+  EXPECT_NE(r.output.find("envgi: error:"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("broken.xml:"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(out));
+  std::string scene = tinyScene(d, 8, 1);
+  EXPECT_NE(runCli("render " + scene + " -o " + d.file("x.txt")).code, 0);
+  EXPECT_NE(runCli("render " + scene + " -o " + out + " --integrator bdpt").code, 0);
+  EXPECT_NE(runCli("render " + scene + " -o " + out + " --strategy nonsense").code, 0);
+  EXPECT_NE(runCli("render " + scene + " -o " + out + " -D broken").code, 0);
+  EXPECT_FALSE(fs::exists(out));
+  size_t files = 0;
+  for (auto& e : fs::directory_iterator(d.path)) files += e.path().filename().string().find(".tmp") != std::string::npos;
+  EXPECT_EQ(files, 0u);
+}
+
+// SIGINT during a long render: the finished passes are written and the exit is clean.
+TEST(CliRender, InterruptKeepsFinishedWork) {
+  TempDir d;
+  std::string scene = tinyScene(d, 64, 100000);
+  std::string out = d.file("long.exr");
+  std::string cmd = std::string(ENVGI_CLI_PATH) + " render " + scene + " -o " + out + " --no-progress > " +
+                    d.file("log.txt") + " 2>&1 & echo $!";
+  FILE* p = popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  int pid = 0;
+  ASSERT_EQ(fscanf(p, "%d", &pid), 1);
+  pclose(p);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  kill(pid, SIGINT);
+  for (int i = 0; i < 200 && kill(pid, 0) == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  std::string log = slurp(d.file("log.txt"));
+  EXPECT_TRUE(fs::exists(out)) << log;
+  EXPECT_NE(log.find("interrupted"), std::string::npos) << log;
+}

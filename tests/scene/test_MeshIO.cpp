@@ -1,0 +1,136 @@
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "cli/CliRunner.h"
+#include "scene/TriangleMesh.h"
+
+using namespace envgi;
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kAsciiPly =
+    "ply\nformat ascii 1.0\ncomment a quad\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+    "property float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uchar int vertex_indices\n"
+    "end_header\n0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n0 1 0 0 0 1\n4 0 1 2 3\n";
+
+std::string binaryPly(bool bigEndian) {
+  std::string s = std::string("ply\nformat ") + (bigEndian ? "binary_big_endian" : "binary_little_endian") +
+                  " 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                  "element face 1\nproperty list uchar uint vertex_indices\nend_header\n";
+  auto put = [&](const void* p, size_t n) {
+    std::string b(static_cast<const char*>(p), n);
+    if (bigEndian) std::reverse(b.begin(), b.end());
+    s += b;
+  };
+  float v[9] = {0, 0, 0, 2, 0, 0, 0, 3, 0};
+  for (float x : v) put(&x, 4);
+  unsigned char n = 3;
+  s += char(n);
+  for (uint32_t i : {0u, 1u, 2u}) put(&i, 4);
+  return s;
+}
+
+void write(const std::string& path, const std::string& s) { std::ofstream(path, std::ios::binary) << s; }
+
+}  // namespace
+
+TEST(MeshIO, AsciiPlyWithNormalsAndQuad) {
+  test::TempDir d;
+  write(d.file("q.ply"), kAsciiPly);
+  TriangleMesh m = loadPly(d.file("q.ply"));
+  EXPECT_EQ(m.positions.size(), 4u);
+  EXPECT_EQ(m.triangleCount(), 2u);  // the quad is fanned
+  ASSERT_EQ(m.normals.size(), 4u);
+  EXPECT_EQ(m.normals[2].z, 1.f);
+}
+
+TEST(MeshIO, BinaryPlyBothEndians) {
+  test::TempDir d;
+  for (bool be : {false, true}) {
+    write(d.file("b.ply"), binaryPly(be));
+    TriangleMesh m = loadPly(d.file("b.ply"));
+    ASSERT_EQ(m.triangleCount(), 1u);
+    EXPECT_EQ(m.positions[1].x, 2.f);
+    EXPECT_EQ(m.positions[2].y, 3.f);
+    EXPECT_EQ(m.indices[2], 2u);
+  }
+}
+
+TEST(MeshIO, MalformedPlyGivesClearErrors) {
+  test::TempDir d;
+  std::string full = binaryPly(false);
+  struct Bad {
+    std::string content, expect;
+  };
+  std::string ascii = kAsciiPly;
+  std::vector<Bad> bad = {
+      {full.substr(0, 40), "end_header"},                                // cut inside the header
+      {full.substr(0, full.size() - 5), "unexpected end of file"},       // cut inside the data
+      {ascii.substr(0, ascii.size() - 12), "unexpected end of file"},    // ascii cut
+      {"plx\n", "not a PLY file"},
+      {std::string(kAsciiPly).replace(ascii.find("4 0 1 2 3"), 9, "3 0 1 9"), "refers to vertex 9"},
+      {std::string(kAsciiPly).replace(ascii.find("property float x"), 16, "property quux x"), "unknown property type"},
+      {std::string(kAsciiPly).replace(ascii.find("1 1 0 0"), 7, "1 a 0 0"), "expected a number"},
+  };
+  for (const Bad& b : bad) {
+    write(d.file("bad.ply"), b.content);
+    try {
+      loadPly(d.file("bad.ply"));
+      ADD_FAILURE() << "no error for: " << b.expect;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(b.expect), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(MeshIO, ObjAndErrors) {
+  test::TempDir d;
+  write(d.file("t.obj"), "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n");
+  TriangleMesh m = loadObj(d.file("t.obj"));
+  EXPECT_EQ(m.triangleCount(), 2u);
+  EXPECT_EQ(m.normals.size(), m.positions.size());
+  write(d.file("empty.obj"), "v 0 0 0\nv 1 0 0\n");
+  EXPECT_THROW(loadObj(d.file("empty.obj")), std::runtime_error);
+  EXPECT_THROW(loadObj(d.file("missing.obj")), std::runtime_error);
+}
+
+TEST(MeshIO, SharedAssetsLoad) {
+  std::string buddha = std::string(ENVGI_ASSETS_DIR) + "/meshes/happy_buddha/happy_buddha_100k.ply";
+  std::string dragon = std::string(ENVGI_ASSETS_DIR) + "/meshes/dragon/dragon_vrip.ply";
+  if (!fs::exists(buddha)) GTEST_SKIP() << "assets not found in " << ENVGI_ASSETS_DIR;
+  TriangleMesh b = loadPly(buddha);
+  EXPECT_EQ(b.triangleCount(), 100000u);
+  if (fs::exists(dragon)) {
+    TriangleMesh dr = loadPly(dragon);
+    EXPECT_EQ(dr.triangleCount(), 871414u);
+    dr.computeVertexNormals();
+    // Positions, normals and indices: about 24 bytes a triangle.
+    EXPECT_LT(double(dr.bytes()) / dr.triangleCount(), 40.0);
+  }
+}
+
+TEST(MeshIO, PrimitivesAreClosedAndOriented) {
+  TriangleMesh c = makeCube();
+  EXPECT_EQ(c.triangleCount(), 12u);
+  // Every face normal points away from the centre.
+  for (size_t t = 0; t < c.triangleCount(); ++t) {
+    Vec3f p0 = c.positions[c.indices[3 * t]], p1 = c.positions[c.indices[3 * t + 1]], p2 = c.positions[c.indices[3 * t + 2]];
+    EXPECT_GT(dot(cross(p1 - p0, p2 - p0), p0 + p1 + p2), 0.f);
+  }
+  TriangleMesh r = makeRectangle();
+  Vec3f n = cross(r.positions[1] - r.positions[0], r.positions[2] - r.positions[0]);
+  EXPECT_GT(n.z, 0.f);
+  TriangleMesh disk = makeDisk(64);
+  double area = 0.0;
+  for (size_t t = 0; t < disk.triangleCount(); ++t) {
+    Vec3f p0 = disk.positions[disk.indices[3 * t]], p1 = disk.positions[disk.indices[3 * t + 1]],
+          p2 = disk.positions[disk.indices[3 * t + 2]];
+    area += 0.5 * length(cross(p1 - p0, p2 - p0));
+    EXPECT_GT(cross(p1 - p0, p2 - p0).z, 0.f);
+  }
+  EXPECT_NEAR(area, M_PI, 0.01);
+}

@@ -1,0 +1,50 @@
+// Small scenes built in code for integrator tests.
+#pragma once
+
+#include "accel/EmbreeAccel.h"
+#include "render/Renderer.h"
+#include "scene/Scene.h"
+
+namespace envgi::test {
+
+// A sphere of radius 1 at the origin seen by a camera on +z, under a constant environment.
+inline std::unique_ptr<Scene> furnaceScene(const Bsdf& b, int res, int spp) {
+  auto s = std::make_unique<Scene>();
+  s->bsdfs.push_back(b);
+  s->spheres.push_back({Vec3f(0.f), 1.f, false});
+  s->shapes.push_back({true, 0, 0, false, Color(0.f)});
+  s->env = std::make_unique<EnvironmentMap>(EnvironmentMap::constant(Color(1.f)));
+  s->camera.toWorld = lookAt(Vec3f(0, 0, 4), Vec3f(0, 0, 0), Vec3f(0, 1, 0));
+  s->camera.width = s->camera.height = res;
+  s->camera.tanHalfX = s->camera.tanHalfY = std::tan(0.5f * 35.f * kPi / 180.f);
+  s->camera.filter = FilterType::Box;
+  s->sampler.sampleCount = spp;
+  s->sampler.type = SamplerType::Sobol;
+  s->integrator.type = "path";
+  s->integrator.maxDepth = 64;
+  s->finalize();
+  return s;
+}
+
+// Mean of the pixels whose whole footprint sees the sphere (the four corner rays hit it).
+inline double meanOverObject(const Scene& scene, const EmbreeAccel& accel, const Image& img, int* count) {
+  const Camera& c = scene.view().camera;
+  double sum = 0.0;
+  int n = 0;
+  for (int y = 0; y < c.height; ++y)
+    for (int x = 0; x < c.width; ++x) {
+      bool inside = true;
+      for (float dy : {-0.5f, 1.5f})
+        for (float dx : {-0.5f, 1.5f}) {
+          Hit h;
+          inside = inside && accel.intersect(c.generateRay(x + dx, y + dy), &h);
+        }
+      if (!inside) continue;
+      sum += img.at(x, y).y;
+      ++n;
+    }
+  *count = n;
+  return n > 0 ? sum / n : 0.0;
+}
+
+}  // namespace envgi::test
