@@ -6,6 +6,8 @@
 #include <vector>
 
 #include "envmap/EnvironmentMap.h"
+#include "integrators/DirectIntegrator.h"
+#include "integrators/PathIntegrator.h"
 #include "sampling/Mis.h"
 #include "sampling/Sampler.h"
 
@@ -33,6 +35,63 @@ __global__ void envmapKernel(EnvironmentMapView env, int n, CheckResult* out) {
   float pdfs[2] = {es.pdf, env.pdf(EnvStrategy::Uniform, es.dir)};
   out[i] = {es.dir, es.radiance + env.eval(es.dir) * 0.f, es.pdf, env.pdf(s, es.dir, Vec3f(0.f, 1.f, 0.f)),
             misWeight(0, counts, pdfs, 2, 2.f)};
+}
+
+// Every BSDF evaluated and sampled, and camera rays generated, on the device.
+__global__ void bsdfCameraKernel(Camera cam, int n, float* out) {
+  int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  Pcg32 rng(uint64_t(i), 3u);
+  Bsdf b;
+  b.type = BsdfType(i % 8);
+  b.alpha = 0.3f;
+  b.twoSided = (i / 8) % 2 == 1;
+  Vec3f wo = normalize(Vec3f(0.3f, 0.2f, (i % 3 == 0) ? -0.8f : 0.8f));
+  BsdfSample bs;
+  float acc = 0.f;
+  if (bsdfSample(b, wo, rng.nextFloat(), Vec2f(rng.nextFloat(), rng.nextFloat()), &bs))
+    acc = bs.weight.y + bsdfEval(b, wo, bs.wi).x + bsdfPdf(b, wo, bs.wi);
+  Ray r = cam.generateRay(float(i % cam.width) + 0.5f, float((i / cam.width) % cam.height) + 0.5f);
+  Vec2f off = sampleFilter(FilterType(i % 3), Vec2f(rng.nextFloat(), rng.nextFloat()));
+  out[i] = acc + r.d.z + off.x;
+}
+
+// A brute-force sphere tracer: enough to instantiate the integrators in device code.
+struct SphereTracer {
+  const SceneView* sc;
+  ENVGI_HD bool intersect(const Ray& r, Hit* h) const {
+    bool found = false;
+    for (int i = 0; i < sc->sphereCount; ++i) {
+      Vec3f oc = r.o - sc->spheres[i].center;
+      float b = dot(oc, r.d), c = dot(oc, oc) - sqr(sc->spheres[i].radius), disc = b * b - c;
+      if (disc < 0.f) continue;
+      float sq = std::sqrt(disc);
+      float t = -b - sq > 0.f ? -b - sq : -b + sq;
+      if (t > 0.f && t < r.tMax && t < h->t) {
+        h->t = t;
+        h->geomId = sc->meshCount + i;
+        h->primId = 0;
+        found = true;
+      }
+    }
+    return found;
+  }
+  ENVGI_HD bool occluded(Vec3f o, Vec3f d, float tMax) const {
+    Hit h;
+    return intersect(Ray{o, d, tMax}, &h);
+  }
+};
+
+__global__ void integratorKernel(SceneView sc, int n, Color* out) {
+  int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  SphereTracer tr{&sc};
+  Sampler smp;
+  smp.spp = 1;
+  smp.start(uint64_t(i), 0);
+  uint64_t rays = 0;
+  Ray ray = sc.camera.generateRay(float(i % sc.camera.width) + 0.5f, float(i / sc.camera.width) + 0.5f);
+  out[i] = (i % 2) ? pathTrace(sc, tr, ray, smp, PathParams{}, &rays) : directTrace(sc, tr, ray, smp, DirectParams{}, &rays);
 }
 
 namespace {
@@ -104,8 +163,44 @@ int main() {
     maxRel = std::max(maxRel, rel);
     if (rel > 1e-3 || length(es.dir - gpu[i].dir) > 1e-3f) ++mismatches;
   }
+  // BSDFs and camera rays.
+  Camera cam;
+  cam.width = cam.height = 64;
+  cam.tanHalfX = cam.tanHalfY = 0.5f;
+  float* dB = nullptr;
+  cudaMalloc(&dB, sizeof(float) * n);
+  bsdfCameraKernel<<<(n + 255) / 256, 256>>>(cam, n, dB);
+  std::vector<float> bres(n);
+  cudaMemcpy(bres.data(), dB, sizeof(float) * n, cudaMemcpyDeviceToHost);
+  int bad = 0;
+  for (float v : bres) bad += !std::isfinite(v);
+  // The integrators on a two-sphere scene lit by the same map.
+  SceneView sv;
+  SphereView spheres[2] = {{Vec3f(0.f, 0.f, -3.f), 1.f, 0, -1, false}, {Vec3f(0.f, -101.f, -3.f), 100.f, 1, -1, false}};
+  Bsdf bsdfs[2];
+  bsdfs[0].type = BsdfType::RoughConductor;
+  bsdfs[0].perfectMirror = true;
+  bsdfs[0].alpha = 0.2f;
+  sv.spheres = upload(spheres, 2);
+  sv.sphereCount = 2;
+  sv.bsdfs = upload(bsdfs, 2);
+  sv.hasEnvironment = true;
+  sv.env = toDevice(env.view());
+  sv.camera = cam;
+  Color* dC = nullptr;
+  const int m = 64 * 64;
+  cudaMalloc(&dC, sizeof(Color) * m);
+  integratorKernel<<<(m + 127) / 128, 128>>>(sv, m, dC);
+  std::vector<Color> cres(m);
+  err = cudaMemcpy(cres.data(), dC, sizeof(Color) * m, cudaMemcpyDeviceToHost);
+  for (const Color& c : cres) bad += !isFiniteVec(c);
+  std::printf("envgi_cuda_check: BSDF/camera/integrator kernels: %d non-finite results, %s\n", bad,
+              cudaGetErrorString(err));
+  cudaFree(dB);
+  cudaFree(dC);
   for (void* p : g_allocs) cudaFree(p);
   cudaFree(dOut);
+  if (bad > 0 || err != cudaSuccess) return 1;
   std::printf("envgi_cuda_check: %d samples, %d mismatches against the CPU, max pdf rel. diff %.3g\n", n, mismatches,
               maxRel);
   return mismatches <= n / 1000 ? 0 : 1;
