@@ -52,8 +52,8 @@ void runRender(const RenderArgs& a) {
   Scene scene;
   loadScene(a.scene, parseDefines(a.defines), scene);
   if (!a.integrator.empty()) {
-    if (a.integrator != "path" && a.integrator != "direct")
-      throw std::runtime_error("unknown integrator '" + a.integrator + "' (path, direct)");
+    if (a.integrator != "path" && a.integrator != "direct" && a.integrator != "photon" && a.integrator != "sppm")
+      throw std::runtime_error("unknown integrator '" + a.integrator + "' (path, direct, photon, sppm)");
     scene.integrator.type = a.integrator;
   }
   if (!a.strategy.empty()) {
@@ -116,8 +116,8 @@ void addRenderCommand(CLI::App& app) {
   CLI::App* c = app.add_subcommand("render", "Render a scene (Mitsuba 3 XML subset) to an image");
   c->add_option("scene", a->scene, "Scene file (.xml)")->required()->check(CLI::ExistingFile);
   c->add_option("-o,--output", a->output, "Output image (.exr, .pfm, .hdr or .png)")->required();
-  c->add_option("--spp", a->spp, "Samples per pixel (default: the scene's sample_count)")->check(CLI::PositiveNumber);
-  c->add_option("--integrator", a->integrator, "path | direct (overrides the scene)");
+  c->add_option("--spp", a->spp, "Samples per pixel, or passes for sppm (default: the scene's)")->check(CLI::PositiveNumber);
+  c->add_option("--integrator", a->integrator, "path | direct | photon | sppm (overrides the scene)");
   c->add_option("--strategy", a->strategy, "Environment strategy: uniform|cosine|bsdf|importance|alias|adaptive|mis");
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
   c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);

@@ -17,26 +17,23 @@ struct DirectParams {
   EnvStrategy envStrategy = EnvStrategy::Importance;
 };
 
+// Direct light reflected at si towards wo (its own emission excluded): nE light samples and
+// nB BSDF samples, power heuristic weighted by the counts. Also used by the photon mappers.
 template <class Tracer>
-ENVGI_HD Color directTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& smp, const DirectParams& dp,
-                           uint64_t* rayCount) {
-  Hit h;
-  ++*rayCount;
-  if (!tracer.intersect(ray, &h))
-    return (sc.hasEnvironment && !dp.hideEmitters) ? sc.env.eval(ray.d) : Color(0.f);
-  SurfaceInteraction si = sc.interaction(ray, h);
-  Vec3f wo = -ray.d;
-  Color L = dp.hideEmitters ? Color(0.f) : sc.emitted(si, wo);
+ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& si, Vec3f wo,
+                              Sampler& smp, EnvStrategy strategy, int emitterSamples, int bsdfSamples,
+                              uint64_t* rayCount) {
+  Color L(0.f);
   const Bsdf& bsdf = sc.bsdfs[si.bsdf];
   Vec3f woLocal = si.shading.toLocal(wo);
   Vec3f axis = cosineAxis(si, wo);
-  float nE = float(dp.emitterSamples), nB = float(dp.bsdfSamples);
+  float nE = float(emitterSamples), nB = float(bsdfSamples);
 
-  for (int i = 0; i < dp.emitterSamples; ++i) {
+  for (int i = 0; i < emitterSamples; ++i) {
     float uSel = smp.get1D();
     Vec2f uL = smp.get2D(), uL2 = smp.get2D();
     LightSample ls;
-    if (bsdfIsDelta(bsdf) || !sampleLight(sc, si, axis, dp.envStrategy, uSel, uL, uL2, &ls)) continue;
+    if (bsdfIsDelta(bsdf) || !sampleLight(sc, si, axis, strategy, uSel, uL, uL2, &ls)) continue;
     Vec3f wiLocal = si.shading.toLocal(ls.dir);
     Color f = bsdfEval(bsdf, woLocal, wiLocal);
     if (isBlack(f) || isBlack(ls.radiance)) continue;
@@ -48,7 +45,7 @@ ENVGI_HD Color directTrace(const SceneView& sc, const Tracer& tracer, Ray ray, S
     L += f * ls.radiance * (w / (ls.pdf * nE));
   }
 
-  for (int j = 0; j < dp.bsdfSamples; ++j) {
+  for (int j = 0; j < bsdfSamples; ++j) {
     BsdfSample bs;
     float uc = smp.get1D();
     Vec2f ub = smp.get2D();
@@ -62,7 +59,7 @@ ENVGI_HD Color directTrace(const SceneView& sc, const Tracer& tracer, Ray ray, S
     if (!tracer.intersect(r2, &h2)) {
       if (!sc.hasEnvironment) continue;
       Le = sc.env.eval(wi);
-      lightPdf = envLightPdf(sc, dp.envStrategy, wi, axis);
+      lightPdf = envLightPdf(sc, strategy, wi, axis);
     } else {
       SurfaceInteraction s2 = sc.interaction(r2, h2);
       Le = sc.emitted(s2, -wi);
@@ -73,6 +70,19 @@ ENVGI_HD Color directTrace(const SceneView& sc, const Tracer& tracer, Ray ray, S
     L += bs.weight * Le * (w / nB);
   }
   return L;
+}
+
+template <class Tracer>
+ENVGI_HD Color directTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& smp, const DirectParams& dp,
+                           uint64_t* rayCount) {
+  Hit h;
+  ++*rayCount;
+  if (!tracer.intersect(ray, &h))
+    return (sc.hasEnvironment && !dp.hideEmitters) ? sc.env.eval(ray.d) : Color(0.f);
+  SurfaceInteraction si = sc.interaction(ray, h);
+  Vec3f wo = -ray.d;
+  Color L = dp.hideEmitters ? Color(0.f) : sc.emitted(si, wo);
+  return L + directLighting(sc, tracer, si, wo, smp, dp.envStrategy, dp.emitterSamples, dp.bsdfSamples, rayCount);
 }
 
 }  // namespace envgi

@@ -13,6 +13,9 @@
 
 #include "integrators/DirectIntegrator.h"
 #include "integrators/PathIntegrator.h"
+#include "integrators/PhotonIntegrator.h"
+#include "integrators/Sppm.h"
+#include "photon/PhotonShooter.h"
 
 namespace envgi {
 
@@ -60,6 +63,45 @@ class Progress {
   int lastPct_ = -100;
 };
 
+void logPhotonStats(const PhotonShootStats& st) {
+  spdlog::info("photon pass: {} global photons stored ({} emitted), {} caustic ({} emitted), {:.2f} s tracing, "
+               "{:.2f} s building kd-trees, {:.1f} MB ({} bytes a photon)",
+               st.storedGlobal, st.emittedGlobal, st.storedCaustic, st.emittedCaustic, st.traceSeconds,
+               st.buildSeconds, st.bytes / 1e6,
+               st.storedGlobal + st.storedCaustic > 0 ? st.bytes / (st.storedGlobal + st.storedCaustic) : 0);
+}
+
+Image renderSppmFromSettings(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts,
+                             RenderStats* stats) {
+  const IntegratorSettings& is = scene.integrator;
+  SppmSettings ss;
+  ss.passes = opts.spp > 0 ? opts.spp : is.passes;
+  ss.photonsPerPass = is.photonCount;
+  ss.initialRadius = is.initialRadius;
+  ss.alpha = is.alpha;
+  ss.maxDepth = is.maxDepth > 0 ? is.maxDepth : 16;
+  ss.seed = scene.sampler.seed;
+  ss.threads = opts.threads;
+  ss.progress = opts.progress;
+  ss.strategy = strategyOf(is.strategy);
+  ss.checkpointSeconds = opts.checkpointSeconds;
+  ss.checkpoint = opts.checkpoint;
+  ss.cancel = opts.cancel;
+  SppmStats st;
+  Image img = renderSppm(scene, accel, ss, &st);
+  spdlog::info("sppm: {} passes, {} photons ({} photon-visible-point hits), camera passes {:.2f} s, photon passes "
+               "{:.2f} s, mean final radius {:.4g}, {:.1f} MB",
+               st.passesDone, st.photonsShot, st.photonHits, st.cameraSeconds, st.photonSeconds,
+               st.finalMeanRadius, st.bytes / 1e6);
+  if (stats) {
+    stats->seconds = st.seconds;
+    stats->sppDone = st.passesDone;
+    stats->rays = st.rays;
+    stats->cancelled = st.cancelled;
+  }
+  return img;
+}
+
 }  // namespace
 
 Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
@@ -69,7 +111,32 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
   int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
   if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
   const IntegratorSettings& is = scene.integrator;
+  if (is.type == "sppm") return renderSppmFromSettings(scene, accel, opts, stats);
   bool direct = is.type == "direct";
+  bool photon = is.type == "photon";
+  if (!direct && !photon && is.type != "path") throw std::runtime_error("unknown integrator '" + is.type + "'");
+  PhotonMap globalMap, causticMap;
+  PhotonRenderParams php;
+  if (photon) {
+    float radius = makePhotonEmitter(scene).radius;
+    PhotonShootSettings ps;
+    ps.irradianceRadius = is.maxRadius > 0.f ? is.maxRadius : 0.05f * radius;
+    ps.globalPhotons = is.globalPhotons;
+    ps.causticPhotons = is.causticPhotons;
+    ps.seed = scene.sampler.seed;
+    ps.progress = opts.progress;
+    PhotonShootStats pst;
+    shootPhotons(scene, accel, ps, &globalMap, &causticMap, &pst);
+    logPhotonStats(pst);
+    php.global.k = php.caustic.k = is.lookupSize;
+    php.global.maxRadius = is.maxRadius > 0.f ? is.maxRadius : 0.05f * radius;
+    php.caustic.maxRadius = 0.25f * php.global.maxRadius;
+    php.global.coneFilter = php.caustic.coneFilter = is.coneFilter;
+    php.gatherSamples = is.gatherSamples;
+    php.maxDepth = is.maxDepth > 0 ? is.maxDepth : 16;
+    php.hideEmitters = is.hideEmitters;
+    php.strategy = strategyOf(is.strategy);
+  }
   PathParams pp;
   pp.maxDepth = is.maxDepth;
   pp.rrDepth = is.rrDepth;
@@ -135,8 +202,9 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
                 smp.start(uint64_t(y) * W + x, uint32_t(s));
                 Vec2f off = sampleFilter(cam.filter, smp.get2D());
                 Ray ray = cam.generateRay(x + 0.5f + off.x, y + 0.5f + off.y);
-                Color L = direct ? directTrace(sc, tracer, ray, smp, dp, &localRays)
-                                 : pathTrace(sc, tracer, ray, smp, pp, &localRays);
+                Color L = direct   ? directTrace(sc, tracer, ray, smp, dp, &localRays)
+                          : photon ? photonTrace(sc, tracer, ray, smp, globalMap, causticMap, php, &localRays)
+                                   : pathTrace(sc, tracer, ray, smp, pp, &localRays);
                 if (!isFiniteVec(L) || L.x < 0.f || L.y < 0.f || L.z < 0.f) {
                   ++localBad;
                   continue;

@@ -368,8 +368,34 @@ class Loader {
       s.bsdfSamples = getInt(f, p, "bsdf_samples", shading);
       s.hideEmitters = getBool(f, p, "hide_emitters", false);
       s.strategy = getString(f, p, "strategy", "mis");
+    } else if (type == "photon" || type == "photonmapper") {
+      s.type = "photon";
+      s.maxDepth = getInt(f, p, "max_depth", 16);
+      s.hideEmitters = getBool(f, p, "hide_emitters", false);
+      s.strategy = getString(f, p, "strategy", "mis");
+      int g = getInt(f, p, "global_photons", 250000), c = getInt(f, p, "caustic_photons", 250000);
+      if (g < 0 || c < 0) fail(f, n, "photon counts must not be negative");
+      s.globalPhotons = size_t(g);
+      s.causticPhotons = size_t(c);
+      s.lookupSize = getInt(f, p, "lookup_size", 120);
+      if (s.lookupSize < 1 || s.lookupSize > 512) fail(f, n, "lookup_size must be between 1 and 512");
+      s.maxRadius = getFloat(f, p, "max_radius", 0.f);
+      s.gatherSamples = getInt(f, p, "gather_samples", 8);
+      s.coneFilter = getBool(f, p, "cone_filter", false);
+      if (s.maxRadius < 0.f || s.gatherSamples < 0) fail(f, n, "max_radius and gather_samples must not be negative");
+    } else if (type == "sppm") {
+      s.maxDepth = getInt(f, p, "max_depth", 16);
+      s.strategy = getString(f, p, "strategy", "mis");
+      s.passes = getInt(f, p, "passes", 64);
+      int pc = getInt(f, p, "photon_count", 100000);
+      s.initialRadius = getFloat(f, p, "initial_radius", 0.f);
+      s.alpha = getFloat(f, p, "alpha", 2.f / 3.f);
+      if (s.passes < 1 || pc < 1) fail(f, n, "passes and photon_count must be positive");
+      if (!(s.alpha > 0.f && s.alpha < 1.f)) fail(f, n, "alpha must be in (0, 1)");
+      if (s.initialRadius < 0.f) fail(f, n, "initial_radius must not be negative");
+      s.photonCount = size_t(pc);
     } else {
-      fail(f, n, fmt::format("unknown integrator type '{}' (path, direct)", type));
+      fail(f, n, fmt::format("unknown integrator type '{}' (path, direct, photon, sppm)", type));
     }
     static const std::set<std::string> strategies = {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis"};
     if (!strategies.count(s.strategy))
@@ -569,7 +595,7 @@ class Loader {
         b.perfectMirror = false;
       }
       b.specularReflectance = getColor(f, p, "specular_reflectance", Color(1.f));
-      roughness(f, n, p, b, type);
+      if (type == "roughconductor") roughness(f, n, p, b, type);
     } else if (type == "dielectric" || type == "thindielectric" || type == "roughdielectric") {
       b.type = type == "dielectric" ? BsdfType::Dielectric
                : type == "thindielectric" ? BsdfType::ThinDielectric : BsdfType::RoughDielectric;

@@ -1,0 +1,103 @@
+// Stochastic progressive photon mapping (Hachisuka and Jensen 2009). Each pass traces one
+// camera path per pixel to its first non-specular surface (a visible point, with direct light
+// by MIS there), shoots photons, and gathers them at visible points through a hashed grid;
+// per-pixel radii shrink with alpha. The per-path work is host/device code; this driver
+// runs it with oneTBB.
+#pragma once
+
+#include <atomic>
+#include <functional>
+
+#include "accel/EmbreeAccel.h"
+#include "image/Image.h"
+#include "integrators/DirectIntegrator.h"
+#include "photon/HashGrid.h"
+#include "photon/PhotonTracing.h"
+#include "scene/Scene.h"
+
+namespace envgi {
+
+struct VisiblePoint {
+  Vec3f p;
+  Vec3f wo;
+  Frame shading;
+  Color beta;
+  int bsdf = 0;
+  bool valid = false;
+};
+
+// Camera path through specular bounces to the first non-delta surface; adds emission seen
+// along the way and direct light at the visible point to *Ld.
+template <class Tracer>
+ENVGI_HD VisiblePoint sppmCameraPath(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& smp, int maxDepth,
+                                     EnvStrategy strategy, Color* Ld, uint64_t* rays) {
+  VisiblePoint vp;
+  Color beta(1.f);
+  for (int depth = 0; depth < maxDepth; ++depth) {
+    Hit h;
+    ++*rays;
+    if (!tracer.intersect(ray, &h)) {
+      if (sc.hasEnvironment) *Ld += beta * sc.env.eval(ray.d);
+      return vp;
+    }
+    SurfaceInteraction si = sc.interaction(ray, h);
+    Vec3f wo = -ray.d;
+    *Ld += beta * sc.emitted(si, wo);
+    const Bsdf& bsdf = sc.bsdfs[si.bsdf];
+    if (!bsdfIsDelta(bsdf)) {
+      *Ld += beta * directLighting(sc, tracer, si, wo, smp, strategy, 1, 1, rays);
+      vp.p = si.p;
+      vp.wo = wo;
+      vp.shading = si.shading;
+      vp.beta = beta;
+      vp.bsdf = si.bsdf;
+      vp.valid = true;
+      return vp;
+    }
+    BsdfSample bs;
+    float uc = smp.get1D();
+    Vec2f ub = smp.get2D();
+    if (!bsdfSample(bsdf, si.shading.toLocal(wo), uc, ub, &bs)) return vp;
+    beta *= bs.weight;
+    Vec3f wi = si.shading.toWorld(bs.wi);
+    ray = Ray{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};
+  }
+  return vp;
+}
+
+// A photon's contribution f(wo, wi) beta_vp Phi at one visible point within its radius.
+ENVGI_INLINE Color sppmContribution(const SceneView& sc, const VisiblePoint& vp, Vec3f wi, Color power) {
+  const Bsdf& b = sc.bsdfs[vp.bsdf];
+  Vec3f wiLocal = vp.shading.toLocal(wi);
+  float c = std::fabs(wiLocal.z);
+  if (c <= 0.f) return Color(0.f);
+  return vp.beta * bsdfEval(b, vp.shading.toLocal(vp.wo), wiLocal) * power / c;
+}
+
+struct SppmSettings {
+  int passes = 64;
+  size_t photonsPerPass = 100000;
+  float initialRadius = 0.f;  // 0: 1% of the scene's bounding-sphere radius
+  float alpha = 2.f / 3.f;
+  int maxDepth = 16;
+  uint32_t seed = 0;
+  int threads = 0;
+  bool progress = true;
+  EnvStrategy strategy = EnvStrategy::Alias;
+  double checkpointSeconds = 0.0;
+  std::function<void(const Image&, int passesDone)> checkpoint;
+  const std::atomic<bool>* cancel = nullptr;
+};
+
+struct SppmStats {
+  int passesDone = 0;
+  uint64_t photonsShot = 0, photonHits = 0, rays = 0;
+  double cameraSeconds = 0.0, photonSeconds = 0.0, seconds = 0.0;
+  size_t bytes = 0;
+  float finalMeanRadius = 0.f;
+  bool cancelled = false;
+};
+
+Image renderSppm(const Scene& scene, const EmbreeAccel& accel, const SppmSettings& s, SppmStats* stats);
+
+}  // namespace envgi

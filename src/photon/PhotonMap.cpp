@@ -1,0 +1,129 @@
+#include "photon/PhotonMap.h"
+
+#include <nanoflann.hpp>
+#include <tbb/parallel_for.h>
+
+namespace envgi {
+
+namespace {
+struct Cloud {
+  const std::vector<Photon>* pts;
+  size_t kdtree_get_point_count() const { return pts->size(); }
+  float kdtree_get_pt(size_t i, size_t dim) const { return (*pts)[i].p[int(dim)]; }
+  template <class BBox>
+  bool kdtree_get_bbox(BBox&) const {
+    return false;
+  }
+};
+using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, uint32_t>;
+}  // namespace
+
+struct PhotonMap::Index {
+  Cloud cloud;
+  Tree tree;
+  explicit Index(const std::vector<Photon>* p) : cloud{p}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+    tree.buildIndex();
+  }
+};
+
+PhotonMap::PhotonMap() = default;
+PhotonMap::~PhotonMap() = default;
+PhotonMap::PhotonMap(PhotonMap&&) noexcept = default;
+PhotonMap& PhotonMap::operator=(PhotonMap&&) noexcept = default;
+
+void PhotonMap::build(std::vector<Photon> photons) {
+  photons_ = std::move(photons);
+  index_.reset();
+  if (!photons_.empty()) index_ = std::make_unique<Index>(&photons_);
+}
+
+size_t PhotonMap::bytes() const {
+  // The kd-trees hold one index per point plus nodes of about 16 points each.
+  size_t n = photons_.size(), m = irr_.size();
+  return n * (sizeof(Photon) + sizeof(uint32_t)) + n / 16 * 48 +
+         m * (sizeof(IrradiancePoint) + sizeof(Photon) + sizeof(uint32_t)) + m / 16 * 48;
+}
+
+void PhotonMap::precomputeIrradiance(int k, float maxRadius, int stride) {
+  irr_.clear();
+  irrPhotons_.clear();
+  irrIndex_.reset();
+  if (!index_ || stride < 1) return;
+  size_t count = (photons_.size() + size_t(stride) - 1) / size_t(stride);
+  irr_.resize(count);
+  size_t kk = size_t(std::min(std::max(k, 1), 512));
+  float maxR2 = maxRadius * maxRadius;
+  tbb::parallel_for(size_t(0), count, [&](size_t i) {
+    const Photon& c = photons_[i * size_t(stride)];
+    uint32_t idx[512];
+    float d2[512];
+    float q[3] = {c.p.x, c.p.y, c.p.z};
+    size_t found = index_->tree.knnSearch(q, kk, idx, d2);
+    Color sum(0.f);
+    float r2 = 0.f;
+    size_t kept = 0;
+    for (size_t j = 0; j < found; ++j) {
+      if (d2[j] > maxR2) continue;
+      const Photon& ph = photons_[idx[j]];
+      r2 = fmaxf(r2, d2[j]);
+      ++kept;
+      if (dot(ph.n, c.n) > 0.9f) sum += ph.power;  // same side of the same surface
+    }
+    if (kept < kk) r2 = maxR2;
+    irr_[i] = {c.p, c.n, kept > 0 ? sum / (kPi * r2) : Color(0.f)};
+  });
+  irrPhotons_.resize(count);
+  for (size_t i = 0; i < count; ++i) irrPhotons_[i].p = irr_[i].p;
+  irrIndex_ = std::make_unique<Index>(&irrPhotons_);
+}
+
+Color PhotonMap::irradiance(Vec3f p, Vec3f n) const {
+  if (!irrIndex_) return Color(0.f);
+  uint32_t idx[8];
+  float d2[8];
+  float q[3] = {p.x, p.y, p.z};
+  size_t found = irrIndex_->tree.knnSearch(q, 8, idx, d2);
+  for (size_t j = 0; j < found; ++j)
+    if (dot(irr_[idx[j]].n, n) > 0.9f) return irr_[idx[j]].e;
+  return Color(0.f);
+}
+
+Color PhotonMap::estimate(const SceneView& sc, const SurfaceInteraction& si, Vec3f woWorld, const PhotonLookup& q) const {
+  if (!index_ || q.k <= 0) return Color(0.f);
+  const Bsdf& bsdf = sc.bsdfs[si.bsdf];
+  Vec3f woLocal = si.shading.toLocal(woWorld);
+  size_t k = size_t(q.k);
+  uint32_t idx[512];
+  float d2[512];
+  if (k > 512) k = 512;
+  float query[3] = {si.p.x, si.p.y, si.p.z};
+  size_t found = index_->tree.knnSearch(query, k, idx, d2);
+  float maxR2 = q.maxRadius * q.maxRadius;
+  size_t kept = 0;
+  float r2 = 0.f;
+  for (size_t i = 0; i < found; ++i)
+    if (d2[i] <= maxR2) {
+      r2 = fmaxf(r2, d2[i]);
+      ++kept;
+    }
+  if (kept == 0) return Color(0.f);
+  if (kept < k) r2 = maxR2;
+  float r = std::sqrt(r2);
+  const float coneK = 1.1f;
+  Color sum(0.f);
+  for (size_t i = 0; i < found; ++i) {
+    if (d2[i] > maxR2) continue;
+    const Photon& ph = photons_[idx[i]];
+    Vec3f wiLocal = si.shading.toLocal(ph.wi);
+    if (dot(ph.wi, si.ng) * dot(woWorld, si.ng) <= 0.f && !bsdfTransmits(bsdf)) continue;
+    float c = std::fabs(wiLocal.z);
+    if (c <= 0.f) continue;
+    Color f = bsdfEval(bsdf, woLocal, wiLocal) / c;  // eval() carries |cos|; Eq. 12 wants f_r
+    float w = q.coneFilter ? 1.f - std::sqrt(d2[i]) / (coneK * r) : 1.f;
+    sum += f * ph.power * w;
+  }
+  float norm = q.coneFilter ? (1.f - 2.f / (3.f * coneK)) : 1.f;
+  return sum / (kPi * r2 * norm);
+}
+
+}  // namespace envgi

@@ -1,0 +1,55 @@
+// A photon map on the CPU: photons in a nanoflann kd-tree, and the radiance estimate of the
+// paper's Eq. 10-12 from the k nearest photons.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "photon/PhotonTracing.h"
+
+namespace envgi {
+
+struct PhotonLookup {
+  int k = 120;              // photons in the estimate
+  float maxRadius = 0.1f;   // search radius bound
+  bool coneFilter = false;  // Jensen's cone filter, k = 1.1
+};
+
+class PhotonMap {
+ public:
+  PhotonMap();
+  ~PhotonMap();
+  PhotonMap(PhotonMap&&) noexcept;
+  PhotonMap& operator=(PhotonMap&&) noexcept;
+
+  // Takes the photons and builds the kd-tree.
+  void build(std::vector<Photon> photons);
+  size_t size() const { return photons_.size(); }
+  const std::vector<Photon>& photons() const { return photons_; }
+  size_t bytes() const;
+
+  // L_r(x, wo) = 1/(pi r^2) sum f_r(x, wp, wo) dPhi_p (Eq. 12), r the distance to the k-th
+  // photon (Eq. 11), or maxRadius when fewer are within it. Photons arriving from behind the
+  // surface are left out.
+  Color estimate(const SceneView& sc, const SurfaceInteraction& si, Vec3f woWorld, const PhotonLookup& q) const;
+
+  // Christensen's precomputation: irradiance from the k nearest photons at every stride-th
+  // photon, so that a final-gather ray needs one nearest-neighbour lookup, not k.
+  void precomputeIrradiance(int k, float maxRadius, int stride);
+  // Irradiance near p on a surface facing n (zero where no precomputed point fits).
+  Color irradiance(Vec3f p, Vec3f n) const;
+
+ private:
+  struct Index;
+  struct IrradiancePoint {
+    Vec3f p, n;
+    Color e;
+  };
+  std::vector<Photon> photons_;
+  std::unique_ptr<Index> index_;
+  std::vector<IrradiancePoint> irr_;
+  std::vector<Photon> irrPhotons_;  // positions of irr_, for their own kd-tree
+  std::unique_ptr<Index> irrIndex_;
+};
+
+}  // namespace envgi

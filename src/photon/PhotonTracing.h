@@ -1,0 +1,102 @@
+// The paper's first pass (Section 3): photons leave the environment map (its Algorithm 1
+// density) and the area lights, bounce with Russian roulette by albedo through glass and
+// mirrors, and are handed to a store callback at every non-specular hit after the first.
+// Host/device: the store callback and the tracer are template parameters.
+#pragma once
+
+#include "integrators/LightSampling.h"
+#include "sampling/Sampler.h"
+
+namespace envgi {
+
+struct Photon {
+  Vec3f p;
+  Vec3f wi;     // unit direction the photon came from (pointing away from the surface)
+  Vec3f n;      // geometric normal where it was stored, facing wi
+  Color power;  // flux carried, already divided by the number of photons emitted
+};
+
+struct PhotonEmitter {
+  Vec3f center;        // of the scene's bounding sphere
+  float radius = 1.f;
+  float envProb = 1.f; // chance a photon leaves the environment rather than an area light
+
+  // Origin, direction and flux (times the photon count) of one emitted photon.
+  ENVGI_HD bool emit(const SceneView& sc, Sampler& smp, Ray* ray, Color* power) const {
+    float uSel = smp.get1D();
+    Vec2f u1 = smp.get2D(), u2 = smp.get2D();
+    if (uSel < envProb && sc.hasEnvironment) {
+      // Direction by importance; origin on a disk facing it that covers the bounding sphere.
+      EnvSample es = sc.env.sample(EnvStrategy::Importance, u1);
+      if (!(es.pdf > 0.f) || isBlack(es.radiance)) return false;
+      Frame f = Frame::fromNormal(es.dir);
+      Vec2f d = sampleConcentricDisk(u2);
+      ray->o = center + (es.dir + f.s * d.x + f.t * d.y) * radius;
+      ray->d = -es.dir;
+      ray->tMax = INFINITY;
+      *power = es.radiance * (kPi * radius * radius / (es.pdf * envProb));
+      return true;
+    }
+    if (sc.lightCount == 0) return false;
+    float pmf;
+    int li = sc.lightSelect.sample(u2.x, u2.y, &pmf, nullptr);
+    const LightPrim& lp = sc.lights[li];
+    Vec3f p, n;
+    sampleLightPrim(sc, lp, u1, &p, &n);
+    Vec2f u3 = smp.get2D();
+    Vec3f dir = Frame::fromNormal(n).toWorld(sampleCosineHemisphere(u3));
+    ray->o = offsetRayOrigin(p, n, dir, 0.f);
+    ray->d = normalize(dir);
+    ray->tMax = INFINITY;
+    // Le cos / (pdf_area pdf_dir) with pdf_dir = cos / pi.
+    *power = lp.radiance * (kPi * lp.area / (pmf * (1.f - envProb)));
+    return true;
+  }
+};
+
+// Importance (flux) transport through refraction keeps the eta^2 that radiance loses.
+ENVGI_INLINE Color adjointWeight(const Bsdf& b, Vec3f woLocal, const BsdfSample& bs) {
+  if ((b.type == BsdfType::Dielectric || b.type == BsdfType::RoughDielectric) && woLocal.z * bs.wi.z < 0.f) {
+    float etap = woLocal.z > 0.f ? b.ior : 1.f / b.ior;
+    return bs.weight * (etap * etap);
+  }
+  return bs.weight;
+}
+
+// store(si, wiWorld, power, caustic, depth) is called at each non-specular hit after the
+// first; caustic is true when every bounce before it was specular (light -> S+ -> here).
+template <class Tracer, class Store>
+ENVGI_HD int tracePhoton(const SceneView& sc, const Tracer& tracer, Ray ray, Color power, Sampler& smp, int maxDepth,
+                         Store&& store) {
+  bool specularOnly = true;
+  int stored = 0;
+  for (int depth = 0; depth < maxDepth; ++depth) {
+    Hit h;
+    if (!tracer.intersect(ray, &h)) break;
+    SurfaceInteraction si = sc.interaction(ray, h);
+    const Bsdf& bsdf = sc.bsdfs[si.bsdf];
+    Vec3f wi = -ray.d;
+    if (!bsdfIsDelta(bsdf) && depth > 0) {
+      store(si, wi, power, specularOnly, depth);
+      ++stored;
+    }
+    Vec3f woLocal = si.shading.toLocal(wi);
+    BsdfSample bs;
+    float uc = smp.get1D();
+    Vec2f ub = smp.get2D();
+    if (!bsdfSample(bsdf, woLocal, uc, ub, &bs)) break;
+    Color w = adjointWeight(bsdf, woLocal, bs);
+    specularOnly = specularOnly && bs.delta;
+    // Russian roulette by albedo: survivors keep roughly the same power.
+    float q = fminf(1.f, maxComponent(w));
+    if (!(q > 0.f) || smp.get1D() >= q) break;
+    power = power * w / q;
+    Vec3f d = si.shading.toWorld(bs.wi);
+    ray.o = offsetRayOrigin(si.p, si.ng, d, si.t);
+    ray.d = d;
+    ray.tMax = INFINITY;
+  }
+  return stored;
+}
+
+}  // namespace envgi
