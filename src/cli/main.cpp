@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   });
   envgi::cli::addEnvmapCommands(app);
   envgi::cli::addRenderCommand(app);
+  envgi::cli::addPhotonsCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

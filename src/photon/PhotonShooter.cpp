@@ -71,6 +71,11 @@ void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShoo
     if (!cDone) cEmitted = emitted;
     gDone = gDone || g.size() >= s.globalPhotons;
     cDone = cDone || c.size() >= s.causticPhotons;
+    // No specular surface in reach of the lights: do not spin on an empty caustic map.
+    if (!cDone && c.empty() && emitted >= (uint64_t(1) << 20)) {
+      spdlog::info("no caustic paths after {} photons: the caustic map stays empty", emitted);
+      cDone = true;
+    }
     if (s.progress)
       spdlog::debug("photons: {} emitted, {} global, {} caustic stored", emitted, g.size(), c.size());
   }

@@ -108,10 +108,10 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
   const SceneView& sc = scene.view();
   const Camera& cam = sc.camera;
   int W = cam.width, H = cam.height;
-  int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
-  if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
   const IntegratorSettings& is = scene.integrator;
   if (is.type == "sppm") return renderSppmFromSettings(scene, accel, opts, stats);
+  int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
+  if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
   bool direct = is.type == "direct";
   bool photon = is.type == "photon";
   if (!direct && !photon && is.type != "path") throw std::runtime_error("unknown integrator '" + is.type + "'");

@@ -29,6 +29,16 @@ struct Camera {
   }
 };
 
+// Film position (pixels) of a world point, the inverse of generateRay; false behind the camera.
+ENVGI_INLINE bool projectToFilm(const Camera& c, Vec3f p, float* x, float* y) {
+  Vec3f q = c.toWorld.inversePoint(p);
+  if (q.z <= 0.f) return false;
+  float sx = -(q.x / q.z) / c.tanHalfX, sy = (q.y / q.z) / c.tanHalfY;
+  *x = 0.5f * (sx + 1.f) * float(c.width);
+  *y = 0.5f * (1.f - sy) * float(c.height);
+  return *x >= 0.f && *y >= 0.f && *x < float(c.width) && *y < float(c.height);
+}
+
 // Film offset from the pixel centre, sampled by the reconstruction filter itself, so every
 // sample has weight one (filter importance sampling). box: radius 0.5; tent: radius 1;
 // gaussian: standard deviation 0.5 (Mitsuba's default), not truncated.

@@ -115,3 +115,34 @@ TEST(CliRender, InterruptKeepsFinishedWork) {
   EXPECT_TRUE(fs::exists(out)) << log;
   EXPECT_NE(log.find("interrupted"), std::string::npos) << log;
 }
+
+TEST(CliPhotons, DrawsPhotonsAndRejectsBadInput) {
+  TempDir d;
+  std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml";
+  CliResult r = runCli("photons " + scene + " -o " + d.file("p.png") + " -D res=64 --global 2000 --caustic 2000");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_GT(fs::file_size(d.file("p.png")), 500u);
+  EXPECT_NE(r.output.find("caustic photons"), std::string::npos) << r.output;
+  CliResult bad = runCli("photons " + scene + " -o " + d.file("p.txt"));
+  EXPECT_NE(bad.code, 0);
+  EXPECT_FALSE(fs::exists(d.file("p.txt")));
+  CliResult missing = runCli("photons /nonexistent.xml -o " + d.file("q.png"));
+  EXPECT_NE(missing.code, 0);
+  EXPECT_FALSE(fs::exists(d.file("q.png")));
+}
+
+TEST(CliRender, PhotonAndSppmIntegrators) {
+  TempDir d;
+  std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml";
+  for (const char* integ : {"photon", "sppm"}) {
+    CliResult r = runCli(std::string("render ") + scene + " -o " + d.file("c.exr") + " --integrator " + integ +
+                         " --spp 2 -D res=24 --no-progress");
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find(std::string(integ) == "sppm" ? "sppm: 2 passes" : "photon pass:"), std::string::npos)
+        << r.output;
+  }
+  std::ofstream(d.file("bad.xml")) << R"(<scene version="3.0.0"><integrator type="sppm"><float name="alpha" value="1.5"/></integrator></scene>)";
+  CliResult bad = runCli("render " + d.file("bad.xml") + " -o " + d.file("x.exr"));
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.output.find("alpha must be in (0, 1)"), std::string::npos) << bad.output;
+}

@@ -1,0 +1,142 @@
+// Photon emission and maps: energy bookkeeping in a closed box, the kd-tree estimate of a
+// known flux density, the hashed grid, and black maps.
+#include <gtest/gtest.h>
+
+#include "integrators/Sppm.h"
+#include "photon/HashGrid.h"
+#include "photon/PhotonShooter.h"
+#include "sampling/Pcg32.h"
+#include "support/TestScenes.h"
+
+using namespace envgi;
+
+namespace {
+
+// A closed box [-1,1]^3 facing inwards, albedo rho, lit by a tiny black emissive sphere.
+std::unique_ptr<Scene> closedBox(float rho) {
+  auto s = std::make_unique<Scene>();
+  Bsdf wall;
+  wall.reflectance = Color(rho);
+  Bsdf black;
+  black.reflectance = Color(0.f);
+  s->bsdfs = {wall, black};
+  TriangleMesh cube = makeCube();
+  for (size_t i = 0; i < cube.indices.size(); i += 3) std::swap(cube.indices[i + 1], cube.indices[i + 2]);
+  for (Vec3f& n : cube.normals) n = -n;
+  s->meshes.push_back(cube);
+  s->shapes.push_back({false, 0, 0, false, Color(0.f)});
+  s->spheres.push_back({Vec3f(0.f), 0.01f, false});
+  s->shapes.push_back({true, 0, 1, true, Color(1.f)});
+  s->camera.width = s->camera.height = 8;
+  s->camera.tanHalfX = s->camera.tanHalfY = 0.5f;
+  s->finalize();
+  return s;
+}
+
+}  // namespace
+
+// Stored power = emitted power x (rho + rho^2 + ...) = Phi rho / (1 - rho): the first hit is
+// not stored (direct light is the renderer's), every later arrival is.
+TEST(PhotonShooting, ClosedBoxEnergyBalance) {
+  for (float rho : {0.3f, 0.6f}) {
+    auto scene = closedBox(rho);
+    EmbreeAccel accel(*scene);
+    PhotonShootSettings ps;
+    ps.globalPhotons = 200000;
+    ps.causticPhotons = 0;
+    ps.maxDepth = 64;
+    ps.progress = false;
+    PhotonMap global, caustic;
+    PhotonShootStats st;
+    shootPhotons(*scene, accel, ps, &global, &caustic, &st);
+    EXPECT_EQ(caustic.size(), 0u);
+    double stored = 0.0;
+    for (const Photon& p : global.photons()) stored += p.power.y;
+    double phi = kPi * 4.0 * kPi * 0.01 * 0.01;  // Le pi A, one-sided
+    double expected = phi * rho / (1.0 - rho);
+    EXPECT_NEAR(stored, expected, 0.02 * expected) << "rho " << rho;
+  }
+}
+
+// Photons spread uniformly over a plane with flux density E give L = rho/pi E on a diffuse
+// surface (Eq. 12).
+TEST(PhotonMapEstimate, UniformDensityGivesDiffuseRadiance) {
+  Scene s;
+  Bsdf d;
+  d.reflectance = Color(0.5f);
+  s.bsdfs = {d};
+  s.finalize();
+  std::vector<Photon> ph;
+  Pcg32 rng(2);
+  const int n = 200000;
+  const float E = 3.f, area = 4.f;  // the plane [-1,1]^2 at z = 0
+  for (int i = 0; i < n; ++i) {
+    Vec3f wi = sampleCosineHemisphere({rng.nextFloat(), rng.nextFloat()});
+    ph.push_back({Vec3f(2.f * rng.nextFloat() - 1.f, 2.f * rng.nextFloat() - 1.f, 0.f), wi, Vec3f(0, 0, 1),
+                  Color(E * area / n)});
+  }
+  PhotonMap map;
+  map.build(ph);
+  SurfaceInteraction si;
+  si.p = Vec3f(0.1f, -0.2f, 0.f);
+  si.ng = Vec3f(0, 0, 1);
+  si.shading = Frame::fromNormal(si.ng);
+  si.bsdf = 0;
+  for (bool cone : {false, true}) {
+    PhotonLookup q;
+    q.k = 200;
+    q.maxRadius = 0.5f;
+    q.coneFilter = cone;
+    Color L = map.estimate(s.view(), si, Vec3f(0, 0, 1), q);
+    EXPECT_NEAR(L.x, 0.5f / kPi * E, 0.1f * 0.5f / kPi * E) << "cone " << cone;
+  }
+  map.precomputeIrradiance(200, 0.5f, 4);
+  EXPECT_NEAR(map.irradiance(si.p, Vec3f(0, 0, 1)).x, E, 0.1f * E);
+  EXPECT_EQ(map.irradiance(si.p, Vec3f(0, 0, -1)).x, 0.f) << "the back side has no irradiance point";
+}
+
+TEST(HashGrid, FindsEveryPointWithinTheCellSize) {
+  Pcg32 rng(4);
+  std::vector<Vec3f> pts(5000);
+  std::vector<char> valid(pts.size(), 1);
+  for (Vec3f& p : pts) p = Vec3f(rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2);
+  valid[7] = 0;
+  const float r = 0.3f;
+  HashGrid g;
+  g.build(pts, valid, r);
+  for (int t = 0; t < 200; ++t) {
+    Vec3f q(rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2);
+    std::vector<int> found, expect;
+    g.view().forNeighbours(q, [&](int i) {
+      if (lengthSq(pts[size_t(i)] - q) <= r * r) found.push_back(i);
+    });
+    for (size_t i = 0; i < pts.size(); ++i)
+      if (valid[i] && lengthSq(pts[i] - q) <= r * r) expect.push_back(int(i));
+    std::sort(found.begin(), found.end());
+    ASSERT_EQ(found, expect);
+  }
+}
+
+// An all-black map is a light of zero power: no photons, a black image, no NaN.
+TEST(PhotonIntegrators, BlackMapShootsNothingAndRendersBlack) {
+  Bsdf b;
+  auto scene = test::furnaceScene(b, 16, 4);
+  scene->env = std::make_unique<EnvironmentMap>(Image(16, 8), EnvironmentMapOptions{});
+  scene->finalize();
+  EmbreeAccel accel(*scene);
+  PhotonShootSettings ps;
+  ps.progress = false;
+  PhotonMap g, c;
+  shootPhotons(*scene, accel, ps, &g, &c, nullptr);
+  EXPECT_EQ(g.size() + c.size(), 0u);
+  for (const char* type : {"photon", "sppm"}) {
+    scene->integrator.type = type;
+    scene->integrator.passes = 3;
+    scene->integrator.photonCount = 1000;
+    RenderOptions o;
+    o.progress = false;
+    RenderStats st;
+    Image img = render(*scene, accel, o, &st);
+    for (float v : img.rgb) ASSERT_EQ(v, 0.f) << type;
+  }
+}

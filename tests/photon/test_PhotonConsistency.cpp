@@ -1,0 +1,116 @@
+// The photon integrators against the path tracer: SPPM converges to it on a diffuse scene, the
+// photon integrator's error falls as photons grow, and caustics appear under glass.
+#include <gtest/gtest.h>
+
+#include "support/CausticScene.h"
+
+using namespace envgi;
+
+namespace {
+
+std::unique_ptr<Scene> diffuseScene(bool glassSphere) {
+  auto s = std::make_unique<Scene>();
+  Bsdf floor;
+  floor.reflectance = Color(0.7f, 0.6f, 0.5f);
+  Bsdf ball;
+  ball.reflectance = Color(0.3f, 0.6f, 0.8f);
+  if (glassSphere) {
+    ball.type = BsdfType::Dielectric;
+    ball.ior = 1.5f;
+  }
+  s->bsdfs = {floor, ball};
+  TriangleMesh plane = makeRectangle();
+  plane.transform(scale(Vec3f(3.f)));
+  plane.transform(rotate(Vec3f(1, 0, 0), -90.f));
+  s->meshes.push_back(plane);
+  s->shapes.push_back({false, 0, 0, false, Color(0.f)});
+  s->spheres.push_back({Vec3f(0.f, 1.f, 0.f), 1.f, false});
+  s->shapes.push_back({true, 0, 1, false, Color(0.f)});
+  // A sky with a small bright sun high above: sharp shadows, a sharp caustic.
+  Image sky(128, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 128; ++x) sky.set(x, y, Color(y < 32 ? 0.4f : 0.05f));
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 128; ++x) sky.set(x, y, Color(400.f));
+  s->env = std::make_unique<EnvironmentMap>(std::move(sky), EnvironmentMapOptions{});
+  s->camera.toWorld = lookAt(Vec3f(0, 3.5f, 4.5f), Vec3f(0, 0.5f, 0), Vec3f(0, 1, 0));
+  s->camera.width = s->camera.height = 16;
+  s->camera.tanHalfX = s->camera.tanHalfY = std::tan(0.5f * 45.f * kPi / 180.f);
+  s->camera.filter = FilterType::Box;
+  s->finalize();
+  return s;
+}
+
+Image run(Scene& s, const std::string& type, int spp, std::vector<float>* var = nullptr) {
+  s.integrator.type = type;
+  s.sampler.sampleCount = spp;
+  s.finalize();
+  EmbreeAccel accel(s);
+  RenderOptions o;
+  o.progress = false;
+  o.varianceOut = var;
+  RenderStats st;
+  return render(s, accel, o, &st);
+}
+
+}  // namespace
+
+// Region means of SPPM lie within 4 sigma of the path tracer's (its variance from the
+// renderer) plus 4% for SPPM's remaining bias.
+TEST(PhotonConsistency, SppmMatchesPathOnDiffuseScene) {
+  auto scene = diffuseScene(false);
+  std::vector<float> var;
+  Image ref = run(*scene, "path", 1024, &var);
+  scene->integrator.passes = 128;
+  scene->integrator.photonCount = 20000;
+  Image sppm = run(*scene, "sppm", -1);
+  for (int ry = 0; ry < 16; ry += 4)
+    for (int rx = 0; rx < 16; rx += 4) {
+      double a = 0, b = 0, v = 0;
+      for (int y = ry; y < ry + 4; ++y)
+        for (int x = rx; x < rx + 4; ++x) {
+          a += luminance(ref.at(x, y)) / 16;
+          b += luminance(sppm.at(x, y)) / 16;
+          v += var[size_t(y) * 16 + x] / 256;
+        }
+      EXPECT_NEAR(b, a, 4 * std::sqrt(v) + 0.04 * a) << "region " << rx << "," << ry;
+    }
+}
+
+TEST(PhotonConsistency, PhotonErrorFallsWithPhotonCount) {
+  auto scene = diffuseScene(false);
+  Image ref = run(*scene, "path", 1024);
+  auto rmse = [&](size_t photons) {
+    scene->integrator.globalPhotons = photons;
+    scene->integrator.causticPhotons = photons / 4;
+    scene->integrator.gatherSamples = 0;  // read the global map directly: the photon error shows
+    Image img = run(*scene, "photon", 16);
+    double e = 0;
+    for (size_t i = 0; i < img.rgb.size(); ++i) e += sqr(img.rgb[i] - ref.rgb[i]);
+    return std::sqrt(e / img.rgb.size());
+  };
+  double small = rmse(2000), large = rmse(100000);
+  EXPECT_LT(large, small) << "rmse " << small << " -> " << large;
+}
+
+// A glass ball under a small sun focuses it into a caustic brighter than the sunlit floor
+// around it, with both photon integrators.
+TEST(PhotonConsistency, CausticAppearsUnderGlass) {
+  test::CausticSetup cs = test::causticScene(48);
+  EmbreeAccel accel(*cs.scene);
+  std::vector<int> focus = test::floorPixels(*cs.scene, accel, cs.causticCentre, 0.f, 0.15f);
+  std::vector<int> ring = test::floorPixels(*cs.scene, accel, cs.causticCentre, 1.8f, 2.6f);
+  ASSERT_GT(focus.size(), 3u);
+  ASSERT_GT(ring.size(), 20u);
+  for (const char* type : {"sppm", "photon"}) {
+    Scene& s = *cs.scene;
+    s.integrator.passes = 24;
+    s.integrator.photonCount = 100000;
+    s.integrator.globalPhotons = 20000;
+    s.integrator.causticPhotons = 100000;
+    s.integrator.gatherSamples = 2;
+    Image img = run(s, type, 4);
+    double a = test::meanLum(img, focus), b = test::meanLum(img, ring);
+    EXPECT_GT(a, 1.5 * b) << type << ": caustic " << a << " vs surround " << b;
+  }
+}

@@ -1,0 +1,70 @@
+// A glass ball on a diffuse floor under a sky with a small sun 30 degrees from the zenith: the
+// ball focuses the sun into a caustic on the floor, on the side away from the sun.
+#pragma once
+
+#include "support/TestScenes.h"
+
+namespace envgi::test {
+
+struct CausticSetup {
+  std::unique_ptr<Scene> scene;
+  Vec3f causticCentre;  // on the floor
+};
+
+inline CausticSetup causticScene(int res, bool chrome = false) {
+  CausticSetup cs;
+  auto s = std::make_unique<Scene>();
+  Bsdf floor;
+  floor.reflectance = Color(0.7f);
+  Bsdf ball;
+  ball.type = chrome ? BsdfType::Conductor : BsdfType::Dielectric;
+  ball.perfectMirror = true;
+  ball.ior = 1.5f;
+  s->bsdfs = {floor, ball};
+  TriangleMesh plane = makeRectangle();
+  plane.transform(scale(Vec3f(6.f)));
+  plane.transform(rotate(Vec3f(1, 0, 0), -90.f));
+  s->meshes.push_back(plane);
+  s->shapes.push_back({false, 0, 0, false, Color(0.f)});
+  s->spheres.push_back({Vec3f(0.f, 1.f, 0.f), 1.f, false});
+  s->shapes.push_back({true, 0, 1, false, Color(0.f)});
+  Image sky(128, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 128; ++x) sky.set(x, y, Color(y < 32 ? 0.3f : 0.02f));
+  for (int y = 10; y < 12; ++y)
+    for (int x = 31; x < 33; ++x) sky.set(x, y, Color(3000.f));
+  Vec3f sun = EnvironmentMapView::uvToDir(Vec2f(32.f / 128.f, 11.f / 64.f));
+  cs.causticCentre = Vec3f(0.f, 1.f, 0.f) - sun * (1.f / sun.y);
+  s->env = std::make_unique<EnvironmentMap>(std::move(sky), EnvironmentMapOptions{});
+  Vec3f c = cs.causticCentre;
+  s->camera.toWorld = lookAt(c + Vec3f(-3.f, 3.5f, 0.3f), c, Vec3f(0, 1, 0));
+  s->camera.width = s->camera.height = res;
+  s->camera.tanHalfX = s->camera.tanHalfY = std::tan(0.5f * 50.f * kPi / 180.f);
+  s->camera.filter = FilterType::Box;
+  s->finalize();
+  cs.scene = std::move(s);
+  return cs;
+}
+
+// Pixels whose camera ray lands directly on the floor within [r0, r1) of the centre.
+inline std::vector<int> floorPixels(const Scene& s, const EmbreeAccel& accel, Vec3f centre, float r0, float r1) {
+  std::vector<int> out;
+  const Camera& c = s.view().camera;
+  for (int y = 0; y < c.height; ++y)
+    for (int x = 0; x < c.width; ++x) {
+      Ray r = c.generateRay(x + 0.5f, y + 0.5f);
+      Hit h;
+      if (!accel.intersect(r, &h) || h.geomId != 0) continue;
+      float d = length(r.o + r.d * h.t - centre);
+      if (d >= r0 && d < r1) out.push_back(y * c.width + x);
+    }
+  return out;
+}
+
+inline double meanLum(const Image& img, const std::vector<int>& px) {
+  double s = 0.0;
+  for (int i : px) s += luminance(img.at(i % img.width, i / img.width));
+  return px.empty() ? 0.0 : s / double(px.size());
+}
+
+}  // namespace envgi::test
