@@ -34,6 +34,7 @@ void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShoo
   const uint64_t cap = 64 * std::max(s.globalPhotons, s.causticPhotons) + 100000;
   const int batch = 1 << 15, chunk = 1024;
   EmbreeTracer tracer{&accel};
+  double lastLog = 0.0;
   if (!anyLight) {
     spdlog::warn("the scene emits no light: no photons shot");
     gDone = cDone = true;
@@ -76,8 +77,12 @@ void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShoo
       spdlog::info("no caustic paths after {} photons: the caustic map stays empty", emitted);
       cDone = true;
     }
-    if (s.progress)
-      spdlog::debug("photons: {} emitted, {} global, {} caustic stored", emitted, g.size(), c.size());
+    double t = std::chrono::duration<double>(Clock::now() - t0).count();
+    if (s.progress && t - lastLog >= 2.0) {
+      lastLog = t;
+      spdlog::info("photon pass: {} emitted, {}/{} global, {}/{} caustic stored, {:.1f} s", emitted, g.size(),
+                   s.globalPhotons, c.size(), s.causticPhotons, t);
+    }
   }
   for (Photon& p : g) p.power = p.power / float(std::max<uint64_t>(gEmitted, 1));
   for (Photon& p : c) p.power = p.power / float(std::max<uint64_t>(cEmitted, 1));

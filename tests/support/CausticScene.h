@@ -28,12 +28,13 @@ inline CausticSetup causticScene(int res, bool chrome = false) {
   s->shapes.push_back({false, 0, 0, false, Color(0.f)});
   s->spheres.push_back({Vec3f(0.f, 1.f, 0.f), 1.f, false});
   s->shapes.push_back({true, 0, 1, false, Color(0.f)});
-  Image sky(128, 64);
-  for (int y = 0; y < 64; ++y)
-    for (int x = 0; x < 128; ++x) sky.set(x, y, Color(y < 32 ? 0.3f : 0.02f));
-  for (int y = 10; y < 12; ++y)
-    for (int x = 31; x < 33; ++x) sky.set(x, y, Color(3000.f));
-  Vec3f sun = EnvironmentMapView::uvToDir(Vec2f(32.f / 128.f, 11.f / 64.f));
+  // The sun is one pixel of a 512x256 map (about 2e-5 sr): hard to hit by BSDF sampling
+  // through glass, easy to shoot photons from.
+  Image sky(512, 256);
+  for (int y = 0; y < 256; ++y)
+    for (int x = 0; x < 512; ++x) sky.set(x, y, Color(y < 128 ? 0.3f : 0.02f));
+  sky.set(128, 44, Color(48000.f));
+  Vec3f sun = EnvironmentMapView::uvToDir(Vec2f(128.5f / 512.f, 44.5f / 256.f));
   cs.causticCentre = Vec3f(0.f, 1.f, 0.f) - sun * (1.f / sun.y);
   s->env = std::make_unique<EnvironmentMap>(std::move(sky), EnvironmentMapOptions{});
   Vec3f c = cs.causticCentre;

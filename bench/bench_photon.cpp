@@ -1,0 +1,99 @@
+// Photon mapping costs on the Cornell box: photons traced per second and the time of the
+// first pass as the count grows (1e5 to 1e7), radiance lookups per second, bytes per stored
+// photon, and SPPM passes.
+// Run: build/bin/envgi_bench_photon --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include "integrators/Sppm.h"
+#include "photon/PhotonShooter.h"
+#include "sampling/Pcg32.h"
+#include "scene/SceneLoader.h"
+
+using namespace envgi;
+
+namespace {
+struct Fixture {
+  Scene scene;
+  std::unique_ptr<EmbreeAccel> accel;
+  Fixture() {
+    loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml", {{"res", "128"}}, scene);
+    accel = std::make_unique<EmbreeAccel>(scene);
+  }
+};
+Fixture& fixture() {
+  static Fixture f;
+  return f;
+}
+}  // namespace
+
+static void BM_PhotonPass(benchmark::State& state) {
+  Fixture& f = fixture();
+  PhotonShootSettings ps;
+  ps.globalPhotons = size_t(state.range(0));
+  ps.causticPhotons = size_t(state.range(0)) / 4;
+  ps.progress = false;
+  PhotonShootStats st;
+  for (auto _ : state) {
+    PhotonMap g, c;
+    shootPhotons(f.scene, *f.accel, ps, &g, &c, &st);
+    benchmark::DoNotOptimize(g.size());
+  }
+  double stored = double(st.storedGlobal + st.storedCaustic);
+  state.counters["stored"] = stored;
+  state.counters["emitted"] = double(std::max(st.emittedGlobal, st.emittedCaustic));
+  state.counters["emitted/s"] = double(std::max(st.emittedGlobal, st.emittedCaustic)) / st.traceSeconds;
+  state.counters["trace_s"] = st.traceSeconds;
+  state.counters["kdtree_s"] = st.buildSeconds;
+  state.counters["bytes/photon"] = double(st.bytes) / stored;
+}
+BENCHMARK(BM_PhotonPass)->Arg(100000)->Arg(1000000)->Arg(10000000)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
+
+static void BM_RadianceLookup(benchmark::State& state) {
+  Fixture& f = fixture();
+  static PhotonMap g, c;
+  if (g.size() == 0) {
+    PhotonShootSettings ps;
+    ps.globalPhotons = 1000000;
+    ps.causticPhotons = 0;
+    ps.progress = false;
+    shootPhotons(f.scene, *f.accel, ps, &g, &c, nullptr);
+  }
+  const SceneView& sc = f.scene.view();
+  PhotonLookup q;
+  q.k = int(state.range(0));
+  q.maxRadius = 0.1f;
+  Pcg32 rng(3);
+  const auto& ph = g.photons();
+  Color acc(0.f);
+  for (auto _ : state) {
+    const Photon& p = ph[rng.nextUInt() % ph.size()];
+    SurfaceInteraction si;
+    si.p = p.p + Vec3f(0.01f * rng.nextFloat(), 0.f, 0.01f * rng.nextFloat());
+    si.ng = p.n;
+    si.shading = Frame::fromNormal(p.n);
+    si.bsdf = 0;
+    acc += g.estimate(sc, si, p.n, q);
+  }
+  benchmark::DoNotOptimize(acc);
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_RadianceLookup)->Arg(50)->Arg(120);
+
+static void BM_SppmPass(benchmark::State& state) {
+  Fixture& f = fixture();
+  SppmSettings s;
+  s.passes = 1;
+  s.photonsPerPass = size_t(state.range(0));
+  s.progress = false;
+  SppmStats st;
+  for (auto _ : state) {
+    Image img = renderSppm(f.scene, *f.accel, s, &st);
+    benchmark::DoNotOptimize(img.rgb.data());
+  }
+  state.counters["photons/s"] = double(s.photonsPerPass) / st.photonSeconds;
+  state.counters["camera_s"] = st.cameraSeconds;
+  state.counters["photon_s"] = st.photonSeconds;
+}
+BENCHMARK(BM_SppmPass)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+BENCHMARK_MAIN();
