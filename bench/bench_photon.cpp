@@ -43,7 +43,7 @@ static void BM_PhotonPass(benchmark::State& state) {
   state.counters["emitted"] = double(std::max(st.emittedGlobal, st.emittedCaustic));
   state.counters["emitted/s"] = double(std::max(st.emittedGlobal, st.emittedCaustic)) / st.traceSeconds;
   state.counters["trace_s"] = st.traceSeconds;
-  state.counters["kdtree_s"] = st.buildSeconds;
+  state.counters["kdtree_irradiance_s"] = st.buildSeconds;
   state.counters["bytes/photon"] = double(st.bytes) / stored;
 }
 BENCHMARK(BM_PhotonPass)->Arg(100000)->Arg(1000000)->Arg(10000000)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
