@@ -2,12 +2,18 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <map>
+#include <string>
+#include <vector>
 
 namespace envgi::cli {
 
 void addEnvmapCommands(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addPhotonsCommand(CLI::App& app);
+
+// -D name=value pairs into a map; throws on a pair without '='.
+std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds);
 
 // Parses a strategy name (uniform|cosine|importance|alias|adaptive); throws on others.
 int parseStrategyName(const std::string& name);

@@ -23,12 +23,7 @@ struct PhotonsArgs {
 };
 
 void runPhotons(const PhotonsArgs& a) {
-  std::map<std::string, std::string> defs;
-  for (const std::string& d : a.defines) {
-    size_t eq = d.find('=');
-    if (eq == std::string::npos || eq == 0) throw std::runtime_error("-D expects name=value, got '" + d + "'");
-    defs[d.substr(0, eq)] = d.substr(eq + 1);
-  }
+  std::map<std::string, std::string> defs = parseDefines(a.defines);
   std::string ext = std::filesystem::path(a.output).extension().string();
   if (ext != ".png" && ext != ".exr") throw std::runtime_error("output '" + a.output + "' must end in .png or .exr");
   Scene scene;

@@ -33,16 +33,6 @@ struct RenderArgs {
   double checkpoint = 60.0;
 };
 
-std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds) {
-  std::map<std::string, std::string> out;
-  for (const std::string& d : ds) {
-    size_t eq = d.find('=');
-    if (eq == std::string::npos || eq == 0) throw std::runtime_error("-D expects name=value, got '" + d + "'");
-    out[d.substr(0, eq)] = d.substr(eq + 1);
-  }
-  return out;
-}
-
 void runRender(const RenderArgs& a) {
   namespace fs = std::filesystem;
   std::string ext = fs::path(a.output).extension().string();
@@ -110,6 +100,16 @@ void runRender(const RenderArgs& a) {
 }
 
 }  // namespace
+
+std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds) {
+  std::map<std::string, std::string> out;
+  for (const std::string& d : ds) {
+    size_t eq = d.find('=');
+    if (eq == std::string::npos || eq == 0) throw std::runtime_error("-D expects name=value, got '" + d + "'");
+    out[d.substr(0, eq)] = d.substr(eq + 1);
+  }
+  return out;
+}
 
 void addRenderCommand(CLI::App& app) {
   auto a = std::make_shared<RenderArgs>();

@@ -50,10 +50,8 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
   }
   if (sc.lightCount == 0) return false;
   float pmf;
-  int li = sc.lightSelect.sample(u2.x, u2.y, &pmf, nullptr);
-  const LightPrim& lp = sc.lights[li];
   Vec3f p, n;
-  sampleLightPrim(sc, lp, u, &p, &n);
+  const LightPrim& lp = sampleAreaLight(sc, u2, u, &pmf, &p, &n);
   Vec3f d = p - si.p;
   float dist2 = lengthSq(d);
   if (dist2 <= 0.f) return false;

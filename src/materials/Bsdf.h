@@ -79,13 +79,18 @@ ENVGI_INLINE bool roughDielectricHalf(const Bsdf& b, Vec3f wo, Vec3f wi, Vec3f* 
   return true;
 }
 
+// A two-sided BSDF seen from behind is the front side mirrored through the surface.
+ENVGI_INLINE void toFrontSide(const Bsdf& b, Vec3f* wo, Vec3f* wi) {
+  if (b.twoSided && wo->z < 0.f) {
+    wo->z = -wo->z;
+    wi->z = -wi->z;
+  }
+}
+
 }  // namespace detail
 
 ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
-  if (b.twoSided && wo.z < 0.f) {
-    wo.z = -wo.z;
-    wi.z = -wi.z;
-  }
+  detail::toFrontSide(b, &wo, &wi);
   switch (b.type) {
     case BsdfType::Diffuse:
       if (wo.z <= 0.f || wi.z <= 0.f) return Color(0.f);
@@ -126,10 +131,7 @@ ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
 }
 
 ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
-  if (b.twoSided && wo.z < 0.f) {
-    wo.z = -wo.z;
-    wi.z = -wi.z;
-  }
+  detail::toFrontSide(b, &wo, &wi);
   switch (b.type) {
     case BsdfType::Diffuse:
       if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;

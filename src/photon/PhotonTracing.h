@@ -39,10 +39,8 @@ struct PhotonEmitter {
     }
     if (sc.lightCount == 0) return false;
     float pmf;
-    int li = sc.lightSelect.sample(u2.x, u2.y, &pmf, nullptr);
-    const LightPrim& lp = sc.lights[li];
     Vec3f p, n;
-    sampleLightPrim(sc, lp, u1, &p, &n);
+    const LightPrim& lp = sampleAreaLight(sc, u2, u1, &pmf, &p, &n);
     Vec2f u3 = smp.get2D();
     Vec3f dir = Frame::fromNormal(n).toWorld(sampleCosineHemisphere(u3));
     ray->o = offsetRayOrigin(p, n, dir, 0.f);
