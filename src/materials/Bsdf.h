@@ -168,6 +168,16 @@ ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
   }
 }
 
+namespace detail {
+// Non-delta lobes: the pdf of the sampled direction over all lobes, and weight = eval / pdf.
+ENVGI_INLINE bool finishSample(const Bsdf& b, Vec3f wo, BsdfSample* s) {
+  s->pdf = bsdfPdf(b, wo, s->wi);
+  if (!(s->pdf > 0.f)) return false;
+  s->weight = bsdfEval(b, wo, s->wi) / s->pdf;
+  return true;
+}
+}  // namespace detail
+
 // uc picks a lobe, u the direction within it. Returns false when no direction is produced.
 ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s) {
   bool flip = b.twoSided && wo.z < 0.f;
@@ -197,10 +207,7 @@ ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSam
       Vec3f m = GGX{b.alpha}.sampleVisible(wo, u);
       s->wi = reflect(wo, m);
       if (s->wi.z <= 0.f) return false;
-      s->pdf = bsdfPdf(b, wo, s->wi);
-      if (!(s->pdf > 0.f)) return false;
-      s->weight = bsdfEval(b, wo, s->wi) / s->pdf;
-      ok = true;
+      ok = detail::finishSample(b, wo, s);
       break;
     }
     case BsdfType::Dielectric: {
@@ -256,10 +263,7 @@ ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSam
         }
         if (!refractDir(wo, n, e, &s->wi) || s->wi.z * wo.z >= 0.f) return false;
       }
-      s->pdf = bsdfPdf(b, wo, s->wi);
-      if (!(s->pdf > 0.f)) return false;
-      s->weight = bsdfEval(b, wo, s->wi) / s->pdf;
-      ok = true;
+      ok = detail::finishSample(b, wo, s);
       break;
     }
     case BsdfType::Plastic:
@@ -281,10 +285,7 @@ ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSam
         s->wi = sampleCosineHemisphere(u);
       }
       if (s->wi.z <= 0.f) return false;
-      s->pdf = bsdfPdf(b, wo, s->wi);
-      if (!(s->pdf > 0.f)) return false;
-      s->weight = bsdfEval(b, wo, s->wi) / s->pdf;
-      ok = true;
+      ok = detail::finishSample(b, wo, s);
       break;
     }
   }

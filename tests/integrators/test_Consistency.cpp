@@ -12,7 +12,6 @@ namespace {
 
 // A glossy sphere on a diffuse floor under a smooth synthetic sky with a broad bright patch.
 std::unique_ptr<Scene> makeScene() {
-  auto s = std::make_unique<Scene>();
   Bsdf floor;
   floor.reflectance = Color(0.6f, 0.55f, 0.5f);
   Bsdf glossy;
@@ -20,25 +19,13 @@ std::unique_ptr<Scene> makeScene() {
   glossy.perfectMirror = true;
   glossy.specularReflectance = Color(0.8f);
   glossy.alpha = 0.35f;
-  s->bsdfs = {floor, glossy};
-  TriangleMesh plane = makeRectangle();
-  plane.transform(scale(Vec3f(4.f)));
-  plane.transform(rotate(Vec3f(1, 0, 0), -90.f));
-  s->meshes.push_back(plane);
-  s->shapes.push_back({false, 0, 0, false, Color(0.f)});
-  s->spheres.push_back({Vec3f(0.f, 1.f, 0.f), 1.f, false});
-  s->shapes.push_back({true, 0, 1, false, Color(0.f)});
   Image sky(64, 32);
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 64; ++x) {
       float patch = (std::abs(x - 20) < 5 && std::abs(y - 8) < 4) ? 6.f : 0.f;
       sky.set(x, y, Color(0.3f + 0.02f * (32 - y) + patch, 0.35f + patch, 0.4f + 0.5f * patch));
     }
-  s->env = std::make_unique<EnvironmentMap>(std::move(sky), EnvironmentMapOptions{});
-  s->camera.toWorld = lookAt(Vec3f(0, 2.5f, 5.f), Vec3f(0, 0.8f, 0), Vec3f(0, 1, 0));
-  s->camera.width = s->camera.height = 16;
-  s->camera.tanHalfX = s->camera.tanHalfY = std::tan(0.5f * 40.f * kPi / 180.f);
-  s->camera.filter = FilterType::Box;
+  auto s = test::sphereOnFloor(floor, glossy, 4.f, std::move(sky), Vec3f(0, 2.5f, 5.f), Vec3f(0, 0.8f, 0), 16, 40.f);
   s->sampler.type = SamplerType::Independent;
   s->sampler.sampleCount = 256;
   s->finalize();

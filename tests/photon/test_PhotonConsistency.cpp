@@ -9,7 +9,6 @@ using namespace envgi;
 namespace {
 
 std::unique_ptr<Scene> diffuseScene(bool glassSphere) {
-  auto s = std::make_unique<Scene>();
   Bsdf floor;
   floor.reflectance = Color(0.7f, 0.6f, 0.5f);
   Bsdf ball;
@@ -18,27 +17,11 @@ std::unique_ptr<Scene> diffuseScene(bool glassSphere) {
     ball.type = BsdfType::Dielectric;
     ball.ior = 1.5f;
   }
-  s->bsdfs = {floor, ball};
-  TriangleMesh plane = makeRectangle();
-  plane.transform(scale(Vec3f(3.f)));
-  plane.transform(rotate(Vec3f(1, 0, 0), -90.f));
-  s->meshes.push_back(plane);
-  s->shapes.push_back({false, 0, 0, false, Color(0.f)});
-  s->spheres.push_back({Vec3f(0.f, 1.f, 0.f), 1.f, false});
-  s->shapes.push_back({true, 0, 1, false, Color(0.f)});
-  // A sky with a small bright sun high above: sharp shadows, a sharp caustic.
+  // A sky with a bright band high above: sharp shadows, a sharp caustic.
   Image sky(128, 64);
   for (int y = 0; y < 64; ++y)
-    for (int x = 0; x < 128; ++x) sky.set(x, y, Color(y < 32 ? 0.4f : 0.05f));
-  for (int y = 0; y < 2; ++y)
-    for (int x = 0; x < 128; ++x) sky.set(x, y, Color(400.f));
-  s->env = std::make_unique<EnvironmentMap>(std::move(sky), EnvironmentMapOptions{});
-  s->camera.toWorld = lookAt(Vec3f(0, 3.5f, 4.5f), Vec3f(0, 0.5f, 0), Vec3f(0, 1, 0));
-  s->camera.width = s->camera.height = 16;
-  s->camera.tanHalfX = s->camera.tanHalfY = std::tan(0.5f * 45.f * kPi / 180.f);
-  s->camera.filter = FilterType::Box;
-  s->finalize();
-  return s;
+    for (int x = 0; x < 128; ++x) sky.set(x, y, Color(y < 2 ? 400.f : (y < 32 ? 0.4f : 0.05f)));
+  return test::sphereOnFloor(floor, ball, 3.f, std::move(sky), Vec3f(0, 3.5f, 4.5f), Vec3f(0, 0.5f, 0), 16, 45.f);
 }
 
 Image run(Scene& s, const std::string& type, int spp, std::vector<float>* var = nullptr) {

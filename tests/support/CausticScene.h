@@ -13,21 +13,12 @@ struct CausticSetup {
 
 inline CausticSetup causticScene(int res, bool chrome = false) {
   CausticSetup cs;
-  auto s = std::make_unique<Scene>();
   Bsdf floor;
   floor.reflectance = Color(0.7f);
   Bsdf ball;
   ball.type = chrome ? BsdfType::Conductor : BsdfType::Dielectric;
   ball.perfectMirror = true;
   ball.ior = 1.5f;
-  s->bsdfs = {floor, ball};
-  TriangleMesh plane = makeRectangle();
-  plane.transform(scale(Vec3f(6.f)));
-  plane.transform(rotate(Vec3f(1, 0, 0), -90.f));
-  s->meshes.push_back(plane);
-  s->shapes.push_back({false, 0, 0, false, Color(0.f)});
-  s->spheres.push_back({Vec3f(0.f, 1.f, 0.f), 1.f, false});
-  s->shapes.push_back({true, 0, 1, false, Color(0.f)});
   // The sun is one pixel of a 512x256 map (about 2e-5 sr): hard to hit by BSDF sampling
   // through glass, easy to shoot photons from.
   Image sky(512, 256);
@@ -36,13 +27,8 @@ inline CausticSetup causticScene(int res, bool chrome = false) {
   sky.set(128, 44, Color(48000.f));
   Vec3f sun = EnvironmentMapView::uvToDir(Vec2f(128.5f / 512.f, 44.5f / 256.f));
   cs.causticCentre = Vec3f(0.f, 1.f, 0.f) - sun * (1.f / sun.y);
-  s->env = std::make_unique<EnvironmentMap>(std::move(sky), EnvironmentMapOptions{});
   Vec3f c = cs.causticCentre;
-  s->camera.toWorld = lookAt(c + Vec3f(-3.f, 3.5f, 0.3f), c, Vec3f(0, 1, 0));
-  s->camera.width = s->camera.height = res;
-  s->camera.tanHalfX = s->camera.tanHalfY = std::tan(0.5f * 50.f * kPi / 180.f);
-  s->camera.filter = FilterType::Box;
-  s->finalize();
+  auto s = sphereOnFloor(floor, ball, 6.f, std::move(sky), c + Vec3f(-3.f, 3.5f, 0.3f), c, res, 50.f);
   cs.scene = std::move(s);
   return cs;
 }

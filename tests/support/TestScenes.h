@@ -26,6 +26,28 @@ inline std::unique_ptr<Scene> furnaceScene(const Bsdf& b, int res, int spp) {
   return s;
 }
 
+// A sphere of radius 1 resting on a square floor of half-size `half` (facing +y), lit by
+// `sky`, seen by a square camera of `res` pixels with a box filter.
+inline std::unique_ptr<Scene> sphereOnFloor(const Bsdf& floor, const Bsdf& ball, float half, Image sky, Vec3f eye,
+                                            Vec3f target, int res, float fovDeg) {
+  auto s = std::make_unique<Scene>();
+  s->bsdfs = {floor, ball};
+  TriangleMesh plane = makeRectangle();
+  plane.transform(scale(Vec3f(half)));
+  plane.transform(rotate(Vec3f(1, 0, 0), -90.f));
+  s->meshes.push_back(plane);
+  s->shapes.push_back({false, 0, 0, false, Color(0.f)});
+  s->spheres.push_back({Vec3f(0.f, 1.f, 0.f), 1.f, false});
+  s->shapes.push_back({true, 0, 1, false, Color(0.f)});
+  s->env = std::make_unique<EnvironmentMap>(std::move(sky), EnvironmentMapOptions{});
+  s->camera.toWorld = lookAt(eye, target, Vec3f(0, 1, 0));
+  s->camera.width = s->camera.height = res;
+  s->camera.tanHalfX = s->camera.tanHalfY = std::tan(0.5f * fovDeg * kPi / 180.f);
+  s->camera.filter = FilterType::Box;
+  s->finalize();
+  return s;
+}
+
 // Mean of the pixels whose whole footprint sees the sphere (the four corner rays hit it).
 inline double meanOverObject(const Scene& scene, const EmbreeAccel& accel, const Image& img, int* count) {
   const Camera& c = scene.view().camera;
