@@ -30,7 +30,11 @@ Image constantMap(float v) {
   return img;
 }
 
-std::string gracePath() { return std::string(ENVGI_ASSETS_DIR) + "/envmaps/grace/grace_latlong.hdr"; }
+// The shared copy where present, else the one bundled with the example scenes.
+std::string gracePath() {
+  std::string shared = std::string(ENVGI_ASSETS_DIR) + "/envmaps/grace/grace_latlong.hdr";
+  return std::filesystem::exists(shared) ? shared : std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/grace_latlong.hdr";
+}
 
 struct Case {
   std::string map;
