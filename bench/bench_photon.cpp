@@ -31,6 +31,7 @@ static void BM_PhotonPass(benchmark::State& state) {
   PhotonShootSettings ps;
   ps.globalPhotons = size_t(state.range(0));
   ps.causticPhotons = size_t(state.range(0)) / 4;
+  ps.irradianceStride = 4;  // as the photon integrator's final gather needs
   ps.progress = false;
   PhotonShootStats st;
   for (auto _ : state) {

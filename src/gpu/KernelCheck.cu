@@ -115,9 +115,7 @@ EnvironmentMapView toDevice(EnvironmentMapView v) {
   v.dist.condInt = upload(v.dist.condInt, size_t(v.height));
   v.dist.marginal.func = upload(v.dist.marginal.func, size_t(v.height));
   v.dist.marginal.cdf = upload(v.dist.marginal.cdf, size_t(v.height) + 1);
-  v.alias.prob = upload(v.alias.prob, px);
-  v.alias.alias = upload(v.alias.alias, px);
-  v.alias.pmf = upload(v.alias.pmf, px);
+  v.alias.bins = upload(v.alias.bins, px);
   v.adaptive.nodes = upload(v.adaptive.nodes, size_t(v.adaptive.nodeCount));
   v.adaptive.leafNodes = upload(v.adaptive.leafNodes, size_t(v.adaptive.leafCount));
   v.adaptive.leafSolidAngle = upload(v.adaptive.leafSolidAngle, size_t(v.adaptive.leafCount));

@@ -32,7 +32,7 @@ ENVGI_INLINE float areaLightPdf(const SceneView& sc, int light, Vec3f p, Vec3f l
   float cosL = std::fabs(dot(ln, d)) / std::sqrt(dist2);
   if (cosL <= 0.f) return 0.f;
   float sel = 1.f - sc.envSelectProb();
-  return sel * sc.lightSelect.pmf[light] / sc.lights[light].area * dist2 / cosL;
+  return sel * sc.lightSelect.pmf(light) / sc.lights[light].area * dist2 / cosL;
 }
 
 ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si, Vec3f axis, EnvStrategy strategy,

@@ -95,8 +95,10 @@ void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShoo
   }
   global->build(std::move(g));
   caustic->build(std::move(c));
-  global->precomputeIrradiance(s.irradianceLookup, s.irradianceRadius, 4);
-  caustic->precomputeIrradiance(s.irradianceLookup, 0.25f * s.irradianceRadius, 4);
+  if (s.irradianceStride > 0) {
+    global->precomputeIrradiance(s.irradianceLookup, s.irradianceRadius, s.irradianceStride);
+    caustic->precomputeIrradiance(s.irradianceLookup, 0.25f * s.irradianceRadius, s.irradianceStride);
+  }
   if (stats) {
     stats->traceSeconds = std::chrono::duration<double>(t1 - t0).count();
     stats->buildSeconds = std::chrono::duration<double>(Clock::now() - t1).count();

@@ -14,7 +14,9 @@ struct PhotonShootSettings {
   int maxDepth = 16;
   uint32_t seed = 0;
   bool progress = true;
-  // Precomputed irradiance (Christensen 1999) at every 4th photon, for final-gather lookups.
+  // Precomputed irradiance (Christensen 1999) at every stride-th photon, for final-gather
+  // lookups; 0 skips it (nothing reads it unless the photon integrator gathers).
+  int irradianceStride = 0;
   int irradianceLookup = 64;
   float irradianceRadius = 0.1f;
 };

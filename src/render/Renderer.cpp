@@ -121,6 +121,7 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
     float radius = makePhotonEmitter(scene).radius;
     PhotonShootSettings ps;
     ps.irradianceRadius = is.maxRadius > 0.f ? is.maxRadius : 0.05f * radius;
+    ps.irradianceStride = is.gatherSamples > 0 ? 4 : 0;
     ps.globalPhotons = is.globalPhotons;
     ps.causticPhotons = is.causticPhotons;
     ps.seed = scene.sampler.seed;

@@ -7,11 +7,19 @@
 
 namespace envgi {
 
+// One bin: its acceptance probability, its alias, and its own probability, side by side so a
+// draw that keeps its bin reads a single cache line.
+struct AliasBin {
+  float prob;
+  int alias;
+  float pmf;
+};
+
 struct AliasTableView {
-  const float* prob = nullptr;    // acceptance probability of bin i
-  const int* alias = nullptr;     // bin taken when bin i rejects
-  const float* pmf = nullptr;     // normalised weights
+  const AliasBin* bins = nullptr;
   int n = 0;
+
+  ENVGI_HD float pmf(int i) const { return bins[i].pmf; }
 
   // Picks a bin: u1 chooses the column, u2 decides between it and its alias, so each
   // decision keeps a float's full precision even for millions of bins. *u2Remapped is u2
@@ -19,16 +27,19 @@ struct AliasTableView {
   ENVGI_HD int sample(float u1, float u2, float* pmfOut, float* u2Remapped) const {
     float scaled = u1 * float(n);
     int i = scaled < float(n) ? int(scaled) : n - 1;
+    const AliasBin b = bins[i];
     int chosen;
-    float remap;
-    if (u2 < prob[i]) {
+    float remap, pmf;
+    if (u2 < b.prob) {
       chosen = i;
-      remap = u2 / prob[i];
+      remap = u2 / b.prob;
+      pmf = b.pmf;
     } else {
-      chosen = alias[i];
-      remap = (u2 - prob[i]) / (1.f - prob[i]);
+      chosen = b.alias;
+      remap = (u2 - b.prob) / (1.f - b.prob);
+      pmf = bins[chosen].pmf;
     }
-    if (pmfOut) *pmfOut = pmf[chosen];
+    if (pmfOut) *pmfOut = pmf;
     if (u2Remapped) *u2Remapped = remap < kOneMinusEpsilon ? remap : kOneMinusEpsilon;
     return chosen;
   }
@@ -39,12 +50,11 @@ class AliasTable {
   AliasTable() = default;
   // Weights need not be normalised; all-zero weights give the uniform distribution.
   AliasTable(const float* weights, size_t n);
-  AliasTableView view() const { return {prob_.data(), alias_.data(), pmf_.data(), int(prob_.size())}; }
-  size_t bytes() const { return prob_.size() * (2 * sizeof(float) + sizeof(int)); }
+  AliasTableView view() const { return {bins_.data(), int(bins_.size())}; }
+  size_t bytes() const { return bins_.size() * sizeof(AliasBin); }
 
  private:
-  std::vector<float> prob_, pmf_;
-  std::vector<int> alias_;
+  std::vector<AliasBin> bins_;
 };
 
 }  // namespace envgi
