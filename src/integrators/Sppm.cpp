@@ -20,7 +20,7 @@ Image renderSppm(const Scene& scene, const EmbreeAccel& accel, const SppmSetting
   if (!(s.alpha > 0.f && s.alpha < 1.f)) throw std::runtime_error("sppm: alpha must be in (0, 1)");
   PhotonEmitter emitter = makePhotonEmitter(scene);
   float r0 = s.initialRadius > 0.f ? s.initialRadius : 0.01f * emitter.radius;
-  bool anyLight = (scene.env && scene.env->luminancePower() > 0.f) || sc.lightCount > 0;
+  bool anyLight = emitter.emitsLight(sc);
 
   std::vector<float> r2(np, r0 * r0), n(np, 0.f);
   std::vector<Color> tau(np, Color(0.f)), ld(np, Color(0.f));

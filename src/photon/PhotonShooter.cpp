@@ -25,8 +25,7 @@ void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShoo
   auto t0 = Clock::now();
   const SceneView& sc = scene.view();
   PhotonEmitter emitter = makePhotonEmitter(scene);
-  bool anyLight = (emitter.envProb > 0.f) || sc.lightCount > 0;
-  if (scene.env && scene.env->luminancePower() <= 0.f && sc.lightCount == 0) anyLight = false;
+  bool anyLight = emitter.emitsLight(sc);
   std::vector<Photon> g, c;
   bool gDone = s.globalPhotons == 0, cDone = s.causticPhotons == 0;
   uint64_t emitted = 0, gEmitted = 0, cEmitted = 0;

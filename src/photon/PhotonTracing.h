@@ -21,6 +21,9 @@ struct PhotonEmitter {
   float radius = 1.f;
   float envProb = 1.f; // chance a photon leaves the environment rather than an area light
 
+  // False when nothing in the scene emits (a black map and no area lights): no photons then.
+  ENVGI_HD bool emitsLight(const SceneView& sc) const { return envProb > 0.f || sc.lightCount > 0; }
+
   // Origin, direction and flux (times the photon count) of one emitted photon.
   ENVGI_HD bool emit(const SceneView& sc, Sampler& smp, Ray* ray, Color* power) const {
     float uSel = smp.get1D();

@@ -84,6 +84,12 @@ class Loader {
   [[noreturn]] void fail(const SourceFile* f, pugi::xml_node n, const std::string& what) const {
     throw std::runtime_error(fmt::format("{}:{}: {}", f->path, f->lineOf(n.offset_debug()), what));
   }
+  // Re-raises an error from below with this element's file and line, unless it has them already.
+  [[noreturn]] void rethrowAt(const SourceFile* f, pugi::xml_node n, const std::runtime_error& e) const {
+    std::string what = e.what();
+    if (what.rfind(f->path, 0) == 0) throw e;
+    fail(f, n, what);
+  }
   void warnOnce(const std::string& msg) {
     if (warned_.insert(msg).second) spdlog::warn("{}", msg);
   }
@@ -300,9 +306,7 @@ class Loader {
           fail(f, c, fmt::format("unknown transform operation <{}>", tag));
         }
       } catch (const std::runtime_error& e) {
-        std::string what = e.what();
-        if (what.rfind(f->path, 0) == 0) throw;
-        fail(f, c, what);
+        rethrowAt(f, c, e);
       }
       t = op * t;
     }
@@ -510,7 +514,7 @@ class Loader {
     warnUnused(f, p, "sampler '" + type + "'");
   }
 
-  // Returns the radiance for an area emitter; registers environment emitters directly.
+  // An area emitter marks its shape emissive; envmap and constant become the scene's environment.
   void emitter(const SourceFile* f, pugi::xml_node n, ShapeEntry* shape) {
     checkAttrs(f, n, {"type", "id", "name"});
     std::string type = attr(f, n, "type");
@@ -538,7 +542,7 @@ class Loader {
         try {
           scene_.env = std::make_unique<EnvironmentMap>(EnvironmentMap::load(path.string(), o));
         } catch (const std::runtime_error& e) {
-          fail(f, n, e.what());
+          rethrowAt(f, n, e);
         }
       } else {
         Color L = getColor(f, p, "radiance", Color(1.f));
@@ -587,7 +591,7 @@ class Loader {
       try {
         conductorPreset(material, &b.eta, &b.k, &b.perfectMirror);
       } catch (const std::runtime_error& e) {
-        fail(f, n, e.what());
+        rethrowAt(f, n, e);
       }
       if (p.count("eta") || p.count("k")) {
         b.eta = getColor(f, p, "eta", Color(0.f));
@@ -674,9 +678,7 @@ class Loader {
           fail(f, n, fmt::format("unknown shape type '{}' (ply, obj, sphere, rectangle, cube, disk)", type));
         }
       } catch (const std::runtime_error& e) {
-        std::string what = e.what();
-        if (what.rfind(f->path, 0) == 0) throw;
-        fail(f, n, what);
+        rethrowAt(f, n, e);
       }
       bool faceNormals = getBool(f, p, "face_normals", false);
       mesh.transform(toWorld);
