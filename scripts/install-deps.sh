@@ -1,20 +1,15 @@
 #!/usr/bin/env bash
 # Installs the Debian 12 packages envgi builds and tests with. Idempotent: packages already
 # installed are skipped, and apt is not touched when nothing is missing.
-# Usage: scripts/install-deps.sh [--viewer]   (--viewer adds GLFW + Dear ImGui)
 set -euo pipefail
 
 PKGS=(
   build-essential cmake ninja-build pkg-config git ca-certificates
-  libembree-dev libtbb-dev libopenimageio-dev openimageio-tools
+  libembree-dev libtbb-dev libopenexr-dev libstb-dev
   libtinyobjloader-dev libpugixml-dev libcli11-dev nlohmann-json3-dev
   libfmt-dev libspdlog-dev libnanoflann-dev
   libgtest-dev libbenchmark-dev
-  python3 python3-matplotlib python3-numpy
 )
-if [[ "${1:-}" == "--viewer" ]]; then
-  PKGS+=(libglfw3-dev libimgui-dev)
-fi
 
 missing=()
 for p in "${PKGS[@]}"; do

@@ -34,8 +34,12 @@ void writeFileAtomically(const std::string& path, const std::string& content) {
       throw std::runtime_error("cannot write '" + path + "': write failed");
     }
   }
+  renameIntoPlace(tmp.string(), path);
+}
+
+void renameIntoPlace(const std::string& tmp, const std::string& path) {
   std::error_code ec;
-  fs::rename(tmp, p, ec);
+  fs::rename(tmp, path, ec);
   if (ec) {
     fs::remove(tmp, ec);
     throw std::runtime_error("cannot write '" + path + "': rename failed");

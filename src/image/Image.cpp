@@ -2,46 +2,187 @@
 
 #include "core/Files.h"
 
-#include <OpenImageIO/imageio.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
+#include <memory>
 #include <stdexcept>
-#include <unistd.h>
 
 namespace envgi {
 
 namespace fs = std::filesystem;
-using OIIO::ImageInput;
-using OIIO::ImageOutput;
-using OIIO::ImageSpec;
-using OIIO::TypeDesc;
+
+namespace {
+
+std::string lowerExtension(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
+  return ext;
+}
+
+struct FileCloser {
+  void operator()(FILE* f) const { std::fclose(f); }
+};
+using FilePtr = std::unique_ptr<FILE, FileCloser>;
+
+// OpenEXR (as pbrt-v4 and Mitsuba 3 read it): R, G, B as float, or Y alone as grey.
+Image loadExr(const std::string& path) {
+  try {
+    Imf::InputFile in(path.c_str());
+    const Imath::Box2i dw = in.header().dataWindow();
+    int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
+    if (w <= 0 || h <= 0) throw std::runtime_error("image '" + path + "' has no pixels");
+    const Imf::ChannelList& ch = in.header().channels();
+    bool rgb = ch.findChannel("R") && ch.findChannel("G") && ch.findChannel("B");
+    bool grey = !rgb && ch.findChannel("Y");
+    if (!rgb && !grey) throw std::runtime_error("image '" + path + "' has neither R, G, B nor Y channels");
+    Image img(w, h);
+    Imf::FrameBuffer fb;
+    char* base = reinterpret_cast<char*>(img.rgb.data()) -
+                 (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * w) * ptrdiff_t(3 * sizeof(float));
+    size_t xs = 3 * sizeof(float), ys = xs * size_t(w);
+    const char* names[3] = {"R", "G", "B"};
+    for (int k = 0; k < 3; ++k)
+      fb.insert(grey ? "Y" : names[k], Imf::Slice(Imf::FLOAT, base + k * sizeof(float), xs, ys));
+    in.setFrameBuffer(fb);
+    in.readPixels(dw.min.y, dw.max.y);
+    return img;
+  } catch (const std::runtime_error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw std::runtime_error("cannot read image '" + path + "': " + e.what());
+  }
+}
+
+// stb_image for .hdr, .png and .jpg. stb pads a truncated file with zeros rather than failing
+// (and its HDR run-length decoder never ends on zeros), so reads go through callbacks that note
+// a read past the end and answer it with 0xFF bytes, on which every decoder ends quickly.
+struct StbStream {
+  FILE* f;
+  bool pastEnd = false;
+};
+int stbRead(void* user, char* data, int size) {
+  auto* s = static_cast<StbStream*>(user);
+  size_t n = std::fread(data, 1, size_t(size), s->f);
+  if (n == 0 && size > 0) {
+    s->pastEnd = true;
+    std::memset(data, 0xFF, size_t(size));
+    return size;
+  }
+  return int(n);
+}
+void stbSkip(void* user, int n) { std::fseek(static_cast<StbStream*>(user)->f, n, SEEK_CUR); }
+int stbEof(void* user) { return std::feof(static_cast<StbStream*>(user)->f); }
+
+Image loadStb(const std::string& path, bool hdr) {
+  FilePtr f(std::fopen(path.c_str(), "rb"));
+  if (!f) throw std::runtime_error("cannot open image '" + path + "'");
+  StbStream s{f.get()};
+  stbi_io_callbacks cb{stbRead, stbSkip, stbEof};
+  int w = 0, h = 0, nc = 0;
+  float* data = hdr ? stbi_loadf_from_callbacks(&cb, &s, &w, &h, &nc, 3) : nullptr;
+  stbi_uc* ldr = hdr ? nullptr : stbi_load_from_callbacks(&cb, &s, &w, &h, &nc, 3);
+  std::unique_ptr<float, void (*)(void*)> holdF(data, stbi_image_free);
+  std::unique_ptr<stbi_uc, void (*)(void*)> holdL(ldr, stbi_image_free);
+  if (!data && !ldr) throw std::runtime_error("cannot read image '" + path + "': " + stbi_failure_reason());
+  if (s.pastEnd) throw std::runtime_error("cannot read image '" + path + "': file is truncated");
+  Image img(w, h);
+  size_t n = size_t(w) * h * 3;
+  if (data) {
+    std::memcpy(img.rgb.data(), data, n * sizeof(float));
+  } else {
+    // 8-bit files are sRGB-encoded: decode to linear.
+    for (size_t i = 0; i < n; ++i) {
+      float c = ldr[i] / 255.f;
+      img.rgb[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+    }
+  }
+  return img;
+}
+
+// PFM (Netpbm's float format, small enough to read and write here): "PF" (RGB) or "Pf" (grey),
+// size, scale whose sign gives the byte order (negative: little-endian), rows bottom first.
+Image loadPfm(const std::string& path) {
+  FilePtr f(std::fopen(path.c_str(), "rb"));
+  if (!f) throw std::runtime_error("cannot open image '" + path + "'");
+  char magic[3] = {0, 0, 0};
+  int w = 0, h = 0;
+  float scale = 0.f;
+  if (std::fscanf(f.get(), "%2s %d %d %f", magic, &w, &h, &scale) != 4 || magic[0] != 'P' ||
+      (magic[1] != 'F' && magic[1] != 'f'))
+    throw std::runtime_error("cannot read image '" + path + "': not a PFM file");
+  if (w <= 0 || h <= 0 || size_t(w) * size_t(h) > (size_t(1) << 31) || scale == 0.f || !std::isfinite(scale))
+    throw std::runtime_error("cannot read image '" + path + "': bad PFM header");
+  if (std::fgetc(f.get()) == EOF) throw std::runtime_error("cannot read image '" + path + "': file is truncated");
+  int nc = magic[1] == 'F' ? 3 : 1;
+  bool swap = scale > 0.f;  // big-endian data on this little-endian host
+  std::vector<float> raw(size_t(w) * h * nc);
+  if (std::fread(raw.data(), sizeof(float), raw.size(), f.get()) != raw.size())
+    throw std::runtime_error("cannot read image '" + path + "': file is truncated");
+  if (swap)
+    for (float& v : raw) {
+      uint32_t b;
+      std::memcpy(&b, &v, 4);
+      b = __builtin_bswap32(b);
+      std::memcpy(&v, &b, 4);
+    }
+  Image img(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float* p = &raw[(size_t(h - 1 - y) * w + x) * nc];
+      img.set(x, y, nc == 3 ? Color(p[0], p[1], p[2]) : Color(p[0]));
+    }
+  return img;
+}
+
+bool writePfm(const Image& img, const fs::path& path) {
+  FilePtr f(std::fopen(path.c_str(), "wb"));
+  if (!f) return false;
+  std::fprintf(f.get(), "PF\n%d %d\n-1.0\n", img.width, img.height);
+  bool ok = true;
+  for (int y = img.height - 1; y >= 0 && ok; --y)
+    ok = std::fwrite(&img.rgb[size_t(y) * img.width * 3], sizeof(float), size_t(img.width) * 3, f.get()) ==
+         size_t(img.width) * 3;
+  return std::fclose(f.release()) == 0 && ok;
+}
+
+bool writeExr(const Image& img, const fs::path& path) {
+  Imf::Header header(img.width, img.height);
+  header.compression() = Imf::ZIP_COMPRESSION;
+  const char* names[3] = {"R", "G", "B"};
+  Imf::FrameBuffer fb;
+  size_t xs = 3 * sizeof(float), ys = xs * size_t(img.width);
+  for (int k = 0; k < 3; ++k) {
+    header.channels().insert(names[k], Imf::Channel(Imf::FLOAT));
+    fb.insert(names[k], Imf::Slice(Imf::FLOAT, (char*)(img.rgb.data() + k), xs, ys));
+  }
+  Imf::OutputFile out(path.c_str(), header);
+  out.setFrameBuffer(fb);
+  out.writePixels(img.height);
+  return true;
+}
+
+}  // namespace
 
 Image loadImage(const std::string& path) {
   if (!fs::exists(path)) throw std::runtime_error("cannot open image '" + path + "': no such file");
-  auto in = ImageInput::open(path);
-  if (!in) {
-    std::string err = OIIO::geterror();
-    throw std::runtime_error("cannot read image '" + path + "': " + (err.empty() ? "unknown format" : err));
-  }
-  const ImageSpec& spec = in->spec();
-  int w = spec.width, h = spec.height, nc = spec.nchannels;
-  if (w <= 0 || h <= 0 || nc <= 0) throw std::runtime_error("image '" + path + "' has no pixels");
-  std::vector<float> raw(size_t(w) * h * nc);
-  bool ok = in->read_image(0, 0, 0, nc, TypeDesc::FLOAT, raw.data());
-  std::string err = in->geterror();
-  in->close();
-  if (!ok || !err.empty())
-    throw std::runtime_error("cannot read image '" + path + "': " + (err.empty() ? "read failed (truncated?)" : err));
-  Image img(w, h);
-  for (size_t i = 0; i < size_t(w) * h; ++i) {
-    const float* p = &raw[i * nc];
-    img.rgb[i * 3 + 0] = p[0];
-    img.rgb[i * 3 + 1] = nc >= 3 ? p[1] : p[0];
-    img.rgb[i * 3 + 2] = nc >= 3 ? p[2] : p[0];
-  }
-  return img;
+  std::string ext = lowerExtension(path);
+  if (ext == ".exr") return loadExr(path);
+  if (ext == ".pfm") return loadPfm(path);
+  if (ext == ".hdr" || ext == ".pic") return loadStb(path, true);
+  if (ext == ".png" || ext == ".jpg" || ext == ".jpeg") return loadStb(path, false);
+  throw std::runtime_error("cannot read image '" + path + "': unknown format '" + ext +
+                           "' (envgi reads .exr, .hdr, .pfm, .png, .jpg)");
 }
 
 float toneMapChannel(float v, const SaveOptions& opts) {
@@ -55,73 +196,48 @@ float toneMapChannel(float v, const SaveOptions& opts) {
   return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
 }
 
-namespace {
-
-// OpenImageIO 2.4 reads PFM but cannot write it: the format is small enough to write here
-// (Netpbm spec: "PF", size, negative scale = little-endian, rows bottom first).
-bool writePfm(const Image& img, const fs::path& path) {
-  FILE* f = std::fopen(path.c_str(), "wb");
-  if (!f) return false;
-  std::fprintf(f, "PF\n%d %d\n-1.0\n", img.width, img.height);
-  bool ok = true;
-  for (int y = img.height - 1; y >= 0 && ok; --y)
-    ok = std::fwrite(&img.rgb[size_t(y) * img.width * 3], sizeof(float), size_t(img.width) * 3, f) ==
-         size_t(img.width) * 3;
-  return std::fclose(f) == 0 && ok;
+std::vector<unsigned char> toneMapImage(const Image& img, const SaveOptions& opts) {
+  std::vector<unsigned char> ldr(img.rgb.size());
+  for (size_t i = 0; i < ldr.size(); ++i) ldr[i] = (unsigned char)std::lround(toneMapChannel(img.rgb[i], opts) * 255.f);
+  return ldr;
 }
-
-}  // namespace
 
 void saveImage(const Image& img, const std::string& path, const SaveOptions& opts) {
   fs::path p(path);
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  bool isFloat = ext == ".exr" || ext == ".pfm" || ext == ".hdr";
+  std::string ext = lowerExtension(p);
   if (ext.empty()) throw std::runtime_error("output '" + path + "' has no extension to choose a format by");
+  bool known = ext == ".exr" || ext == ".pfm" || ext == ".hdr" || ext == ".png" || ext == ".jpg" || ext == ".jpeg";
+  if (!known)
+    throw std::runtime_error("cannot write '" + path + "': no writer for '" + ext +
+                             "' (envgi writes .exr, .pfm, .hdr, .png, .jpg)");
   fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir)) throw std::runtime_error("cannot write '" + path + "': directory does not exist");
-  // Same extension so OpenImageIO picks the same writer; hidden so a crash leaves no look-alike.
+  // Hidden, so a crash leaves no look-alike; renamed into place only once complete.
   fs::path tmp = temporarySibling(path, ext);
-
-  auto commit = [&] {
-    std::error_code ec;
-    fs::rename(tmp, p, ec);
-    if (ec) {
-      fs::remove(tmp, ec);
-      throw std::runtime_error("cannot write '" + path + "': rename failed");
-    }
-  };
-  if (ext == ".pfm") {
-    if (!writePfm(img, tmp)) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw std::runtime_error("cannot write '" + path + "'");
-    }
-    return commit();
-  }
-  auto out = ImageOutput::create(tmp.string());
-  if (!out) throw std::runtime_error("cannot write '" + path + "': no writer for '" + ext + "'");
-  ImageSpec spec(img.width, img.height, 3, isFloat ? TypeDesc::FLOAT : TypeDesc::UINT8);
-  if (ext == ".exr") spec.attribute("compression", "zip");
-  bool ok = out->open(tmp.string(), spec);
-  if (ok) {
-    if (isFloat) {
-      ok = out->write_image(TypeDesc::FLOAT, img.rgb.data());
+  bool ok = false;
+  std::string err;
+  try {
+    if (ext == ".pfm") {
+      ok = writePfm(img, tmp);
+    } else if (ext == ".exr") {
+      ok = writeExr(img, tmp);
+    } else if (ext == ".hdr") {
+      ok = stbi_write_hdr(tmp.c_str(), img.width, img.height, 3, img.rgb.data()) != 0;
     } else {
-      std::vector<unsigned char> ldr(img.rgb.size());
-      for (size_t i = 0; i < ldr.size(); ++i)
-        ldr[i] = (unsigned char)std::lround(toneMapChannel(img.rgb[i], opts) * 255.f);
-      ok = out->write_image(TypeDesc::UINT8, ldr.data());
+      std::vector<unsigned char> ldr = toneMapImage(img, opts);
+      ok = ext == ".png" ? stbi_write_png(tmp.c_str(), img.width, img.height, 3, ldr.data(), img.width * 3) != 0
+                         : stbi_write_jpg(tmp.c_str(), img.width, img.height, 3, ldr.data(), 95) != 0;
     }
+  } catch (const std::exception& e) {
+    ok = false;
+    err = e.what();
   }
-  std::string err = out->geterror();
-  ok = out->close() && ok;
   if (!ok) {
     std::error_code ec;
     fs::remove(tmp, ec);
     throw std::runtime_error("cannot write '" + path + "': " + (err.empty() ? "write failed" : err));
   }
-  commit();
+  renameIntoPlace(tmp.string(), path);
 }
 
 }  // namespace envgi

@@ -1,4 +1,4 @@
-// Linear RGB float images and their file formats (OpenImageIO underneath).
+// Linear RGB float images and their file formats (OpenEXR and stb_image underneath).
 #pragma once
 
 #include <string>
@@ -33,15 +33,18 @@ struct SaveOptions {
   ToneMap toneMap = ToneMap::Clamp;
 };
 
-// Reads .hdr, .exr, .pfm (and anything else OpenImageIO reads) into linear RGB; throws
-// std::runtime_error naming the file on a missing, unreadable or truncated file.
+// Reads .exr (OpenEXR), .hdr, .png, .jpg (stb_image; 8-bit files are decoded from sRGB) and
+// .pfm into linear RGB; throws std::runtime_error naming the file on a missing, unreadable or
+// truncated file.
 Image loadImage(const std::string& path);
 
-// Writes by extension: .exr and .pfm as linear float, .png/.jpg/.tif as 8-bit sRGB after
+// Writes by extension: .exr, .pfm and .hdr as linear float, .png/.jpg as 8-bit sRGB after
 // exposure and tone curve. The file appears atomically (a temporary file, then rename).
 void saveImage(const Image& img, const std::string& path, const SaveOptions& opts = {});
 
 // Exposure, tone curve and sRGB encoding of one linear value, in [0,1].
 float toneMapChannel(float v, const SaveOptions& opts);
+// The whole image as 8-bit sRGB, 3 bytes a pixel.
+std::vector<unsigned char> toneMapImage(const Image& img, const SaveOptions& opts);
 
 }  // namespace envgi

@@ -1,5 +1,6 @@
-// Renders a scene on the CPU: oneTBB over image tiles, progressive passes of samples, and a
-// checkpoint of the image so far, so a long render never loses finished work.
+// The render loop: progressive passes of samples, progress, a checkpoint of the image so far
+// (a long render never loses finished work) and cancellation, over any PassExecutor (the CPU
+// through oneTBB, or a CUDA GPU).
 #pragma once
 
 #include <atomic>
@@ -8,9 +9,15 @@
 
 #include "accel/EmbreeAccel.h"
 #include "image/Image.h"
+#include "render/PassExecutor.h"
+#include "render/PixelKernel.h"
 #include "scene/Scene.h"
 
 namespace envgi {
+
+// Which tracer the CPU executor uses for path and direct: Embree, or the BVH that the GPU
+// traverses (the GPU's kernel bodies run on the CPU, for checking them without a GPU).
+enum class CpuTracer { Embree, Bvh };
 
 struct RenderOptions {
   int spp = -1;             // -1: the scene's sample_count
@@ -24,6 +31,7 @@ struct RenderOptions {
   // When set, receives the variance of each pixel's mean luminance (for Z-tests between
   // estimators, as Mitsuba's render tests use).
   std::vector<float>* varianceOut = nullptr;
+  CpuTracer cpuTracer = CpuTracer::Embree;
 };
 
 struct RenderStats {
@@ -35,7 +43,22 @@ struct RenderStats {
   double raysPerSecond() const { return seconds > 0.0 ? double(rays) / seconds : 0.0; }
 };
 
+// The path/direct settings the kernels run with, from the scene's integrator settings;
+// throws for integrators that have no per-sample kernel (photon, sppm).
+struct KernelSettings {
+  SampleIntegratorType type = SampleIntegratorType::Path;
+  PathParams path;
+  DirectParams direct;
+  SampleSequence sequence;
+  int spp = 1;
+};
+KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts);
 
+// Renders on the CPU (Embree, or the GPU's BVH by opts.cpuTracer), any integrator.
 Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats);
+
+// The loop itself, over an executor that already holds the scene (e.g. a GPU's).
+Image renderPasses(PassExecutor& executor, int width, int height, int spp, const RenderOptions& opts,
+                   RenderStats* stats);
 
 }  // namespace envgi

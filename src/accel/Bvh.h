@@ -1,0 +1,36 @@
+// The host side of the BVH that the CPU and the GPU both traverse: built by Embree's binned
+// SAH builder (rtcBuildBVH), flattened depth-first into 32-byte nodes with siblings adjacent.
+#pragma once
+
+#include <vector>
+
+#include "accel/BvhView.h"
+#include "scene/Scene.h"
+
+namespace envgi {
+
+struct BvhBuildStats {
+  double seconds = 0.0;
+  size_t triangles = 0, nodes = 0, leaves = 0;
+  int maxDepth = 0;
+  size_t bytes() const { return nodes * sizeof(BvhNode) + triangles * sizeof(BvhTriangle); }
+};
+
+class Bvh {
+ public:
+  explicit Bvh(const Scene& scene);
+  // The view points into this object and into the scene's spheres.
+  BvhView view() const;
+  const BvhBuildStats& stats() const { return stats_; }
+  const std::vector<BvhNode>& nodes() const { return nodes_; }
+  const std::vector<BvhTriangle>& triangles() const { return triangles_; }
+
+ private:
+  std::vector<BvhNode> nodes_;
+  std::vector<BvhTriangle> triangles_;
+  const SphereView* spheres_ = nullptr;
+  int sphereCount_ = 0, sphereGeomOffset_ = 0;
+  BvhBuildStats stats_;
+};
+
+}  // namespace envgi

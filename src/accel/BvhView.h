@@ -1,0 +1,170 @@
+// A binary BVH over the scene's triangles as plain data, traversed by the same code on the
+// CPU and the GPU (closest hit and any hit), plus the scene's analytic spheres. Built on the
+// host by Bvh (Embree's SAH builder), then copied as-is to the device.
+#pragma once
+
+#include "scene/SceneView.h"
+
+namespace envgi {
+
+// 32 bytes. Interior: the two children are adjacent, at `index` and `index + 1`. Leaf
+// (count > 0): triangles [index, index + count) of BvhView::triangles.
+struct BvhNode {
+  float lo[3];
+  int32_t index;
+  float hi[3];
+  int32_t count;
+};
+
+// A triangle ready for the Moeller-Trumbore test (vertex 0 and two edges), with the mesh
+// and primitive it came from so hits read like Embree's.
+struct BvhTriangle {
+  Vec3f v0, e1, e2;
+  int32_t geomId, primId;
+};
+
+constexpr int kBvhStackSize = 64;
+
+struct BvhView {
+  const BvhNode* nodes = nullptr;
+  const BvhTriangle* triangles = nullptr;
+  int nodeCount = 0;
+  const SphereView* spheres = nullptr;  // tested one by one: scenes hold a handful
+  int sphereCount = 0;
+  int sphereGeomOffset = 0;  // geometry id of sphere 0 (meshes come first)
+
+  // Box slab test against [tMin, tMax]; returns the entry distance or INFINITY on a miss.
+  ENVGI_HD static float boxEntry(const BvhNode& n, Vec3f o, Vec3f invD, float tMax) {
+    float t0 = 0.f, t1 = tMax;
+    for (int a = 0; a < 3; ++a) {
+      float tn = (n.lo[a] - o[a]) * invD[a], tf = (n.hi[a] - o[a]) * invD[a];
+      if (tn > tf) {
+        float s = tn;
+        tn = tf;
+        tf = s;
+      }
+      // Widened by 2 ulp-ish (Ize 2013) so grazing rays do not slip between adjacent boxes.
+      tf *= 1.0000004f;
+      t0 = tn > t0 ? tn : t0;
+      t1 = tf < t1 ? tf : t1;
+    }
+    return t0 <= t1 ? t0 : INFINITY;
+  }
+
+  ENVGI_HD static bool triangleHit(const BvhTriangle& tri, const Ray& r, float tMax, float* t, float* u, float* v) {
+    Vec3f pv = cross(r.d, tri.e2);
+    float det = dot(tri.e1, pv);
+    if (det == 0.f) return false;
+    float inv = 1.f / det;
+    Vec3f tv = r.o - tri.v0;
+    float b1 = dot(tv, pv) * inv;
+    if (b1 < 0.f || b1 > 1.f) return false;
+    Vec3f qv = cross(tv, tri.e1);
+    float b2 = dot(r.d, qv) * inv;
+    if (b2 < 0.f || b1 + b2 > 1.f) return false;
+    float tt = dot(tri.e2, qv) * inv;
+    if (!(tt > 0.f && tt < tMax)) return false;
+    *t = tt;
+    *u = b1;
+    *v = b2;
+    return true;
+  }
+
+  // Nearest root in (0, tMax), computed from the closest approach to the centre so that
+  // rays from far away keep their precision.
+  ENVGI_HD static bool sphereHit(const SphereView& s, const Ray& r, float tMax, float* t) {
+    Vec3f oc = r.o - s.center;
+    float dd = dot(r.d, r.d);
+    float b = dot(oc, r.d) / dd;
+    Vec3f closest = oc - r.d * b;
+    float h = s.radius * s.radius - dot(closest, closest);
+    if (h < 0.f) return false;
+    float q = std::sqrt(h / dd);
+    float t0 = -b - q, t1 = -b + q;
+    float tt = t0 > 0.f ? t0 : t1;
+    if (!(tt > 0.f && tt < tMax)) return false;
+    *t = tt;
+    return true;
+  }
+
+  template <bool AnyHit>
+  ENVGI_HD bool traverse(const Ray& r, Hit* hit) const {
+    float tMax = r.tMax;
+    bool found = false;
+    for (int i = 0; i < sphereCount; ++i) {
+      float t;
+      if (sphereHit(spheres[i], r, tMax, &t)) {
+        if (AnyHit) return true;
+        tMax = t;
+        hit->t = t;
+        hit->geomId = sphereGeomOffset + i;
+        hit->primId = 0;
+        hit->u = hit->v = 0.f;
+        found = true;
+      }
+    }
+    if (nodeCount == 0) return found;
+    Vec3f invD(1.f / r.d.x, 1.f / r.d.y, 1.f / r.d.z);
+    int stack[kBvhStackSize];
+    int sp = 0;
+    int node = 0;
+    if (boxEntry(nodes[0], r.o, invD, tMax) == INFINITY) return found;
+    for (;;) {
+      const BvhNode& n = nodes[node];
+      if (n.count > 0) {
+        for (int i = n.index; i < n.index + n.count; ++i) {
+          float t, u, v;
+          if (triangleHit(triangles[i], r, tMax, &t, &u, &v)) {
+            if (AnyHit) return true;
+            tMax = t;
+            hit->t = t;
+            hit->geomId = triangles[i].geomId;
+            hit->primId = triangles[i].primId;
+            hit->u = u;
+            hit->v = v;
+            found = true;
+          }
+        }
+      } else {
+        // Visit the nearer child first; push the farther one.
+        int c0 = n.index, c1 = n.index + 1;
+        float d0 = boxEntry(nodes[c0], r.o, invD, tMax), d1 = boxEntry(nodes[c1], r.o, invD, tMax);
+        if (d0 != INFINITY || d1 != INFINITY) {
+          if (d1 < d0) {
+            int c = c0;
+            c0 = c1;
+            c1 = c;
+            float d = d0;
+            d0 = d1;
+            d1 = d;
+          }
+          if (d1 != INFINITY) stack[sp++] = c1;
+          node = c0;
+          continue;
+        }
+      }
+      // Pop, skipping boxes that the current hit already lies in front of.
+      for (;;) {
+        if (sp == 0) return found;
+        node = stack[--sp];
+        if (AnyHit || boxEntry(nodes[node], r.o, invD, tMax) != INFINITY) break;
+      }
+    }
+  }
+
+  ENVGI_HD bool intersect(const Ray& r, Hit* hit) const { return traverse<false>(r, hit); }
+  ENVGI_HD bool occluded(Vec3f o, Vec3f d, float tMax) const {
+    Hit h;
+    return traverse<true>(Ray{o, d, tMax}, &h);
+  }
+};
+
+// The interface the integrators are written against, over the BVH: the GPU's tracer, and the
+// CPU executor's when it runs the GPU's kernel bodies.
+struct BvhTracer {
+  BvhView bvh;
+  ENVGI_HD bool intersect(const Ray& r, Hit* h) const { return bvh.intersect(r, h); }
+  ENVGI_HD bool occluded(Vec3f o, Vec3f d, float tMax) const { return bvh.occluded(o, d, tMax); }
+};
+
+}  // namespace envgi

@@ -1,0 +1,66 @@
+// Runs render passes on the CPU: oneTBB over image tiles, each pixel through renderPixel, the
+// same body the CUDA kernel runs. Deterministic whatever the thread count (no shared sums).
+#pragma once
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
+
+#include "render/PassExecutor.h"
+#include "render/PixelKernel.h"
+
+namespace envgi {
+
+template <class Integrator>
+class CpuExecutor final : public PassExecutor {
+ public:
+  CpuExecutor(const Camera& cam, SampleSequence seq, Integrator integrate, int threads, bool keepVariance,
+              std::string name, int tileSize = 16)
+      : cam_(cam), seq_(seq), integrate_(std::move(integrate)),
+        arena_(threads > 0 ? threads : tbb::this_task_arena::max_concurrency()), name_(std::move(name)),
+        tile_(tileSize) {
+    film_.sum.assign(size_t(cam.width) * cam.height, Color(0.f));
+    if (keepVariance) film_.sumSqLum.assign(film_.sum.size(), 0.0);
+  }
+
+  std::string deviceName() const override { return name_; }
+
+  void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
+    int W = cam_.width, H = cam_.height;
+    int tilesX = (W + tile_ - 1) / tile_, tilesY = (H + tile_ - 1) / tile_;
+    FilmView fv{film_.sum.data(), film_.sumSqLum.empty() ? nullptr : film_.sumSqLum.data(), W, H};
+    std::atomic<uint64_t> rays{0}, dropped{0};
+    arena_.execute([&] {
+      tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& r) {
+        PixelCounters pc;
+        for (int t = r.begin(); t < r.end(); ++t) {
+          int x0 = (t % tilesX) * tile_, y0 = (t / tilesX) * tile_;
+          int x1 = std::min(W, x0 + tile_), y1 = std::min(H, y0 + tile_);
+          for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) renderPixel(cam_, seq_, integrate_, x, y, s0, s1, fv, &pc);
+          progress.add(size_t(x1 - x0) * size_t(y1 - y0) * size_t(s1 - s0));
+        }
+        rays += pc.rays;
+        dropped += pc.dropped;
+      });
+    });
+    counters->rays += rays.load();
+    counters->dropped += dropped.load();
+  }
+
+  void readFilm(FilmSums* out) override { *out = film_; }
+
+ private:
+  Camera cam_;
+  SampleSequence seq_;
+  Integrator integrate_;
+  tbb::task_arena arena_;
+  std::string name_;
+  int tile_;
+  FilmSums film_;
+};
+
+}  // namespace envgi

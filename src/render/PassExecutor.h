@@ -1,0 +1,34 @@
+// Where a render pass runs. The render loop (Renderer.cpp) owns passes, progress, checkpoints
+// and cancellation; an executor owns the film and runs samples [s0, s1) of every pixel on
+// its device: the CPU through oneTBB, or a CUDA GPU (src/gpu).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/Vec.h"
+#include "render/Progress.h"
+
+namespace envgi {
+
+struct PassCounters {
+  uint64_t rays = 0;
+  uint64_t dropped = 0;
+};
+
+// The film read back to the host: per-pixel sums of radiance and of squared luminance.
+struct FilmSums {
+  std::vector<Color> sum;
+  std::vector<double> sumSqLum;  // empty when the executor was not asked to keep it
+};
+
+class PassExecutor {
+ public:
+  virtual ~PassExecutor() = default;
+  virtual std::string deviceName() const = 0;
+  // Adds samples [s0, s1) of every pixel to the film; reports pixel-samples done to progress.
+  virtual void runPass(int s0, int s1, Progress& progress, PassCounters* counters) = 0;
+  virtual void readFilm(FilmSums* out) = 0;
+};
+
+}  // namespace envgi
