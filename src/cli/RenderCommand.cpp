@@ -1,4 +1,4 @@
-// `envgi render SCENE.xml -o OUT.exr`: the CPU renderer from the command line.
+// `envgi render SCENE.xml -o OUT.exr`: the renderer from the command line, on the CPU or a GPU.
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
@@ -9,8 +9,10 @@
 #include <memory>
 #include <stdexcept>
 
+#include "accel/Bvh.h"
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
+#include "gpu/CudaExecutor.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
 
@@ -31,7 +33,38 @@ struct RenderArgs {
   float exposure = 0.f;
   bool aces = false;
   double checkpoint = 60.0;
+  std::string device = "auto", sampler;
+  int gpu = 0;
 };
+
+double secondsSince(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+// cpu, cuda or auto (CUDA when a device is present and the integrator has GPU kernels).
+bool chooseCuda(const RenderArgs& a, const std::string& integrator) {
+  if (a.device != "cpu" && a.device != "cuda" && a.device != "auto")
+    throw std::runtime_error("unknown device '" + a.device + "' (cpu, cuda, auto)");
+  if (a.device == "cpu") return false;
+  bool kernels = integrator == "path" || integrator == "direct";
+  std::string why;
+  int n = gpu::deviceCount(&why);
+  if (a.device == "cuda") {
+    if (n == 0) throw std::runtime_error("--device cuda: no CUDA device (" + why + ")");
+    if (!kernels)
+      throw std::runtime_error("--device cuda: the '" + integrator + "' integrator runs on the CPU only (path and direct run on the GPU)");
+    return true;
+  }
+  if (n == 0) {
+    spdlog::info("device: CPU ({})", why);
+    return false;
+  }
+  if (!kernels) {
+    spdlog::info("device: CPU (the '{}' integrator has no GPU kernels yet)", integrator);
+    return false;
+  }
+  return true;
+}
 
 void runRender(const RenderArgs& a) {
   namespace fs = std::filesystem;
@@ -51,15 +84,18 @@ void runRender(const RenderArgs& a) {
     scene.integrator.strategy = a.strategy;
   }
   if (a.seed >= 0) scene.sampler.seed = uint32_t(a.seed);
+  if (!a.sampler.empty()) {
+    if (a.sampler == "independent") scene.sampler.type = SamplerType::Independent;
+    else if (a.sampler == "stratified") scene.sampler.type = SamplerType::Stratified;
+    else if (a.sampler == "sobol") scene.sampler.type = SamplerType::Sobol;
+    else throw std::runtime_error("unknown sampler '" + a.sampler + "' (independent, stratified, sobol)");
+  }
   scene.finalize();
+  bool cuda = chooseCuda(a, scene.integrator.type);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   spdlog::info("scene {}: {} triangles, {} spheres, {} area-light primitives{}, {:.1f} MB of geometry, loaded in {:.2f} s",
                a.scene, scene.triangleCount(), scene.spheres.size(), scene.lightCount(),
                scene.env ? ", environment map" : "", scene.geometryBytes() / 1e6, loadSeconds);
-  auto t1 = std::chrono::steady_clock::now();
-  EmbreeAccel accel(scene);
-  spdlog::info("Embree BVH built in {:.2f} s",
-               std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count());
 
   SaveOptions so;
   so.exposure = a.exposure;
@@ -88,7 +124,25 @@ void runRender(const RenderArgs& a) {
                is.type, is.strategy, a.spp > 0 ? a.spp : scene.sampler.sampleCount,
                scene.sampler.type == SamplerType::Independent ? "independent"
                : scene.sampler.type == SamplerType::Stratified ? "stratified" : "sobol");
-  Image img = render(scene, accel, ro, &st);
+  Image img;
+  if (cuda) {
+    Bvh bvh(scene);
+    const BvhBuildStats& bs = bvh.stats();
+    spdlog::info("BVH: {} triangles, {} nodes, depth {}, {:.1f} bytes a triangle, built in {:.2f} s", bs.triangles,
+                 bs.nodes, bs.maxDepth, bs.triangles ? double(bs.bytes()) / double(bs.triangles) : 0.0, bs.seconds);
+    KernelSettings k = kernelSettings(scene, ro);
+    auto t2 = std::chrono::steady_clock::now();
+    size_t bytes = 0;
+    auto ex = gpu::makeCudaExecutor(scene, bvh, k, a.gpu, false, &bytes);
+    spdlog::info("device: {}: scene uploaded in {:.2f} s, {:.1f} MB of device memory", ex->deviceName(),
+                 secondsSince(t2), bytes / 1e6);
+    img = renderPasses(*ex, scene.camera.width, scene.camera.height, k.spp, ro, &st);
+  } else {
+    auto t1 = std::chrono::steady_clock::now();
+    EmbreeAccel accel(scene);
+    spdlog::info("device: CPU; Embree BVH built in {:.2f} s", secondsSince(t1));
+    img = render(scene, accel, ro, &st);
+  }
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   write(img);
@@ -127,6 +181,9 @@ void addRenderCommand(CLI::App& app) {
   c->add_flag("--aces", a->aces, "ACES-style tone curve for 8-bit output");
   c->add_flag("--no-progress", a->noProgress, "No progress bar");
   c->add_option("--checkpoint", a->checkpoint, "Seconds between writes of the image so far (0: never)");
+  c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
+  c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(CLI::NonNegativeNumber);
+  c->add_option("--sampler", a->sampler, "Sample sequence: independent | stratified | sobol (overrides the scene)");
   c->callback([a] { runRender(*a); });
 }
 

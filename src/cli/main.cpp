@@ -10,6 +10,7 @@
 int main(int argc, char** argv) {
   CLI::App app{"envgi: global illumination from HDR environment maps"};
   app.require_subcommand(1);
+  app.set_version_flag("--version", std::string("envgi ") + ENVGI_VERSION);
   bool verbose = false, quiet = false;
   app.add_flag("-v,--verbose", verbose, "Debug logging");
   app.add_flag("-q,--quiet", quiet, "Warnings and errors only");
@@ -22,8 +23,16 @@ int main(int argc, char** argv) {
   envgi::cli::addPhotonsCommand(app);
   try {
     app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // One line, like every other error; --help has the details.
+    std::fprintf(stderr, "envgi: error: %s (see envgi --help)\n", e.what());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "envgi: error: %s\n", e.what());
     return 1;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "envmap/EnvironmentMap.h"
+#include "gpu/DeviceScene.h"
 #include "integrators/DirectIntegrator.h"
 #include "integrators/PathIntegrator.h"
 #include "sampling/Mis.h"
@@ -33,7 +34,7 @@ __global__ void envmapKernel(EnvironmentMapView env, int n, CheckResult* out) {
   EnvSample es = env.sample(s, smp.get2D(), Vec3f(0.f, 1.f, 0.f));
   float counts[2] = {1.f, 1.f};
   float pdfs[2] = {es.pdf, env.pdf(EnvStrategy::Uniform, es.dir)};
-  out[i] = {es.dir, es.radiance + env.eval(es.dir) * 0.f, es.pdf, env.pdf(s, es.dir, Vec3f(0.f, 1.f, 0.f)),
+  out[i] = {es.dir, es.radiance, es.pdf, env.pdf(s, es.dir, Vec3f(0.f, 1.f, 0.f)),
             misWeight(0, counts, pdfs, 2, 2.f)};
 }
 
@@ -94,37 +95,8 @@ __global__ void integratorKernel(SceneView sc, int n, Color* out) {
   out[i] = (i % 2) ? pathTrace(sc, tr, ray, smp, PathParams{}, &rays) : directTrace(sc, tr, ray, smp, DirectParams{}, &rays);
 }
 
-namespace {
-
-std::vector<void*> g_allocs;
-
-template <typename T>
-const T* upload(const T* host, size_t n) {
-  void* d = nullptr;
-  if (cudaMalloc(&d, sizeof(T) * n) != cudaSuccess) return nullptr;
-  cudaMemcpy(d, host, sizeof(T) * n, cudaMemcpyHostToDevice);
-  g_allocs.push_back(d);
-  return static_cast<const T*>(d);
-}
-
-EnvironmentMapView toDevice(EnvironmentMapView v) {
-  size_t px = size_t(v.width) * v.height;
-  v.rgb = upload(v.rgb, px * 3);
-  v.dist.condFunc = upload(v.dist.condFunc, px);
-  v.dist.condCdf = upload(v.dist.condCdf, size_t(v.height) * (v.width + 1));
-  v.dist.condInt = upload(v.dist.condInt, size_t(v.height));
-  v.dist.marginal.func = upload(v.dist.marginal.func, size_t(v.height));
-  v.dist.marginal.cdf = upload(v.dist.marginal.cdf, size_t(v.height) + 1);
-  v.alias.bins = upload(v.alias.bins, px);
-  v.adaptive.nodes = upload(v.adaptive.nodes, size_t(v.adaptive.nodeCount));
-  v.adaptive.leafNodes = upload(v.adaptive.leafNodes, size_t(v.adaptive.leafCount));
-  v.adaptive.leafSolidAngle = upload(v.adaptive.leafSolidAngle, size_t(v.adaptive.leafCount));
-  return v;
-}
-
-}  // namespace
-
-int main() {
+int main() try {
+  gpu::DeviceArena arena;
   int devices = 0;
   if (cudaGetDeviceCount(&devices) != cudaSuccess || devices == 0) {
     std::printf("envgi_cuda_check: no CUDA device; kernels compiled and linked only\n");
@@ -138,7 +110,7 @@ int main() {
   const int n = 1 << 16;
   CheckResult* dOut = nullptr;
   cudaMalloc(&dOut, sizeof(CheckResult) * n);
-  envmapKernel<<<(n + 255) / 256, 256>>>(toDevice(env.view()), n, dOut);
+  envmapKernel<<<(n + 255) / 256, 256>>>(gpu::uploadEnvironment(arena, env.view()), n, dOut);
   std::vector<CheckResult> gpu(n);
   cudaError_t err = cudaMemcpy(gpu.data(), dOut, sizeof(CheckResult) * n, cudaMemcpyDeviceToHost);
   if (err != cudaSuccess) {
@@ -179,11 +151,11 @@ int main() {
   bsdfs[0].type = BsdfType::RoughConductor;
   bsdfs[0].perfectMirror = true;
   bsdfs[0].alpha = 0.2f;
-  sv.spheres = upload(spheres, 2);
+  sv.spheres = arena.upload(spheres, 2, "spheres");
   sv.sphereCount = 2;
-  sv.bsdfs = upload(bsdfs, 2);
+  sv.bsdfs = arena.upload(bsdfs, 2, "materials");
   sv.hasEnvironment = true;
-  sv.env = toDevice(env.view());
+  sv.env = gpu::uploadEnvironment(arena, env.view());
   sv.camera = cam;
   Color* dC = nullptr;
   const int m = 64 * 64;
@@ -196,10 +168,12 @@ int main() {
               cudaGetErrorString(err));
   cudaFree(dB);
   cudaFree(dC);
-  for (void* p : g_allocs) cudaFree(p);
   cudaFree(dOut);
   if (bad > 0 || err != cudaSuccess) return 1;
   std::printf("envgi_cuda_check: %d samples, %d mismatches against the CPU, max pdf rel. diff %.3g\n", n, mismatches,
               maxRel);
   return mismatches <= n / 1000 ? 0 : 1;
+} catch (const std::exception& e) {
+  std::printf("envgi_cuda_check: %s\n", e.what());
+  return 1;
 }

@@ -32,6 +32,15 @@ struct SampleIntegrator {
   }
 };
 
+// What the path and direct kernels run with (Renderer's kernelSettings() fills it from a scene).
+struct KernelSettings {
+  SampleIntegratorType type = SampleIntegratorType::Path;
+  PathParams path;
+  DirectParams direct;
+  SampleSequence sequence;
+  int spp = 1;
+};
+
 // The film as the kernels see it: per-pixel sums of radiance and of squared luminance (the
 // latter may be null), row-major.
 struct FilmView {

@@ -45,13 +45,6 @@ struct RenderStats {
 
 // The path/direct settings the kernels run with, from the scene's integrator settings;
 // throws for integrators that have no per-sample kernel (photon, sppm).
-struct KernelSettings {
-  SampleIntegratorType type = SampleIntegratorType::Path;
-  PathParams path;
-  DirectParams direct;
-  SampleSequence sequence;
-  int spp = 1;
-};
 KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts);
 
 // Renders on the CPU (Embree, or the GPU's BVH by opts.cpuTracer), any integrator.

@@ -146,3 +146,46 @@ TEST(CliRender, PhotonAndSppmIntegrators) {
   EXPECT_NE(bad.code, 0);
   EXPECT_NE(bad.output.find("alpha must be in (0, 1)"), std::string::npos) << bad.output;
 }
+
+// --device: auto falls back to the CPU without a GPU, and says so; cuda without one is one
+// error line and no output file; a bad device name is an error.
+TEST(RenderCli, DeviceChoice) {
+  TempDir d;
+  std::string scene = tinyScene(d, 16, 2);
+  bool gpu = runCli("render " + scene + " -o " + d.file("probe.exr") + " --device cuda --no-progress").code == 0;
+  CliResult a = runCli("render " + scene + " -o " + d.file("auto.exr") + " --device auto --no-progress");
+  ASSERT_EQ(a.code, 0) << a.output;
+  EXPECT_TRUE(fs::exists(d.file("auto.exr")));
+  CliResult c = runCli("render " + scene + " -o " + d.file("cuda.exr") + " --device cuda --no-progress");
+  if (!gpu) {
+    EXPECT_NE(a.output.find("device: CPU"), std::string::npos) << a.output;
+    EXPECT_EQ(c.code, 1);
+    EXPECT_NE(c.output.find("envgi: error: --device cuda: no CUDA device"), std::string::npos) << c.output;
+    EXPECT_FALSE(fs::exists(d.file("cuda.exr")));
+  } else {
+    EXPECT_EQ(c.code, 0) << c.output;
+  }
+  CliResult bad = runCli("render " + scene + " -o " + d.file("bad.exr") + " --device tpu");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.output.find("unknown device 'tpu'"), std::string::npos) << bad.output;
+  // The CPU-only integrators refuse --device cuda whatever the machine.
+  CliResult sppm = runCli("render " + scene + " -o " + d.file("s.exr") + " --device cuda --integrator sppm");
+  EXPECT_EQ(sppm.code, 1);
+}
+
+// --sampler on render, --version, and parse errors as one `envgi: error:` line.
+TEST(RenderCli, SamplerVersionAndParseErrors) {
+  TempDir d;
+  std::string scene = tinyScene(d, 8, 2);
+  CliResult s = runCli("render " + scene + " -o " + d.file("s.exr") + " --sampler stratified --no-progress");
+  EXPECT_EQ(s.code, 0) << s.output;
+  EXPECT_NE(s.output.find("stratified sampler"), std::string::npos) << s.output;
+  EXPECT_EQ(runCli("render " + scene + " -o " + d.file("t.exr") + " --sampler halton").code, 1);
+  CliResult v = runCli("--version");
+  EXPECT_EQ(v.code, 0);
+  EXPECT_EQ(v.output.rfind("envgi ", 0), 0u) << v.output;
+  CliResult missing = runCli("render " + d.file("nope.xml") + " -o " + d.file("x.exr"));
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_EQ(missing.output.rfind("envgi: error: ", 0), 0u) << missing.output;
+  EXPECT_EQ(std::count(missing.output.begin(), missing.output.end(), '\n'), 1) << missing.output;
+}

@@ -1,0 +1,19 @@
+// The CUDA backend of a build made without the CUDA toolkit: there is no device to use.
+#include "gpu/CudaExecutor.h"
+
+#include <stdexcept>
+
+namespace envgi::gpu {
+
+int deviceCount(std::string* why) {
+  if (why) *why = "this envgi was built without CUDA";
+  return 0;
+}
+
+std::string deviceName(int) { return "none"; }
+
+std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene&, const Bvh&, const KernelSettings&, int, bool, size_t*) {
+  throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
+}
+
+}  // namespace envgi::gpu

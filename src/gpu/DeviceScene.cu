@@ -1,0 +1,47 @@
+#include "gpu/DeviceScene.h"
+
+namespace envgi::gpu {
+
+EnvironmentMapView uploadEnvironment(DeviceArena& a, EnvironmentMapView v) {
+  size_t px = size_t(v.width) * v.height;
+  v.rgb = a.upload(v.rgb, px * 3, "environment map");
+  v.dist.condFunc = a.upload(v.dist.condFunc, px, "environment CDFs");
+  v.dist.condCdf = a.upload(v.dist.condCdf, size_t(v.height) * (v.width + 1), "environment CDFs");
+  v.dist.condInt = a.upload(v.dist.condInt, size_t(v.height), "environment CDFs");
+  v.dist.marginal.func = a.upload(v.dist.marginal.func, size_t(v.height), "environment CDFs");
+  v.dist.marginal.cdf = a.upload(v.dist.marginal.cdf, size_t(v.height) + 1, "environment CDFs");
+  v.alias.bins = a.upload(v.alias.bins, size_t(v.alias.n), "environment alias table");
+  v.adaptive.nodes = a.upload(v.adaptive.nodes, size_t(v.adaptive.nodeCount), "adaptive quadtree");
+  v.adaptive.leafNodes = a.upload(v.adaptive.leafNodes, size_t(v.adaptive.leafCount), "adaptive quadtree");
+  v.adaptive.leafSolidAngle = a.upload(v.adaptive.leafSolidAngle, size_t(v.adaptive.leafCount), "adaptive quadtree");
+  return v;
+}
+
+DeviceScene::DeviceScene(const Scene& scene, const Bvh& hostBvh) {
+  const SceneView& hv = scene.view();
+  view = hv;
+  std::vector<MeshView> meshes(hv.meshes, hv.meshes + hv.meshCount);
+  for (int i = 0; i < hv.meshCount; ++i) {
+    const TriangleMesh& tm = scene.meshes[size_t(i)];
+    MeshView& m = meshes[size_t(i)];
+    m.positions = arena.upload(m.positions, tm.positions.size(), "mesh positions");
+    m.normals = m.normals ? arena.upload(m.normals, tm.normals.size(), "mesh normals") : nullptr;
+    m.uvs = m.uvs ? arena.upload(m.uvs, tm.uvs.size(), "mesh uvs") : nullptr;
+    m.indices = arena.upload(m.indices, tm.indices.size(), "mesh indices");
+  }
+  view.meshes = arena.upload(meshes.data(), meshes.size(), "meshes");
+  view.spheres = arena.upload(hv.spheres, size_t(hv.sphereCount), "spheres");
+  view.bsdfs = arena.upload(hv.bsdfs, scene.bsdfs.size(), "materials");
+  view.lights = arena.upload(hv.lights, size_t(hv.lightCount), "lights");
+  view.lightSelect.bins = arena.upload(hv.lightSelect.bins, size_t(hv.lightSelect.n), "light table");
+  if (hv.hasEnvironment) view.env = uploadEnvironment(arena, hv.env);
+  deviceView = arena.upload(&view, 1, "scene");
+
+  BvhView b = hostBvh.view();
+  bvh = b;
+  bvh.nodes = arena.upload(b.nodes, size_t(b.nodeCount), "BVH nodes");
+  bvh.triangles = arena.upload(b.triangles, hostBvh.triangles().size(), "BVH triangles");
+  bvh.spheres = view.spheres;
+}
+
+}  // namespace envgi::gpu
