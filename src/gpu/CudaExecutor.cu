@@ -87,7 +87,10 @@ int deviceCount(std::string* why) {
   cudaError_t e = cudaGetDeviceCount(&n);
   if (e != cudaSuccess) {
     cudaGetLastError();
-    if (why) *why = cudaGetErrorString(e);
+    if (why)
+      *why = e == cudaErrorInsufficientDriver
+                 ? "no NVIDIA driver, or one older than this build's CUDA runtime needs"
+                 : std::string(cudaGetErrorString(e));
     return 0;
   }
   if (n == 0 && why) *why = "no CUDA device";

@@ -10,6 +10,7 @@
 #include "sampling/Pcg32.h"
 #include "sampling/Warp.h"
 #include "scene/SceneLoader.h"
+#include "support/FrameMesh.h"
 
 using namespace envgi;
 
@@ -96,16 +97,7 @@ TEST(Bvh, MatchesEmbreeOnTheDragon) {
   Scene scene;
   loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/buddha.xml", {{"mesh", dragon}}, scene);
   ASSERT_GT(scene.triangleCount(), 800000u);
-  const TriangleMesh* big = &scene.meshes[0];
-  for (const TriangleMesh& m : scene.meshes)
-    if (m.triangleCount() > big->triangleCount()) big = &m;
-  Vec3f lo(INFINITY), hi(-INFINITY);
-  for (Vec3f p : big->positions) {
-    lo = vmin(lo, p);
-    hi = vmax(hi, p);
-  }
-  Vec3f c = (lo + hi) * 0.5f;
-  scene.camera.toWorld = lookAt(c + Vec3f(0.f, 0.3f, 1.2f) * length(hi - lo), c, Vec3f(0, 1, 0));
+  test::frameLargestMesh(scene);
   scene.finalize();
   Bvh bvh(scene);
   std::printf("dragon: %zu triangles, BVH built in %.2f s, %zu nodes, depth %d, %.1f bytes a triangle\n",

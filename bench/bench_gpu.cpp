@@ -1,0 +1,149 @@
+// envgi_bench_gpu: the GPU renderer against the CPU on the same machine, as a table.
+// Happy Buddha (bundled) and the 871k dragon (--dragon PATH, or ../shared/assets), 512^2,
+// `path` with max_depth 8, a GGX conductor (alpha 0.15) in the Grace map, as the Mitsuba 3
+// figure quoted in the GPU issue. Per device: milliseconds per 1-spp frame (median of
+// --frames), M samples/s and M rays/s over a --spp run (default 64; the CPU runs --cpu-spp).
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+#include <algorithm>
+#include <chrono>
+
+#include "accel/Bvh.h"
+#include "accel/EmbreeAccel.h"
+#include "gpu/CudaExecutor.h"
+#include "gpu/GpuSceneFiles.h"
+#include "render/CpuExecutor.h"
+#include "render/Renderer.h"
+#include "scene/SceneLoader.h"
+#include "support/FrameMesh.h"
+
+using namespace envgi;
+
+namespace {
+
+struct Row {
+  std::string scene, device;
+  double frameMs = 0, msamples = 0, mrays = 0;
+  int spp = 0;
+};
+
+double seconds(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+Row measure(PassExecutor& ex, const std::string& scene, int W, int H, int frames, int spp) {
+  Row r;
+  r.scene = scene;
+  r.device = ex.deviceName();
+  Progress quiet(1, false);
+  PassCounters c;
+  ex.runPass(0, 1, quiet, &c);  // warm-up: first-touch, caches, kernel load
+  std::vector<double> t;
+  for (int i = 0; i < frames; ++i) {
+    auto t0 = std::chrono::steady_clock::now();
+    ex.runPass(1 + i, 2 + i, quiet, &c);
+    t.push_back(seconds(t0));
+  }
+  std::sort(t.begin(), t.end());
+  r.frameMs = 1e3 * t[t.size() / 2];
+  PassCounters run;
+  auto t0 = std::chrono::steady_clock::now();
+  int base = 1 + frames;
+  for (int s = 0; s < spp; s += 16) ex.runPass(base + s, base + std::min(spp, s + 16), quiet, &run);
+  double sec = seconds(t0);
+  r.spp = spp;
+  r.msamples = double(W) * H * spp / sec / 1e6;
+  r.mrays = double(run.rays) / sec / 1e6;
+  return r;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string dragon;
+  int res = 512, frames = 9, spp = 64, cpuSpp = 4;
+  bool cpu = true;
+  for (int i = 1; i < argc; ++i) {
+    std::string a = argv[i];
+    auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
+    if (a == "--dragon") dragon = next();
+    else if (a == "--res") res = std::atoi(next().c_str());
+    else if (a == "--frames") frames = std::atoi(next().c_str());
+    else if (a == "--spp") spp = std::atoi(next().c_str());
+    else if (a == "--cpu-spp") cpuSpp = std::atoi(next().c_str());
+    else if (a == "--no-cpu") cpu = false;
+    else {
+      std::fprintf(stderr, "usage: envgi_bench_gpu [--dragon PLY] [--res N] [--frames N] [--spp N] [--cpu-spp N] [--no-cpu]\n");
+      return 2;
+    }
+  }
+  if (res <= 0 || frames <= 0 || spp <= 0 || cpuSpp <= 0) {
+    std::fprintf(stderr, "envgi_bench_gpu: --res, --frames, --spp and --cpu-spp must be positive\n");
+    return 2;
+  }
+#ifdef ENVGI_ASSETS_DIR
+  if (dragon.empty() && std::filesystem::exists(ENVGI_ASSETS_DIR "/meshes/dragon/dragon_vrip.ply"))
+    dragon = ENVGI_ASSETS_DIR "/meshes/dragon/dragon_vrip.ply";
+#endif
+  std::vector<std::pair<std::string, std::string>> scenes = {{"buddha-100k", ""}};
+  if (!dragon.empty()) scenes.push_back({"dragon-871k", dragon});
+  std::string why;
+  int gpus = gpu::deviceCount(&why);
+  if (gpus == 0) std::printf("no CUDA device (%s): CPU figures only\n", why.c_str());
+  std::vector<Row> rows;
+  try {
+    for (auto& [name, mesh] : scenes) {
+      Scene s;
+      std::map<std::string, std::string> defs;
+      if (!mesh.empty()) defs["mesh"] = mesh;
+      loadScene(test::bundledScenesDir() + "/buddha.xml", defs, s);
+      if (!mesh.empty()) test::frameLargestMesh(s);
+      s.camera.width = s.camera.height = res;
+      s.integrator.type = "path";
+      s.integrator.maxDepth = 8;
+      s.integrator.strategy = "mis";
+      for (Bsdf& b : s.bsdfs) {
+        b = Bsdf{};
+        b.type = BsdfType::RoughConductor;
+        b.perfectMirror = true;
+        b.alpha = 0.15f;
+        b.specularReflectance = Color(1.f);
+        b.twoSided = true;
+      }
+      s.finalize();
+      RenderOptions o;
+      o.spp = spp;
+      KernelSettings k = kernelSettings(s, o);
+      auto tb = std::chrono::steady_clock::now();
+      Bvh bvh(s);
+      std::printf("%s: %zu triangles, envgi BVH %.2f s (%.1f bytes a triangle)\n", name.c_str(), s.triangleCount(),
+                  seconds(tb), double(bvh.stats().bytes()) / double(std::max<size_t>(1, bvh.stats().triangles)));
+      if (gpus > 0) {
+        auto ex = gpu::makeCudaExecutor(s, bvh, k, 0, false);
+        rows.push_back(measure(*ex, name, res, res, frames, spp));
+      }
+      if (cpu) {
+        EmbreeAccel accel(s);
+        const SceneView& sc = s.view();
+        SampleIntegrator<EmbreeTracer> integ{k.type, k.path, k.direct, &sc, EmbreeTracer{&accel}};
+        CpuExecutor<decltype(integ)> ex(sc.camera, k.sequence, integ, 0, false, "cpu (Embree)");
+        rows.push_back(measure(ex, name, res, res, std::min(frames, 3), cpuSpp));
+        SampleIntegrator<BvhTracer> integB{k.type, k.path, k.direct, &sc, BvhTracer{bvh.view()}};
+        CpuExecutor<decltype(integB)> exB(sc.camera, k.sequence, integB, 0, false, "cpu (envgi BVH)");
+        rows.push_back(measure(exB, name, res, res, std::min(frames, 3), cpuSpp));
+      }
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "envgi_bench_gpu: error: %s\n", e.what());
+    return 1;
+  }
+  std::printf("\n%dx%d, path, max_depth 8, GGX conductor alpha 0.15, Grace map\n", res, res);
+  std::printf("| scene | device | ms / 1-spp frame | spp run | M samples/s | M rays/s |\n|---|---|---|---|---|---|\n");
+  for (const Row& r : rows)
+    std::printf("| %s | %s | %.2f | %d | %.2f | %.1f |\n", r.scene.c_str(), r.device.c_str(), r.frameMs, r.spp,
+                r.msamples, r.mrays);
+  return 0;
+}
