@@ -11,6 +11,7 @@
 #include "gpu/GpuSceneFiles.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
+#include "support/RegionZTest.h"
 
 using namespace envgi;
 
@@ -41,25 +42,6 @@ Result renderOn(bool cuda, const Scene& s, int spp) {
   return r;
 }
 
-double minRegionP(const Result& a, const Result& b, int region, int* regions) {
-  double minP = 1.0;
-  for (int ry = 0; ry + region <= kRes; ry += region)
-    for (int rx = 0; rx + region <= kRes; rx += region) {
-      double m1 = 0, m2 = 0, v1 = 0, v2 = 0;
-      for (int y = ry; y < ry + region; ++y)
-        for (int x = rx; x < rx + region; ++x) {
-          m1 += luminance(a.img.at(x, y));
-          m2 += luminance(b.img.at(x, y));
-          v1 += a.var[size_t(y) * kRes + x];
-          v2 += b.var[size_t(y) * kRes + x];
-        }
-      double n = double(region) * region;
-      double z = (m1 - m2) / n / std::sqrt((v1 + v2) / (n * n) + 1e-12);
-      minP = std::min(minP, std::erfc(std::fabs(z) / std::sqrt(2.0)));
-      ++*regions;
-    }
-  return minP;
-}
 
 struct Case {
   std::string scene, integrator, strategy;
@@ -86,7 +68,7 @@ TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
     s.sampler.seed = 2;
     Result gpu = renderOn(true, s, 128);
     int regions = 0;
-    double p = minRegionP(cpu, gpu, region, &regions);
+    double p = test::minRegionP(cpu.img, cpu.var, gpu.img, gpu.var, region, &regions);
     double mc = 0, mg = 0;
     for (size_t i = 0; i < cpu.img.rgb.size(); ++i) {
       mc += cpu.img.rgb[i];

@@ -5,6 +5,7 @@
 
 #include "accel/Bvh.h"
 #include "scene/SceneLoader.h"
+#include "support/RegionZTest.h"
 #include "support/ChiSquare.h"
 #include "support/TestScenes.h"
 
@@ -32,26 +33,6 @@ Result run(const Scene& s, CpuTracer tracer, int spp) {
 }
 
 // Smallest two-sided p-value of the region means' differences over `region`-pixel squares.
-double minRegionP(const Result& a, const Result& b, int W, int H, int region, int* regions) {
-  double minP = 1.0;
-  *regions = 0;
-  for (int ry = 0; ry + region <= H; ry += region)
-    for (int rx = 0; rx + region <= W; rx += region) {
-      double m1 = 0, m2 = 0, v1 = 0, v2 = 0;
-      for (int y = ry; y < ry + region; ++y)
-        for (int x = rx; x < rx + region; ++x) {
-          m1 += luminance(a.img.at(x, y));
-          m2 += luminance(b.img.at(x, y));
-          v1 += a.var[size_t(y) * W + x];
-          v2 += b.var[size_t(y) * W + x];
-        }
-      double n = double(region) * region;
-      double z = (m1 - m2) / n / std::sqrt((v1 + v2) / (n * n) + 1e-12);
-      minP = std::min(minP, std::erfc(std::fabs(z) / std::sqrt(2.0)));
-      ++*regions;
-    }
-  return minP;
-}
 
 }  // namespace
 
@@ -69,7 +50,7 @@ TEST(CpuExecutor, BvhKernelsMatchEmbreeOnBundledScenes) {
       s.sampler.seed = 4;  // independent estimates, so the Z-test's variances add
       Result b = run(s, CpuTracer::Bvh, 32);
       int regions = 0;
-      double p = minRegionP(a, b, 48, 48, 8, &regions);
+      double p = test::minRegionP(a.img, a.var, b.img, b.var, 8, &regions);
       EXPECT_GT(p, test::sidakAlpha(regions * 6)) << name << " " << integrator;
       double ma = 0, mb = 0;
       for (size_t i = 0; i < a.img.rgb.size(); ++i) {
