@@ -4,7 +4,7 @@
 // Run: build/bin/envgi_bench_photon --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
-#include "integrators/Sppm.h"
+#include "render/SppmExecutor.h"
 #include "photon/PhotonShooter.h"
 #include "sampling/Pcg32.h"
 #include "scene/SceneLoader.h"
@@ -82,14 +82,16 @@ BENCHMARK(BM_RadianceLookup)->Arg(50)->Arg(120);
 
 static void BM_SppmPass(benchmark::State& state) {
   Fixture& f = fixture();
-  SppmSettings s;
-  s.passes = 1;
+  SppmParams s;
   s.photonsPerPass = size_t(state.range(0));
-  s.progress = false;
   SppmStats st;
+  Progress quiet(1, false);
   for (auto _ : state) {
-    Image img = renderSppm(f.scene, *f.accel, s, &st);
-    benchmark::DoNotOptimize(img.rgb.data());
+    SppmExecutor ex(f.scene, *f.accel, s, 0);
+    PassCounters c;
+    ex.runPass(0, 1, quiet, &c);
+    st = ex.stats();
+    benchmark::DoNotOptimize(c.rays);
   }
   state.counters["photons/s"] = double(s.photonsPerPass) / st.photonSeconds;
   state.counters["camera_s"] = st.cameraSeconds;

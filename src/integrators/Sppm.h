@@ -1,19 +1,14 @@
 // Stochastic progressive photon mapping (Hachisuka and Jensen 2009). Each pass traces one
 // camera path per pixel to its first non-specular surface (a visible point, with direct light
 // by MIS there), shoots photons, and gathers them at visible points through a hashed grid;
-// per-pixel radii shrink with alpha. The per-path work is host/device code; this driver
-// runs it with oneTBB.
+// per-pixel radii shrink with alpha. This is the per-path, host/device part; the driver that
+// runs its passes is render/SppmExecutor.
 #pragma once
 
-#include <atomic>
-#include <functional>
-
-#include "accel/EmbreeAccel.h"
-#include "image/Image.h"
 #include "integrators/DirectIntegrator.h"
 #include "photon/HashGrid.h"
 #include "photon/PhotonTracing.h"
-#include "scene/Scene.h"
+#include "scene/SceneView.h"
 
 namespace envgi {
 
@@ -74,30 +69,13 @@ ENVGI_INLINE Color sppmContribution(const SceneView& sc, const VisiblePoint& vp,
   return vp.beta * bsdfEval(b, vp.shading.toLocal(vp.wo), wiLocal) * power / c;
 }
 
-struct SppmSettings {
-  int passes = 64;
+struct SppmParams {
   size_t photonsPerPass = 100000;
   float initialRadius = 0.f;  // 0: 1% of the scene's bounding-sphere radius
   float alpha = 2.f / 3.f;
   int maxDepth = 16;
   uint32_t seed = 0;
-  int threads = 0;
-  bool progress = true;
   EnvStrategy strategy = EnvStrategy::Alias;
-  double checkpointSeconds = 0.0;
-  std::function<void(const Image&, int passesDone)> checkpoint;
-  const std::atomic<bool>* cancel = nullptr;
 };
-
-struct SppmStats {
-  int passesDone = 0;
-  uint64_t photonsShot = 0, photonHits = 0, rays = 0;
-  double cameraSeconds = 0.0, photonSeconds = 0.0, seconds = 0.0;
-  size_t bytes = 0;
-  float finalMeanRadius = 0.f;
-  bool cancelled = false;
-};
-
-Image renderSppm(const Scene& scene, const EmbreeAccel& accel, const SppmSettings& s, SppmStats* stats);
 
 }  // namespace envgi

@@ -29,6 +29,8 @@ class PassExecutor {
   // Adds samples [s0, s1) of every pixel to the film; reports pixel-samples done to progress.
   virtual void runPass(int s0, int s1, Progress& progress, PassCounters* counters) = 0;
   virtual void readFilm(FilmSums* out) = 0;
+  // The most samples one pass may take: passes are where checkpoints and Ctrl-C happen.
+  virtual int maxPassSize() const { return 64; }
 };
 
 }  // namespace envgi

@@ -10,7 +10,7 @@
 #include "accel/Bvh.h"
 #include "render/CpuExecutor.h"
 #include "integrators/PhotonIntegrator.h"
-#include "integrators/Sppm.h"
+#include "render/SppmExecutor.h"
 #include "photon/PhotonShooter.h"
 
 namespace envgi {
@@ -38,34 +38,24 @@ void logPhotonStats(const PhotonShootStats& st) {
                st.storedGlobal + st.storedCaustic > 0 ? st.bytes / (st.storedGlobal + st.storedCaustic) : 0);
 }
 
-Image renderSppmFromSettings(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts,
-                             RenderStats* stats) {
+Image renderSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
   const IntegratorSettings& is = scene.integrator;
-  SppmSettings ss;
-  ss.passes = opts.spp > 0 ? opts.spp : is.passes;
-  ss.photonsPerPass = is.photonCount;
-  ss.initialRadius = is.initialRadius;
-  ss.alpha = is.alpha;
-  ss.maxDepth = is.maxDepth > 0 ? is.maxDepth : 16;
-  ss.seed = scene.sampler.seed;
-  ss.threads = opts.threads;
-  ss.progress = opts.progress;
-  ss.strategy = strategyOf(is.strategy);
-  ss.checkpointSeconds = opts.checkpointSeconds;
-  ss.checkpoint = opts.checkpoint;
-  ss.cancel = opts.cancel;
-  SppmStats st;
-  Image img = renderSppm(scene, accel, ss, &st);
+  SppmParams sp;
+  sp.photonsPerPass = is.photonCount;
+  sp.initialRadius = is.initialRadius;
+  sp.alpha = is.alpha;
+  sp.maxDepth = is.maxDepth > 0 ? is.maxDepth : 16;
+  sp.seed = scene.sampler.seed;
+  sp.strategy = strategyOf(is.strategy);
+  int passes = opts.spp > 0 ? opts.spp : is.passes;
+  if (passes <= 0) throw std::runtime_error("sppm: passes must be positive");
+  SppmExecutor ex(scene, accel, sp, opts.threads);
+  Image img = renderPasses(ex, scene.view().camera.width, scene.view().camera.height, passes, opts, stats);
+  SppmStats st = ex.stats();
   spdlog::info("sppm: {} passes, {} photons ({} photon-visible-point hits), camera passes {:.2f} s, photon passes "
                "{:.2f} s, mean final radius {:.4g}, {:.1f} MB",
-               st.passesDone, st.photonsShot, st.photonHits, st.cameraSeconds, st.photonSeconds,
-               st.finalMeanRadius, st.bytes / 1e6);
-  if (stats) {
-    stats->seconds = st.seconds;
-    stats->sppDone = st.passesDone;
-    stats->rays = st.rays;
-    stats->cancelled = st.cancelled;
-  }
+               st.passesDone, st.photonsShot, st.photonHits, st.cameraSeconds, st.photonSeconds, st.meanRadius,
+               st.bytes / 1e6);
   return img;
 }
 
@@ -97,9 +87,11 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
 }
 
 Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts, RenderStats* stats) {
-  // Passes double in size (1, 1, 2, 4, ...) up to 64 samples, so a checkpoint comes early.
+  // Passes double in size (1, 1, 2, 4, ...) up to the executor's limit (64 samples on the CPU),
+  // so a checkpoint comes early.
   std::vector<std::pair<int, int>> passes;
-  for (int s = 0, n = 1; s < spp; s += n, n = std::min(2 * n, 64)) passes.push_back({s, std::min(spp, s + n)});
+  const int maxPass = std::max(1, ex.maxPassSize());
+  for (int s = 0, n = 1; s < spp; s += n, n = std::min(2 * n, maxPass)) passes.push_back({s, std::min(spp, s + n)});
   Progress progress(size_t(W) * H * spp, opts.progress);
   PassCounters counters;
   FilmSums film;
@@ -156,7 +148,7 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
   const SceneView& sc = scene.view();
   const Camera& cam = sc.camera;
   const IntegratorSettings& is = scene.integrator;
-  if (is.type == "sppm") return renderSppmFromSettings(scene, accel, opts, stats);
+  if (is.type == "sppm") return renderSppm(scene, accel, opts, stats);
   bool keepVar = opts.varianceOut != nullptr;
   EmbreeTracer embree{&accel};
   if (is.type == "photon") {
