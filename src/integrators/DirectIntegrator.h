@@ -4,7 +4,7 @@
 // estimator of the other, so the paper's strategies can be compared on the same image.
 #pragma once
 
-#include "integrators/LightSampling.h"
+#include "lights/LightSampling.h"
 #include "sampling/Mis.h"
 #include "sampling/Sampler.h"
 

@@ -3,7 +3,7 @@
 // once for any tracer with intersect() and occluded(): Embree on the CPU, a BVH on the GPU.
 #pragma once
 
-#include "integrators/LightSampling.h"
+#include "lights/LightSampling.h"
 #include "sampling/Mis.h"
 #include "sampling/Sampler.h"
 

@@ -4,8 +4,8 @@
 // Host/device: the store callback and the tracer are template parameters.
 #pragma once
 
-#include "integrators/LightSampling.h"
 #include "sampling/Sampler.h"
+#include "scene/SceneView.h"
 
 namespace envgi {
 
