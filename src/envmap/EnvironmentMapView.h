@@ -118,14 +118,13 @@ struct EnvironmentMapView {
         break;
       }
       case EnvStrategy::Alias: {
-        // The position inside the pixel reuses u.x's low bits across the column and the
-        // remapped u.y down the row: for maps of 2^k pixels, u.x keeps 24 - k bits of jitter.
-        float pmf, uy;
-        int i = alias.sample(u.x, u.y, &pmf, &uy);
+        // The position inside the pixel comes from the bits the bin choice left over: the
+        // first dozen place it across, the rest (frac of r 2^12) down.
+        float pmf, r;
+        int i = alias.sample(u, &pmf, &r);
         int px = i % width, py = i / width;
-        // Centred on its quantisation step, so a sample never sits exactly on a pixel edge.
-        float step = fminf(float(alias.n) * 0x1p-24f, 1.f);
-        float ux = fminf(u.x * float(alias.n) - std::floor(u.x * float(alias.n)) + 0.5f * step, kOneMinusEpsilon);
+        float ux = r, scaled = r * 4096.f;
+        float uy = fminf(scaled - std::floor(scaled), kOneMinusEpsilon);
         out.uv = {(float(px) + ux) / float(width), (float(py) + uy) / float(height)};
         local = uvToDir(out.uv);
         out.pdf = importancePdfUV(out.uv);

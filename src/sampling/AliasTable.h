@@ -3,7 +3,7 @@
 
 #include <vector>
 
-#include "core/Common.h"
+#include "core/Vec.h"
 
 namespace envgi {
 
@@ -21,26 +21,38 @@ struct AliasTableView {
 
   ENVGI_HD float pmf(int i) const { return bins[i].pmf; }
 
-  // Picks a bin: u1 chooses the column, u2 decides between it and its alias, so each
-  // decision keeps a float's full precision even for millions of bins. *u2Remapped is u2
-  // stretched back to a fresh uniform number.
-  ENVGI_HD int sample(float u1, float u2, float* pmfOut, float* u2Remapped) const {
-    float scaled = u1 * float(n);
-    int i = scaled < float(n) ? int(scaled) : n - 1;
-    const AliasBin b = bins[i];
+  // Picks a bin from both coordinates of u, read as one 48-bit number (samplers give 24-bit
+  // floats): its top part times n chooses the column, so every column is chosen with its exact
+  // probability to 2^-48 however many there are (u.x alone would pick 2^24 columns at most, some
+  // of them 8 and some 9 times in 2^24); the rest decides between the column and its alias and
+  // is then stretched back to a uniform number, *rest, with the bits the choice left over
+  // (48 - log2 n, less a few for the coin).
+  ENVGI_HD int sample(Vec2f u, float* pmfOut, float* rest) const {
+    const uint64_t k24 = uint64_t(1) << 24, mask24 = k24 - 1;
+    uint64_t hi = uint64_t(u.x * float(k24)) & mask24, lo = uint64_t(u.y * float(k24)) & mask24;
+    // (hi 2^24 + lo) n / 2^48 without 128-bit arithmetic: both products fit in 55 bits.
+    uint64_t a = hi * uint64_t(n), b = lo * uint64_t(n);
+    uint64_t a2 = a + (b >> 24);
+    uint64_t i64 = a2 >> 24;
+    int i = i64 < uint64_t(n) ? int(i64) : n - 1;
+    uint64_t rem = ((a2 & mask24) << 24) | (b & mask24);  // uniform in [0, 2^48) within the column
+    const double k48 = 281474976710656.0;                  // 2^48
+    const AliasBin bin = bins[i];
+    double t = double(bin.prob) * k48, r = double(rem);
     int chosen;
-    float remap, pmf;
-    if (u2 < b.prob) {
+    double remap;
+    if (r < t) {
       chosen = i;
-      remap = u2 / b.prob;
-      pmf = b.pmf;
+      remap = r / t;
     } else {
-      chosen = b.alias;
-      remap = (u2 - b.prob) / (1.f - b.prob);
-      pmf = bins[chosen].pmf;
+      chosen = bin.alias;
+      remap = (r - t) / (k48 - t);
     }
-    if (pmfOut) *pmfOut = pmf;
-    if (u2Remapped) *u2Remapped = remap < kOneMinusEpsilon ? remap : kOneMinusEpsilon;
+    if (pmfOut) *pmfOut = bins[chosen].pmf;
+    if (rest) {
+      float f = float(remap);
+      *rest = f < kOneMinusEpsilon ? f : kOneMinusEpsilon;
+    }
     return chosen;
   }
 };

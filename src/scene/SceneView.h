@@ -136,7 +136,7 @@ ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2
 
 // Picks an area-light primitive by power (u2) and a uniform point on it (u).
 ENVGI_INLINE const LightPrim& sampleAreaLight(const SceneView& sc, Vec2f u2, Vec2f u, float* pmf, Vec3f* p, Vec3f* n) {
-  int li = sc.lightSelect.sample(u2.x, u2.y, pmf, nullptr);
+  int li = sc.lightSelect.sample(u2, pmf, nullptr);
   const LightPrim& lp = sc.lights[li];
   sampleLightPrim(sc, lp, u, p, n);
   return lp;

@@ -175,3 +175,31 @@ TEST(EnvSamplingSun, EstimatorsAreUnbiased) {
   }
 }
 }  // namespace
+
+// The alias strategy places samples anywhere inside a pixel, also for maps of 2^21 pixels
+// (where u.x alone would leave 3 bits, i.e. 8 positions across a pixel): 16 strata across and
+// 16 down are equally full.
+TEST(EnvSamplingAlias, PositionInsidePixelIsUniformOnLargeMaps) {
+  Image img(2048, 1024);
+  for (size_t i = 0; i < img.rgb.size(); ++i) img.rgb[i] = 1.f;
+  EnvironmentMapOptions o;
+  o.bilinear = false;
+  EnvironmentMap env(std::move(img), o);
+  EnvironmentMapView v = env.view();
+  Pcg32 rng(21);
+  const int draws = 1 << 18, strata = 16;
+  std::vector<int> across(strata, 0), down(strata, 0);
+  for (int k = 0; k < draws; ++k) {
+    EnvSample s = v.sample(EnvStrategy::Alias, Vec2f(rng.nextFloat(), rng.nextFloat()));
+    float fx = s.uv.x * 2048.f - std::floor(s.uv.x * 2048.f), fy = s.uv.y * 1024.f - std::floor(s.uv.y * 1024.f);
+    ++across[std::min(strata - 1, int(fx * strata))];
+    ++down[std::min(strata - 1, int(fy * strata))];
+  }
+  double e = double(draws) / strata, cx = 0.0, cy = 0.0;
+  for (int i = 0; i < strata; ++i) {
+    cx += (across[i] - e) * (across[i] - e) / e;
+    cy += (down[i] - e) * (down[i] - e) / e;
+  }
+  EXPECT_LT(cx, 50.0);  // 15 dof: p < 1e-5 above this
+  EXPECT_LT(cy, 50.0);
+}
