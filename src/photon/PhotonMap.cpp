@@ -70,7 +70,7 @@ void PhotonMap::precomputeIrradiance(int k, float maxRadius, int stride) {
       if (dot(ph.n, c.n) > 0.9f) sum += ph.power;  // same side of the same surface
     }
     if (kept < kk) r2 = maxR2;
-    irr_[i] = {c.p, c.n, kept > 0 ? sum / (kPi * r2) : Color(0.f)};
+    irr_[i] = {c.p, c.n, kept > 0 ? sum / (kPi * r2) : Color(0.f), r2};
   });
   irrPhotons_.resize(count);
   for (size_t i = 0; i < count; ++i) irrPhotons_[i].p = irr_[i].p;
@@ -83,8 +83,12 @@ Color PhotonMap::irradiance(Vec3f p, Vec3f n) const {
   float d2[8];
   float q[3] = {p.x, p.y, p.z};
   size_t found = irrIndex_->tree.knnSearch(q, 8, idx, d2);
-  for (size_t j = 0; j < found; ++j)
-    if (dot(irr_[idx[j]].n, n) > 0.9f) return irr_[idx[j]].e;
+  // Only a point whose own estimate covered p (Christensen 1999): a gather ray that lands
+  // where no photons arrived must not borrow irradiance from a distant surface.
+  for (size_t j = 0; j < found; ++j) {
+    const IrradiancePoint& ip = irr_[idx[j]];
+    if (d2[j] <= ip.r2 && dot(ip.n, n) > 0.9f) return ip.e;
+  }
   return Color(0.f);
 }
 

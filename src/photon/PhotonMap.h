@@ -36,7 +36,8 @@ class PhotonMap {
   // Christensen's precomputation: irradiance from the k nearest photons at every stride-th
   // photon, so that a final-gather ray needs one nearest-neighbour lookup, not k.
   void precomputeIrradiance(int k, float maxRadius, int stride);
-  // Irradiance near p on a surface facing n (zero where no precomputed point fits).
+  // Irradiance near p on a surface facing n: that of the nearest precomputed point facing the
+  // same way whose estimate radius covers p, zero where none does.
   Color irradiance(Vec3f p, Vec3f n) const;
 
  private:
@@ -44,6 +45,7 @@ class PhotonMap {
   struct IrradiancePoint {
     Vec3f p, n;
     Color e;
+    float r2;  // squared radius of the photons it was estimated from
   };
   std::vector<Photon> photons_;
   std::unique_ptr<Index> index_;

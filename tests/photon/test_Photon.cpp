@@ -93,6 +93,11 @@ TEST(PhotonMapEstimate, UniformDensityGivesDiffuseRadiance) {
   map.precomputeIrradiance(200, 0.5f, 4);
   EXPECT_NEAR(map.irradiance(si.p, Vec3f(0, 0, 1)).x, E, 0.1f * E);
   EXPECT_EQ(map.irradiance(si.p, Vec3f(0, 0, -1)).x, 0.f) << "the back side has no irradiance point";
+  // The lookup is bounded by the radius each point was estimated over: 100 units away, where no
+  // photon arrived, a gather ray finds nothing rather than the plane's irradiance.
+  EXPECT_EQ(map.irradiance(Vec3f(100.f, 0.f, 0.f), Vec3f(0, 0, 1)).x, 0.f);
+  EXPECT_EQ(map.irradiance(Vec3f(0.f, 0.f, 3.f), Vec3f(0, 0, 1)).x, 0.f);
+  EXPECT_GT(map.irradiance(Vec3f(0.99f, 0.f, 0.f), Vec3f(0, 0, 1)).x, 0.f) << "the plane's edge is still covered";
 }
 
 TEST(HashGrid, FindsEveryPointWithinTheCellSize) {
