@@ -103,6 +103,7 @@ EnvironmentMap::EnvironmentMap(Image img, const EnvironmentMapOptions& opts, con
   // The quadtree baseline balances plain map power, never compensated power.
   std::vector<float> plain = opts.misCompensation ? samplingWeights(image_, opts.bilinear, false) : weight;
   adaptive_ = AdaptiveQuadtree(plain.data(), image_.width, image_.height, opts.adaptiveLeaves);
+  if (opts.misCompensation) emission_ = AliasTable(plain.data(), plain.size());
   if (dist_.integral() <= 0.f) spdlog::warn("environment map '{}' is black everywhere: a light of zero power", name);
 }
 
@@ -116,6 +117,7 @@ EnvironmentMapView EnvironmentMap::view() const {
   v.toWorld = opts_.toWorld;
   v.dist = dist_.view();
   v.alias = alias_.view();
+  v.emission = opts_.misCompensation ? emission_.view() : v.alias;
   v.adaptive = adaptive_.view();
   return v;
 }

@@ -47,7 +47,7 @@ class EnvironmentMap {
   EnvironmentMapStats stats() const;
   // Luminance power, integral of Y(L) over the sphere (zero for an all-black map).
   float luminancePower() const;
-  size_t samplingBytes() const { return dist_.bytes() + alias_.bytes(); }
+  size_t samplingBytes() const { return dist_.bytes() + alias_.bytes() + emission_.bytes(); }
 
   // Per-pixel sampling weight: luminance of the lookup's average over the pixel, times sin theta.
   static std::vector<float> samplingWeights(const Image& img, bool bilinear, bool misCompensation);
@@ -57,6 +57,7 @@ class EnvironmentMap {
   EnvironmentMapOptions opts_;
   PiecewiseConstant2D dist_;
   AliasTable alias_;
+  AliasTable emission_;  // plain luminance; built only when alias_ is compensated
   AdaptiveQuadtree adaptive_;
   size_t invalid_ = 0;
 };

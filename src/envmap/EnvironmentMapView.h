@@ -39,6 +39,9 @@ struct EnvironmentMapView {
   Transform toWorld;
   PiecewiseConstant2DView dist;  // func = luminance x sin(theta) per pixel
   AliasTableView alias;          // over all pixels, same weights as dist
+  // Light leaving the map, by plain luminance x sin(theta): the same table as `alias` unless
+  // MIS compensation made dist and alias sample max(L - mean, 0), which misses dim directions.
+  AliasTableView emission;
   AdaptiveQuadtreeView adaptive;
 
   ENVGI_HD static Vec2f dirToUV(Vec3f d) {
@@ -84,6 +87,31 @@ struct EnvironmentMapView {
   ENVGI_HD Color eval(Vec3f d) const { return lookupUV(dirToUV(toLocal(d))); }
 
   // Density in solid angle of the importance density at (u, v): p(u,v) / (2 pi^2 sin theta).
+  // A pixel from an alias table over the map and a position inside it from the bits the choice
+  // left over: 12 across, 11 down, each centred in its step so that float rounding never
+  // carries a sample over the pixel's edge into its neighbour.
+  ENVGI_HD Vec2f sampleTable(const AliasTableView& t, Vec2f u, float* pmf) const {
+    float r;
+    int i = t.sample(u, pmf, &r);
+    int px = i % width, py = i / width;
+    float a = std::floor(r * 4096.f), rest = r * 4096.f - a;
+    float ux = (a + 0.5f) * (1.f / 4096.f), uy = (std::floor(rest * 2048.f) + 0.5f) * (1.f / 2048.f);
+    return {(float(px) + ux) / float(width), (float(py) + uy) / float(height)};
+  }
+
+  // A direction for light leaving the map (photon emission), drawn by plain luminance even
+  // where MIS compensation is on; pdf in solid angle.
+  ENVGI_HD EnvSample sampleEmission(Vec2f u) const {
+    EnvSample out;
+    float pmf;
+    out.uv = sampleTable(emission, u, &pmf);
+    float st = std::sin(kPi * out.uv.y);
+    out.pdf = st > 0.f ? pmf * float(width) * float(height) / (2.f * kPi * kPi * st) : 0.f;
+    out.dir = fromLocal(uvToDir(out.uv));
+    out.radiance = out.pdf > 0.f ? lookupUV(out.uv) : Color(0.f);
+    return out;
+  }
+
   ENVGI_HD float importancePdfUV(Vec2f uv) const {
     float st = std::sin(kPi * uv.y);
     if (st <= 0.f) return 0.f;
@@ -118,14 +146,8 @@ struct EnvironmentMapView {
         break;
       }
       case EnvStrategy::Alias: {
-        // The position inside the pixel comes from the bits the bin choice left over: the
-        // first dozen place it across, the rest (frac of r 2^12) down.
-        float pmf, r;
-        int i = alias.sample(u, &pmf, &r);
-        int px = i % width, py = i / width;
-        float ux = r, scaled = r * 4096.f;
-        float uy = fminf(scaled - std::floor(scaled), kOneMinusEpsilon);
-        out.uv = {(float(px) + ux) / float(width), (float(py) + uy) / float(height)};
+        float pmf;
+        out.uv = sampleTable(alias, u, &pmf);
         local = uvToDir(out.uv);
         out.pdf = importancePdfUV(out.uv);
         break;

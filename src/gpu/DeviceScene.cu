@@ -10,7 +10,9 @@ EnvironmentMapView uploadEnvironment(DeviceArena& a, EnvironmentMapView v) {
   v.dist.condInt = a.upload(v.dist.condInt, size_t(v.height), "environment CDFs");
   v.dist.marginal.func = a.upload(v.dist.marginal.func, size_t(v.height), "environment CDFs");
   v.dist.marginal.cdf = a.upload(v.dist.marginal.cdf, size_t(v.height) + 1, "environment CDFs");
+  bool sharedEmission = v.emission.bins == v.alias.bins;
   v.alias.bins = a.upload(v.alias.bins, size_t(v.alias.n), "environment alias table");
+  v.emission.bins = sharedEmission ? v.alias.bins : a.upload(v.emission.bins, size_t(v.emission.n), "environment emission table");
   v.adaptive.nodes = a.upload(v.adaptive.nodes, size_t(v.adaptive.nodeCount), "adaptive quadtree");
   v.adaptive.leafNodes = a.upload(v.adaptive.leafNodes, size_t(v.adaptive.leafCount), "adaptive quadtree");
   v.adaptive.leafSolidAngle = a.upload(v.adaptive.leafSolidAngle, size_t(v.adaptive.leafCount), "adaptive quadtree");

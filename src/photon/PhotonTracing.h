@@ -29,8 +29,9 @@ struct PhotonEmitter {
     float uSel = smp.get1D();
     Vec2f u1 = smp.get2D(), u2 = smp.get2D();
     if (uSel < envProb && sc.hasEnvironment) {
-      // Direction by importance; origin on a disk facing it that covers the bounding sphere.
-      EnvSample es = sc.env.sample(EnvStrategy::Importance, u1);
+      // Direction by the map's luminance (Algorithm 1's density, never the MIS-compensated
+      // one); origin on a disk facing it that covers the bounding sphere.
+      EnvSample es = sc.env.sampleEmission(u1);
       if (!(es.pdf > 0.f) || isBlack(es.radiance)) return false;
       Frame f = Frame::fromNormal(es.dir);
       Vec2f d = sampleConcentricDisk(u2);

@@ -80,6 +80,14 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
       is.bsdfSamples >= 0 ? is.bsdfSamples : ((is.strategy == "mis" || is.strategy == "bsdf") ? 1 : 0);
   if (k.type == SampleIntegratorType::Direct && k.direct.emitterSamples + k.direct.bsdfSamples == 0)
     throw std::runtime_error("direct integrator: no samples");
+  // A compensated map density is zero where L is below its mean: only with BSDF samples beside
+  // it does every direction get covered (Karlik et al. 2019).
+  bool compensated = scene.env && scene.env->options().misCompensation;
+  bool mapDensity = k.direct.envStrategy == EnvStrategy::Alias || k.direct.envStrategy == EnvStrategy::Importance;
+  if (k.type == SampleIntegratorType::Direct && compensated && mapDensity && k.direct.emitterSamples > 0 &&
+      k.direct.bsdfSamples == 0)
+    throw std::runtime_error("direct integrator: mis_compensation samples only the map's bright part; it needs "
+                             "bsdf_samples > 0 (or the strategy 'mis') to cover the rest");
   k.sequence.type = scene.sampler.type;
   k.sequence.spp = uint32_t(k.spp);
   k.sequence.seed = scene.sampler.seed;
