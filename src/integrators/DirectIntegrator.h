@@ -18,11 +18,12 @@ struct DirectParams {
 };
 
 // Direct light reflected at si towards wo (its own emission excluded): nE light samples and
-// nB BSDF samples, power heuristic weighted by the counts. Also used by the photon mappers.
+// nB BSDF samples, power heuristic weighted by the counts. Also used by the photon mappers,
+// which follow delta lobes themselves and so leave out BSDF samples of them (skipDelta).
 template <class Tracer>
 ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& si, Vec3f wo,
                               Sampler& smp, EnvStrategy strategy, int emitterSamples, int bsdfSamples,
-                              uint64_t* rayCount) {
+                              uint64_t* rayCount, bool skipDelta = false) {
   Color L(0.f);
   const Bsdf& bsdf = sc.bsdfs[si.bsdf];
   Vec3f woLocal = si.shading.toLocal(wo);
@@ -49,7 +50,7 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
     BsdfSample bs;
     float uc = smp.get1D();
     Vec2f ub = smp.get2D();
-    if (!bsdfSample(bsdf, woLocal, uc, ub, &bs)) continue;
+    if (!bsdfSample(bsdf, woLocal, uc, ub, &bs) || (skipDelta && bs.delta)) continue;
     Vec3f wi = si.shading.toWorld(bs.wi);
     Ray r2{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};
     Hit h2;

@@ -63,8 +63,13 @@ Color photonTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& s
     Vec3f wo = -ray.d;
     if (countEmission) L += beta * sc.emitted(si, wo);
     const Bsdf& bsdf = sc.bsdfs[si.bsdf];
-    if (!bsdfIsDelta(bsdf)) {
-      L += beta * directLighting(sc, tracer, si, wo, smp, pp.strategy, 1, 1, rays);
+    // Smooth plastic's coat is a mirror: follow it with its sampling probability (what it
+    // reflects may be lit, not emitting), and estimate the base here otherwise.
+    float pDelta = bsdfDeltaProb(bsdf, si.shading.toLocal(wo));
+    float uLobe = pDelta > 0.f && pDelta < 1.f ? smp.get1D() : 1.f;
+    if (pDelta < 1.f && uLobe >= pDelta) {
+      beta = beta / (1.f - pDelta);
+      L += beta * directLighting(sc, tracer, si, wo, smp, pp.strategy, 1, 1, rays, true);
       if (isDiffuseLike(bsdf, pp.glossyThreshold)) {
         L += beta * caustic.estimate(sc, si, wo, pp.caustic);
         if (pp.gatherSamples <= 0) {
@@ -100,9 +105,10 @@ Color photonTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& s
     }
     // Mirrors, glass and sharp glossy lobes: follow the path.
     BsdfSample bs;
-    float uc = smp.get1D();
+    float uc = pDelta > 0.f && pDelta < 1.f ? uLobe : smp.get1D();  // < pDelta: the coat
     Vec2f ub = smp.get2D();
     if (!bsdfSample(bsdf, si.shading.toLocal(wo), uc, ub, &bs)) break;
+    if (pDelta > 0.f && pDelta < 1.f && !bs.delta) break;
     beta *= bs.weight;
     if (isBlack(beta)) break;
     countEmission = bs.delta;  // after a glossy bounce, directLighting counted the emitters

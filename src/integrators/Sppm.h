@@ -39,8 +39,13 @@ ENVGI_HD VisiblePoint sppmCameraPath(const SceneView& sc, const Tracer& tracer, 
     Vec3f wo = -ray.d;
     *Ld += beta * sc.emitted(si, wo);
     const Bsdf& bsdf = sc.bsdfs[si.bsdf];
-    if (!bsdfIsDelta(bsdf)) {
-      *Ld += beta * directLighting(sc, tracer, si, wo, smp, strategy, 1, 1, rays);
+    // Smooth plastic's coat is a mirror: follow it with its sampling probability (what it
+    // reflects may be lit, not emitting), and make the visible point on the base otherwise.
+    float pDelta = bsdfDeltaProb(bsdf, si.shading.toLocal(wo));
+    float uLobe = smp.get1D();
+    if (pDelta < 1.f && uLobe >= pDelta) {
+      beta = beta / (1.f - pDelta);
+      *Ld += beta * directLighting(sc, tracer, si, wo, smp, strategy, 1, 1, rays, true);
       vp.p = si.p;
       vp.wo = wo;
       vp.shading = si.shading;
@@ -50,9 +55,9 @@ ENVGI_HD VisiblePoint sppmCameraPath(const SceneView& sc, const Tracer& tracer, 
       return vp;
     }
     BsdfSample bs;
-    float uc = smp.get1D();
+    float uc = pDelta < 1.f ? uLobe : smp.get1D();  // < pDelta: bsdfSample picks the coat
     Vec2f ub = smp.get2D();
-    if (!bsdfSample(bsdf, si.shading.toLocal(wo), uc, ub, &bs)) return vp;
+    if (!bsdfSample(bsdf, si.shading.toLocal(wo), uc, ub, &bs) || !bs.delta) return vp;
     beta *= bs.weight;
     Vec3f wi = si.shading.toWorld(bs.wi);
     ray = Ray{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};

@@ -293,4 +293,15 @@ ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSam
   return ok && isFiniteVec(s->weight);
 }
 
+// Probability that bsdfSample picks a delta lobe from wo when the BSDF also has a smooth one
+// (smooth plastic's coat); 0 for BSDFs without delta lobes, 1 for purely delta ones. Callers
+// that follow delta lobes themselves (SPPM, the photon integrator) split on it.
+ENVGI_INLINE float bsdfDeltaProb(const Bsdf& b, Vec3f wo) {
+  if (bsdfIsDelta(b)) return 1.f;
+  if (b.type != BsdfType::Plastic) return 0.f;
+  float c = b.twoSided ? std::fabs(wo.z) : wo.z;
+  if (c <= 0.f) return 0.f;
+  return detail::plasticSpecularProb(b, fresnelDielectric(c, b.ior));
+}
+
 }  // namespace envgi

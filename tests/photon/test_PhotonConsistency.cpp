@@ -2,6 +2,7 @@
 // photon integrator's error falls as photons grow, and caustics appear under glass.
 #include <gtest/gtest.h>
 
+#include "materials/BsdfFactory.h"
 #include "support/CausticScene.h"
 
 using namespace envgi;
@@ -96,4 +97,44 @@ TEST(PhotonConsistency, CausticAppearsUnderGlass) {
     double a = test::meanLum(img, focus), b = test::meanLum(img, ring);
     EXPECT_GT(a, 1.5 * b) << type << ": caustic " << a << " vs surround " << b;
   }
+}
+
+// A smooth-plastic floor (dark base, so its coat's mirror image dominates) beside a lit white
+// ball: both photon integrators follow the coat, so the ball's reflection appears and SPPM
+// matches the path tracer over every region, the reflection included.
+TEST(PhotonConsistency, SmoothPlasticReflectsLitSurfaces) {
+  Bsdf floor;
+  floor.type = BsdfType::Plastic;
+  floor.reflectance = Color(0.05f);
+  floor.ior = 1.5f;
+  finishPlastic(floor);
+  Bsdf ball;
+  ball.reflectance = Color(0.8f);
+  Image sky(128, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 128; ++x) sky.set(x, y, Color(y < 3 ? 300.f : (y < 32 ? 0.3f : 0.02f)));
+  auto scene = test::sphereOnFloor(floor, ball, 4.f, std::move(sky), Vec3f(0, 1.2f, 5.f), Vec3f(0, 0.6f, 0), 16, 40.f);
+  std::vector<float> var;
+  Image ref = run(*scene, "path", 1024, &var);
+  scene->integrator.passes = 256;
+  scene->integrator.photonCount = 40000;
+  Image sppm = run(*scene, "sppm", -1);
+  scene->integrator.globalPhotons = 100000;
+  scene->integrator.causticPhotons = 20000;
+  scene->integrator.gatherSamples = 8;
+  Image photon = run(*scene, "photon", 64);
+  for (int ry = 0; ry < 16; ry += 4)
+    for (int rx = 0; rx < 16; rx += 4) {
+      double a = 0, b = 0, c = 0, v = 0;
+      for (int y = ry; y < ry + 4; ++y)
+        for (int x = rx; x < rx + 4; ++x) {
+          a += luminance(ref.at(x, y)) / 16;
+          b += luminance(sppm.at(x, y)) / 16;
+          c += luminance(photon.at(x, y)) / 16;
+          v += var[size_t(y) * 16 + x] / 256;
+        }
+      EXPECT_NEAR(b, a, 4 * std::sqrt(v) + 0.04 * a) << "sppm, region " << rx << "," << ry;
+      // The photon integrator's final gather approximates the base as Lambertian: looser.
+      EXPECT_NEAR(c, a, 4 * std::sqrt(v) + 0.10 * a) << "photon, region " << rx << "," << ry;
+    }
 }
