@@ -43,7 +43,8 @@ def bsdfs():
                         f'<bsdf type="roughdielectric"><float name="int_ior" value="{ior}"/><float name="alpha" value="{a}"/>'
                         '<string name="distribution" value="ggx"/></bsdf>'))
     out.append(('conductor none', '<bsdf type="conductor"><string name="material" value="none"/></bsdf>'))
-    out.append(('conductor Au', '<bsdf type="conductor"><string name="material" value="Au"/></bsdf>'))
+    for m in ('Au', 'Ag', 'Al', 'Cu', 'Cr'):
+        out.append((f'conductor {m}', f'<bsdf type="conductor"><string name="material" value="{m}"/></bsdf>'))
     for a in (0.1, 0.3, 0.6):
         for m in ('none', 'Au'):
             out.append((f'roughconductor {m} a {a}',
