@@ -25,8 +25,9 @@ ENVGI_INLINE bool isDiffuseLike(const Bsdf& b, float glossyThreshold) {
     case BsdfType::Diffuse:
     case BsdfType::Plastic:
     case BsdfType::RoughPlastic: return true;
-    case BsdfType::RoughConductor:
-    case BsdfType::RoughDielectric: return b.alpha >= glossyThreshold;
+    // Rough glass is followed like glass: its light comes mostly through it, which irradiance
+    // on its surface cannot stand for.
+    case BsdfType::RoughConductor: return b.alpha >= glossyThreshold;
     default: return false;
   }
 }
@@ -38,8 +39,10 @@ ENVGI_INLINE Color diffuseAlbedo(const Bsdf& b) {
     case BsdfType::Diffuse: return b.reflectance;
     case BsdfType::Plastic:
     case BsdfType::RoughPlastic: {
-      float t = 1.f - fresnelDielectric(1.f, b.ior);
-      return b.reflectance * (t * t / ((1.f - b.fdrInt) * b.ior * b.ior));
+      // The base's albedo towards the normal under uniform light: light enters through the coat
+      // with 1 - Fdr (the coat's hemispherical Fresnel from outside) and leaves with 1 - F(0).
+      float tOut = 1.f - fresnelDielectric(1.f, b.ior), tIn = 1.f - b.fdrExt;
+      return b.reflectance * (tOut * tIn / ((1.f - b.fdrInt) * b.ior * b.ior));
     }
     case BsdfType::RoughConductor:
       return b.specularReflectance * (b.perfectMirror ? Color(1.f) : fresnelConductor(1.f, b.eta, b.k));

@@ -32,6 +32,7 @@ struct Bsdf {
   float alpha = 0.1f;                    // GGX roughness
   float ior = 1.5046f;                   // interior / exterior index of refraction
   float fdrInt = 0.f;                    // plastic: diffuse Fresnel reflectance seen from inside
+  float fdrExt = 0.f;                    // plastic: the same seen from outside
   float specularSamplingWeight = 0.5f;   // plastic: share of samples given to the coating
 };
 

@@ -47,6 +47,7 @@ float fresnelDiffuseReflectance(float eta) {
 
 void finishPlastic(Bsdf& b) {
   b.fdrInt = fresnelDiffuseReflectance(1.f / b.ior);
+  b.fdrExt = fresnelDiffuseReflectance(b.ior);
   float dMean = (b.reflectance.x + b.reflectance.y + b.reflectance.z) / 3.f;
   float sMean = (b.specularReflectance.x + b.specularReflectance.y + b.specularReflectance.z) / 3.f;
   b.specularSamplingWeight = sMean + dMean > 0.f ? sMean / (sMean + dMean) : 0.5f;

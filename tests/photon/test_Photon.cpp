@@ -2,7 +2,9 @@
 // known flux density, the hashed grid, and black maps.
 #include <gtest/gtest.h>
 
+#include "integrators/PhotonIntegrator.h"
 #include "integrators/Sppm.h"
+#include "materials/BsdfFactory.h"
 #include "photon/HashGrid.h"
 #include "photon/PhotonShooter.h"
 #include "sampling/Pcg32.h"
@@ -189,4 +191,26 @@ TEST(PhotonEmission, CompensatedMapStillEmitsEverywhere) {
   EXPECT_THROW(render(*scene, accel, ro, nullptr), std::runtime_error);
   scene->integrator.strategy = "mis";
   EXPECT_NO_THROW(render(*scene, accel, ro, nullptr));
+}
+
+// The final gather's stand-in albedo for plastic is the base's true albedo towards the normal
+// under uniform light (a quadrature of eval), not above it: white plastic creates no energy.
+TEST(PhotonIntegrators, PlasticGatherAlbedoIsTheBaseAlbedo) {
+  for (float ior : {1.3f, 1.5f, 1.9f}) {
+    Bsdf b;
+    b.type = BsdfType::Plastic;
+    b.reflectance = Color(1.f);
+    b.ior = ior;
+    finishPlastic(b);
+    Pcg32 rng(8);
+    const int n = 400000;
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+      Vec3f wi = sampleUniformHemisphere(Vec2f(rng.nextFloat(), rng.nextFloat()));
+      sum += bsdfEval(b, Vec3f(0, 0, 1), wi).x * 2.0 * kPi;  // eval carries cos(wi)
+    }
+    double albedo = sum / n;
+    EXPECT_NEAR(diffuseAlbedo(b).x, albedo, 0.005 * albedo) << "ior " << ior;
+    EXPECT_LT(albedo, 1.0);
+  }
 }
