@@ -58,12 +58,13 @@ def bsdfs():
                         '<string name="distribution" value="ggx"/></bsdf>'))
     return out
 
-# Where envgi differs from Mitsuba by design (docs/validation.md says why).
+# Where envgi is known to differ from Mitsuba (docs/validation.md says why): by design, or open.
 DESIGN = {
     'roughplastic': 'envgi\'s rough plastic uses smooth Fresnel terms for its diffuse base, not Mitsuba\'s precomputed tables',
-    # The bundled scenes whose objects are rough plastic (the Buddha, the teapot).
-    'buddha': 'the Buddha is rough plastic (see roughplastic)',
-    'teapot-glass': 'the teapot is rough plastic (see roughplastic)',
+    # The bundled scenes lit by Grace: rough-plastic objects (above), and the map's rows sit at
+    # v = j / (H - 1) in Mitsuba but at pixel centres in envgi, which shifts sharp features.
+    'buddha': 'open: env-map row placement (Mitsuba v = j/(H-1), envgi pixel centres); rough-plastic Buddha',
+    'teapot-glass': 'open: env-map row placement (Mitsuba v = j/(H-1), envgi pixel centres); rough-plastic teapot',
 }
 
 # Envgi-only properties that Mitsuba would reject as unreferenced.
