@@ -33,7 +33,8 @@ struct RenderArgs {
   float exposure = 0.f;
   bool aces = false;
   double checkpoint = 60.0;
-  std::string device = "auto", sampler;
+  std::string device = "auto", sampler, pointMethod;
+  int points = 0;
   int gpu = 0;
 };
 
@@ -80,8 +81,14 @@ void runRender(const RenderArgs& a) {
     scene.integrator.type = a.integrator;
   }
   if (!a.strategy.empty()) {
-    parseStrategyName(a.strategy == "mis" || a.strategy == "bsdf" ? "importance" : a.strategy);
+    if (a.strategy != "points") parseStrategyName(a.strategy == "mis" || a.strategy == "bsdf" ? "importance" : a.strategy);
     scene.integrator.strategy = a.strategy;
+  }
+  if (a.points > 0) scene.integrator.pointCount = a.points;
+  if (!a.pointMethod.empty()) {
+    if (a.pointMethod != "sample" && a.pointMethod != "mediancut")
+      throw std::runtime_error("unknown point method '" + a.pointMethod + "' (sample, mediancut)");
+    scene.integrator.pointMethod = a.pointMethod;
   }
   if (a.seed >= 0) scene.sampler.seed = uint32_t(a.seed);
   if (!a.sampler.empty()) {
@@ -172,7 +179,9 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("-o,--output", a->output, "Output image (.exr, .pfm, .hdr or .png)")->required();
   c->add_option("--spp", a->spp, "Samples per pixel, or passes for sppm (default: the scene's)")->check(CLI::PositiveNumber);
   c->add_option("--integrator", a->integrator, "path | direct | photon | sppm (overrides the scene)");
-  c->add_option("--strategy", a->strategy, "Environment strategy: uniform|cosine|bsdf|importance|alias|adaptive|mis");
+  c->add_option("--strategy", a->strategy, "Environment strategy: uniform|cosine|bsdf|importance|alias|adaptive|mis|points");
+  c->add_option("--points", a->points, "points: directional lights in the collapsed map (default 64)")->check(CLI::PositiveNumber);
+  c->add_option("--point-method", a->pointMethod, "points: sample (Algorithm 1 draws, power L/pdf/N) | mediancut");
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
   c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   c->add_option("--seed", a->seed, "Sampler seed (overrides the scene)")->check(CLI::NonNegativeNumber);

@@ -107,6 +107,19 @@ EnvironmentMap::EnvironmentMap(Image img, const EnvironmentMapOptions& opts, con
   if (dist_.integral() <= 0.f) spdlog::warn("environment map '{}' is black everywhere: a light of zero power", name);
 }
 
+void EnvironmentMap::setPoints(std::vector<DirectionalLight> points) {
+  double total = 0.0;
+  for (const DirectionalLight& d : points) total += std::max(0.f, luminance(d.irradiance));
+  double acc = 0.0;
+  for (DirectionalLight& d : points) {
+    d.pmf = total > 0.0 ? float(std::max(0.f, luminance(d.irradiance)) / total) : 1.f / float(points.size());
+    acc += d.pmf;
+    d.cdf = float(acc);
+  }
+  if (!points.empty()) points.back().cdf = 1.f;  // a draw never falls past the last light
+  points_ = std::move(points);
+}
+
 EnvironmentMapView EnvironmentMap::view() const {
   EnvironmentMapView v;
   v.rgb = image_.rgb.data();
@@ -119,6 +132,8 @@ EnvironmentMapView EnvironmentMap::view() const {
   v.alias = alias_.view();
   v.emission = opts_.misCompensation ? emission_.view() : v.alias;
   v.adaptive = adaptive_.view();
+  v.points = points_.empty() ? nullptr : points_.data();
+  v.pointCount = int(points_.size());
   return v;
 }
 

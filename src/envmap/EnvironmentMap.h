@@ -49,6 +49,11 @@ class EnvironmentMap {
   float luminancePower() const;
   size_t samplingBytes() const { return dist_.bytes() + alias_.bytes() + emission_.bytes(); }
 
+  // The collapsed map that the `points` strategy uses (envmap/CollapsedMap.h makes one).
+  // Fills each light's selection pmf and cdf (by luminance; uniform when all are black).
+  void setPoints(std::vector<DirectionalLight> points);
+  const std::vector<DirectionalLight>& points() const { return points_; }
+
   // Per-pixel sampling weight: luminance of the lookup's average over the pixel, times sin theta.
   static std::vector<float> samplingWeights(const Image& img, bool bilinear, bool misCompensation);
 
@@ -58,6 +63,7 @@ class EnvironmentMap {
   PiecewiseConstant2D dist_;
   AliasTable alias_;
   AliasTable emission_;  // plain luminance; built only when alias_ is compensated
+  std::vector<DirectionalLight> points_;
   AdaptiveQuadtree adaptive_;
   size_t invalid_ = 0;
 };

@@ -22,13 +22,25 @@ enum class EnvStrategy : int {
   Importance = 2,  // Algorithm 1: marginal/conditional CDFs, binary search
   Alias = 3,       // the same density through an alias table
   Adaptive = 4,    // energy-balanced quadtree baseline
+  Points = 5,      // the collapsed map: a fixed set of directional lights (biased)
+};
+
+// One light of the collapsed map (the paper's Section 2): a direction and the irradiance it
+// delivers to a surface facing it, E = L(w) / (pdf(w) N) for weighted sampling, or the power
+// of a median-cut region.
+struct DirectionalLight {
+  Vec3f dir;  // world space, towards the light
+  Color irradiance;
+  float pmf = 0.f;  // chance next-event estimation picks it: by luminance of its irradiance
+  float cdf = 0.f;  // sum of the pmfs up to and including this one
 };
 
 struct EnvSample {
   Vec3f dir;       // world space, pointing away from the scene
   Color radiance;  // scaled radiance arriving from dir
-  float pdf = 0.f; // solid angle
+  float pdf = 0.f; // solid angle; for a delta sample (a collapsed-map light) its selection pmf
   Vec2f uv;
+  bool delta = false;
 };
 
 struct EnvironmentMapView {
@@ -43,6 +55,8 @@ struct EnvironmentMapView {
   // MIS compensation made dist and alias sample max(L - mean, 0), which misses dim directions.
   AliasTableView emission;
   AdaptiveQuadtreeView adaptive;
+  const DirectionalLight* points = nullptr;  // the collapsed map, when one was made
+  int pointCount = 0;
 
   ENVGI_HD static Vec2f dirToUV(Vec3f d) {
     float u = std::atan2(d.x, -d.z) * kInv2Pi;
@@ -152,11 +166,27 @@ struct EnvironmentMapView {
         out.pdf = importancePdfUV(out.uv);
         break;
       }
-      case EnvStrategy::Adaptive:
-      default: {
+      case EnvStrategy::Adaptive: {
         out.uv = adaptive.sample(u, &out.pdf);
         local = uvToDir(out.uv);
         break;
+      }
+      case EnvStrategy::Points: {
+        // One light chosen by its share of the irradiance: radiance / pmf estimates sum_i f E_i.
+        if (pointCount == 0) return out;
+        int lo = 0, hi = pointCount - 1;
+        while (lo < hi) {
+          int mid = (lo + hi) / 2;
+          if (points[mid].cdf > u.x) hi = mid;
+          else lo = mid + 1;
+        }
+        int i = lo;
+        out.dir = points[i].dir;
+        out.pdf = points[i].pmf;
+        out.radiance = points[i].irradiance;
+        out.uv = dirToUV(toLocal(out.dir));
+        out.delta = true;
+        return out;
       }
     }
     out.dir = fromLocal(local);
@@ -170,9 +200,10 @@ struct EnvironmentMapView {
       case EnvStrategy::Cosine: return cosineHemispherePdf(dot(normalize(worldDir), normal));
       case EnvStrategy::Importance:
       case EnvStrategy::Alias: return importancePdfUV(dirToUV(toLocal(worldDir)));
-      case EnvStrategy::Adaptive:
-      default: return adaptive.pdf(dirToUV(toLocal(worldDir)));
+      case EnvStrategy::Adaptive: return adaptive.pdf(dirToUV(toLocal(worldDir)));
+      case EnvStrategy::Points: return 0.f;  // no direction drawn by BSDF sampling hits a point
     }
+    return 0.f;
   }
 };
 

@@ -15,6 +15,7 @@ EnvironmentMapView uploadEnvironment(DeviceArena& a, EnvironmentMapView v) {
   v.emission.bins = sharedEmission ? v.alias.bins : a.upload(v.emission.bins, size_t(v.emission.n), "environment emission table");
   v.adaptive.nodes = a.upload(v.adaptive.nodes, size_t(v.adaptive.nodeCount), "adaptive quadtree");
   v.adaptive.leafNodes = a.upload(v.adaptive.leafNodes, size_t(v.adaptive.leafCount), "adaptive quadtree");
+  v.points = a.upload(v.points, size_t(v.pointCount), "collapsed map");
   v.adaptive.leafSolidAngle = a.upload(v.adaptive.leafSolidAngle, size_t(v.adaptive.leafCount), "adaptive quadtree");
   return v;
 }

@@ -42,7 +42,7 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
     float tMax = ls.environment ? INFINITY : ls.dist * (1.f - 1e-4f) - length(o - si.p);
     ++*rayCount;
     if (tracer.occluded(o, ls.dir, tMax)) continue;
-    float w = nB > 0.f ? powerHeuristic(nE, ls.pdf, nB, bsdfPdf(bsdf, woLocal, wiLocal)) : 1.f;
+    float w = nB > 0.f && !ls.delta ? powerHeuristic(nE, ls.pdf, nB, bsdfPdf(bsdf, woLocal, wiLocal)) : 1.f;
     L += f * ls.radiance * (w / (ls.pdf * nE));
   }
 
@@ -58,7 +58,7 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
     Color Le(0.f);
     float lightPdf = 0.f;
     if (!tracer.intersect(r2, &h2)) {
-      if (!sc.hasEnvironment) continue;
+      if (!sc.hasEnvironment || !envSeenByBsdfSampling(strategy, bs.delta)) continue;
       Le = sc.env.eval(wi);
       lightPdf = envLightPdf(sc, strategy, wi, axis);
     } else {

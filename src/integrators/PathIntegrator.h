@@ -27,7 +27,7 @@ ENVGI_HD Color pathTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sam
     Hit h;
     ++*rayCount;
     if (!tracer.intersect(ray, &h)) {
-      if (sc.hasEnvironment && !(depth == 1 && pp.hideEmitters)) {
+      if (sc.hasEnvironment && !(depth == 1 && pp.hideEmitters) && envSeenByBsdfSampling(pp.envStrategy, prevDelta)) {
         Color Le = sc.env.eval(ray.d);
         float w = prevDelta ? 1.f : powerHeuristic(1.f, prevPdf, 1.f, envLightPdf(sc, pp.envStrategy, ray.d, prevAxis));
         L += beta * Le * w;
@@ -61,7 +61,7 @@ ENVGI_HD Color pathTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sam
         float tMax = ls.environment ? INFINITY : ls.dist * (1.f - 1e-4f) - length(o - si.p);
         ++*rayCount;
         if (!tracer.occluded(o, ls.dir, tMax)) {
-          float w = powerHeuristic(1.f, ls.pdf, 1.f, bsdfPdf(bsdf, woLocal, wiLocal));
+          float w = ls.delta ? 1.f : powerHeuristic(1.f, ls.pdf, 1.f, bsdfPdf(bsdf, woLocal, wiLocal));
           L += beta * f * ls.radiance * (w / ls.pdf);
         }
       }

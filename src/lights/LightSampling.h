@@ -10,14 +10,19 @@ struct LightSample {
   Vec3f dir;            // from the shading point towards the light
   float dist = INFINITY;
   Color radiance;
-  float pdf = 0.f;      // solid angle, selection included
+  float pdf = 0.f;      // solid angle, selection included; a pmf for a delta light
   bool environment = false;
+  bool delta = false;   // a collapsed-map light: no MIS, BSDF sampling cannot find it
 };
 
 // The cosine strategy samples about the normal on the side the viewer is on.
 ENVGI_INLINE Vec3f cosineAxis(const SurfaceInteraction& si, Vec3f wo) {
   return dot(si.shading.n, wo) >= 0.f ? si.shading.n : -si.shading.n;
 }
+
+// Whether a BSDF-sampled ray that escapes to the map counts: not where next-event estimation
+// already took the whole map as collapsed-map lights (a delta bounce still sees the map).
+ENVGI_INLINE bool envSeenByBsdfSampling(EnvStrategy s, bool prevDelta) { return prevDelta || s != EnvStrategy::Points; }
 
 ENVGI_INLINE float envLightPdf(const SceneView& sc, EnvStrategy s, Vec3f dir, Vec3f axis) {
   if (!sc.hasEnvironment) return 0.f;
@@ -46,6 +51,7 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
     ls->radiance = es.radiance;
     ls->pdf = es.pdf * pe;
     ls->environment = true;
+    ls->delta = es.delta;
     return true;
   }
   if (sc.lightCount == 0) return false;
@@ -64,6 +70,7 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
   ls->radiance = lp.radiance;
   ls->pdf = (1.f - pe) * pmf / lp.area * dist2 / cosL;
   ls->environment = false;
+  ls->delta = false;
   return ls->pdf > 0.f;
 }
 

@@ -35,7 +35,9 @@ struct IntegratorSettings {
   bool hideEmitters = false;
   int emitterSamples = -1;    // direct: -1 = default for the strategy
   int bsdfSamples = -1;
-  std::string strategy = "mis";  // uniform|cosine|bsdf|importance|alias|adaptive|mis
+  std::string strategy = "mis";  // uniform|cosine|bsdf|importance|alias|adaptive|mis|points
+  int pointCount = 64;                // points: lights in the collapsed map
+  std::string pointMethod = "sample"; // points: sample (Algorithm 1 draws) | mediancut
   // photon (Jensen's two passes; names after Mitsuba 0.6's photon mapper)
   size_t globalPhotons = 250000;
   size_t causticPhotons = 250000;

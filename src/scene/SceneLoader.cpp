@@ -366,12 +366,16 @@ class Loader {
       s.rrDepth = getInt(f, p, "rr_depth", 5);
       s.hideEmitters = getBool(f, p, "hide_emitters", false);
       s.strategy = getString(f, p, "strategy", "mis");
+      s.pointCount = getInt(f, p, "point_count", 64);
+      s.pointMethod = getString(f, p, "point_method", "sample");
     } else if (type == "direct") {
       int shading = getInt(f, p, "shading_samples", -1);
       s.emitterSamples = getInt(f, p, "emitter_samples", shading);
       s.bsdfSamples = getInt(f, p, "bsdf_samples", shading);
       s.hideEmitters = getBool(f, p, "hide_emitters", false);
       s.strategy = getString(f, p, "strategy", "mis");
+      s.pointCount = getInt(f, p, "point_count", 64);
+      s.pointMethod = getString(f, p, "point_method", "sample");
     } else if (type == "photon" || type == "photonmapper") {
       s.type = "photon";
       s.maxDepth = getInt(f, p, "max_depth", 16);
@@ -401,9 +405,12 @@ class Loader {
     } else {
       fail(f, n, fmt::format("unknown integrator type '{}' (path, direct, photon, sppm)", type));
     }
-    static const std::set<std::string> strategies = {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis"};
+    static const std::set<std::string> strategies = {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis", "points"};
     if (!strategies.count(s.strategy))
-      fail(f, n, fmt::format("unknown strategy '{}' (uniform, cosine, bsdf, importance, alias, adaptive, mis)", s.strategy));
+      fail(f, n, fmt::format("unknown strategy '{}' (uniform, cosine, bsdf, importance, alias, adaptive, mis, points)", s.strategy));
+    if (s.pointCount < 1) fail(f, n, "point_count must be at least 1");
+    if (s.pointMethod != "sample" && s.pointMethod != "mediancut")
+      fail(f, n, fmt::format("unknown point_method '{}' (sample, mediancut)", s.pointMethod));
     if (s.maxDepth < -1 || s.maxDepth == 0) fail(f, n, "max_depth must be -1 or at least 1");
     if (s.emitterSamples < -1 || s.bsdfSamples < -1) fail(f, n, "sample counts must not be negative");
     warnUnused(f, p, "integrator '" + type + "'");

@@ -1,0 +1,23 @@
+// The collapsed map (the paper's Section 2, "simplified representation ... using weighted
+// sampling"): the environment turned into N directional lights shared by every shading point.
+// Biased by construction: fast, noise-free in the light's direction, wrong in its shape.
+#pragma once
+
+#include <vector>
+
+#include "envmap/EnvironmentMap.h"
+
+namespace envgi {
+
+enum class CollapseMethod { WeightedSampling, MedianCut };
+
+// N directions drawn by Algorithm 1 (stratified, Owen-scrambled Sobol' points for `seed`), each
+// with irradiance L / (pdf N): their sum estimates the map's integral.
+std::vector<DirectionalLight> collapseByWeightedSampling(const EnvironmentMap& map, int n, uint32_t seed);
+
+// Debevec's median cut (2005): the map split into N regions of equal luminance power (always
+// across the region's longer side in angle), each a light at its power centroid carrying the
+// region's integral of L. The sum over lights is the map's integral.
+std::vector<DirectionalLight> collapseByMedianCut(const EnvironmentMap& map, int n);
+
+}  // namespace envgi
