@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   envgi::cli::addEnvmapCommands(app);
   envgi::cli::addRenderCommand(app);
   envgi::cli::addPhotonsCommand(app);
+  envgi::cli::addStudyCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -196,6 +196,14 @@ float toneMapChannel(float v, const SaveOptions& opts) {
   return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
 }
 
+std::string encodePng(int width, int height, const std::vector<unsigned char>& rgb) {
+  std::string out;
+  auto append = [](void* ctx, void* data, int size) { static_cast<std::string*>(ctx)->append(static_cast<char*>(data), size_t(size)); };
+  if (!stbi_write_png_to_func(append, &out, width, height, 3, rgb.data(), width * 3))
+    throw std::runtime_error("cannot encode a PNG");
+  return out;
+}
+
 std::vector<unsigned char> toneMapImage(const Image& img, const SaveOptions& opts) {
   std::vector<unsigned char> ldr(img.rgb.size());
   for (size_t i = 0; i < ldr.size(); ++i) ldr[i] = (unsigned char)std::lround(toneMapChannel(img.rgb[i], opts) * 255.f);

@@ -44,6 +44,9 @@ void saveImage(const Image& img, const std::string& path, const SaveOptions& opt
 
 // Exposure, tone curve and sRGB encoding of one linear value, in [0,1].
 float toneMapChannel(float v, const SaveOptions& opts);
+// An 8-bit RGB buffer (3 bytes a pixel) encoded as PNG, in memory.
+std::string encodePng(int width, int height, const std::vector<unsigned char>& rgb);
+
 // The whole image as 8-bit sRGB, 3 bytes a pixel.
 std::vector<unsigned char> toneMapImage(const Image& img, const SaveOptions& opts);
 

@@ -33,13 +33,6 @@ std::string tinyScene(const TempDir& d, int res, int spp) {
   return path;
 }
 
-std::string slurp(const std::string& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
-
 }  // namespace
 
 TEST(CliRender, WritesExrAndPngAndReportsRate) {

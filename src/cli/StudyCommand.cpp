@@ -1,0 +1,258 @@
+// `envgi study SCENE.xml -o DIR`: the paper's comparison as one command. A reference, then every
+// strategy at each sample count (and time budget) with several seeds; RMSE and relMSE against the
+// reference into results.csv / results.json and a self-contained report.html. Resumable: each
+// finished run is a JSON file under DIR/runs, written atomically and skipped when re-run.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <stdexcept>
+
+#include "accel/EmbreeAccel.h"
+#include "cli/Commands.h"
+#include "core/Files.h"
+#include "render/Renderer.h"
+#include "scene/SceneLoader.h"
+#include "study/ErrorMetrics.h"
+#include "study/Report.h"
+
+namespace envgi::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct StudyArgs {
+  std::string scene, out, reference, strategies = "uniform,cosine,bsdf,adaptive,importance,mis,points-64",
+                                     spp = "1,4,16,64,256", times, integrator = "direct";
+  std::vector<std::string> defines;
+  int seeds = 2, referenceSpp = 4096, threads = 0;
+};
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+// A comma-separated list of positive numbers; `what` names the option in errors.
+std::vector<double> positiveNumbers(const std::string& list, const std::string& option, const std::string& what) {
+  std::vector<double> out;
+  for (const std::string& s : splitList(list)) {
+    double v = 0;
+    try {
+      size_t used = 0;
+      v = std::stod(s, &used);
+      if (used != s.size()) v = 0;
+    } catch (...) {
+    }
+    if (!(v > 0)) throw std::runtime_error(option + ": '" + s + "' is not " + what);
+    out.push_back(v);
+  }
+  return out;
+}
+
+// A strategy name of the study: a render strategy, or points-N (the collapsed map with N lights).
+void applyStrategy(const std::string& name, Scene& scene) {
+  static const std::vector<std::string> known = {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis"};
+  if (name.rfind("points-", 0) == 0) {
+    int n = 0;
+    try {
+      n = std::stoi(name.substr(7));
+    } catch (...) {
+    }
+    if (n < 1) throw std::runtime_error("strategy '" + name + "': points-N needs a positive N");
+    scene.integrator.strategy = "points";
+    scene.integrator.pointCount = n;
+    return;
+  }
+  if (std::find(known.begin(), known.end(), name) == known.end())
+    throw std::runtime_error("unknown strategy '" + name +
+                             "' (uniform, cosine, bsdf, importance, alias, adaptive, mis, points-N)");
+  scene.integrator.strategy = name;
+}
+
+struct Rendered {
+  Image image;
+  double seconds = 0.0;
+};
+
+Rendered renderOnce(const StudyArgs& a, const std::string& strategy, int spp, uint32_t seed) {
+  Scene scene;
+  loadScene(a.scene, parseDefines(a.defines), scene);
+  scene.integrator.type = a.integrator;
+  applyStrategy(strategy, scene);
+  scene.sampler.seed = seed;
+  scene.finalize();
+  EmbreeAccel accel(scene);
+  RenderOptions o;
+  o.spp = spp;
+  o.progress = false;
+  o.threads = a.threads;
+  RenderStats st;
+  Rendered r;
+  r.image = render(scene, accel, o, &st);
+  r.seconds = st.seconds;
+  return r;
+}
+
+std::string runKey(const StudyRun& r) {
+  return r.timeBudget > 0 ? fmt::format("{}_time{}_seed{}", r.strategy, r.timeBudget, r.seed)
+                          : fmt::format("{}_spp{}_seed{}", r.strategy, r.spp, r.seed);
+}
+
+nlohmann::json toJson(const StudyRun& r) {
+  return {{"strategy", r.strategy}, {"spp", r.spp},          {"time_budget", r.timeBudget}, {"seed", r.seed},
+          {"seconds", r.seconds},   {"rmse", r.rmse},        {"relmse", r.relMse}};
+}
+
+StudyRun fromJson(const nlohmann::json& j) {
+  StudyRun r;
+  r.strategy = j.at("strategy");
+  r.spp = j.at("spp");
+  r.timeBudget = j.at("time_budget");
+  r.seed = j.at("seed");
+  r.seconds = j.at("seconds");
+  r.rmse = j.at("rmse");
+  r.relMse = j.at("relmse");
+  return r;
+}
+
+void runStudy(const StudyArgs& a) {
+  auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::string> strategies = splitList(a.strategies);
+  std::vector<double> sppValues = positiveNumbers(a.spp, "--spp", "a positive sample count");
+  std::vector<int> sppList;
+  for (double v : sppValues) {
+    if (v != std::floor(v)) throw std::runtime_error("--spp: '" + fmt::format("{}", v) + "' is not a positive sample count");
+    sppList.push_back(int(v));
+  }
+  std::vector<double> times = positiveNumbers(a.times, "--time", "a positive number of seconds");
+  if (strategies.empty()) throw std::runtime_error("--strategies is empty");
+  if (sppList.empty()) throw std::runtime_error("--spp is empty");
+  if (a.seeds < 1) throw std::runtime_error("--seeds must be at least 1");
+  if (a.integrator != "direct" && a.integrator != "path")
+    throw std::runtime_error("--integrator must be direct or path");
+  {
+    Scene probe;
+    for (const std::string& s : strategies) applyStrategy(s, probe);  // names checked before any work
+  }
+  fs::create_directories(a.out + "/runs");
+  std::string probe = a.out + "/.write_test";
+  writeFileAtomically(probe, "ok");  // an unwritable folder fails here, before any rendering
+  fs::remove(probe);
+
+  // The reference: given, or rendered once (and reused by a re-run).
+  Image ref;
+  std::string refPath = a.reference.empty() ? a.out + "/reference.exr" : a.reference;
+  if (!a.reference.empty() || fs::exists(refPath)) {
+    ref = loadImage(refPath);
+    spdlog::info("study: reference {}", refPath);
+  } else {
+    spdlog::info("study: rendering the reference, mis at {} spp", a.referenceSpp);
+    Rendered r = renderOnce(a, "mis", a.referenceSpp, 1000003u);
+    ref = r.image;
+    saveImage(ref, refPath);
+    spdlog::info("study: reference done in {:.1f} s", r.seconds);
+  }
+  for (float v : ref.rgb)
+    if (!std::isfinite(v)) throw std::runtime_error("reference '" + refPath + "' has NaN or infinite pixels");
+  {
+    Scene s;
+    loadScene(a.scene, parseDefines(a.defines), s);
+    if (s.camera.width != ref.width || s.camera.height != ref.height)
+      throw std::runtime_error(fmt::format("reference '{}' is {}x{}, the scene renders {}x{}", refPath, ref.width,
+                                           ref.height, s.camera.width, s.camera.height));
+  }
+
+  std::vector<StudyRun> plan;
+  for (const std::string& s : strategies)
+    for (int n : sppList)
+      for (int seed = 0; seed < a.seeds; ++seed) plan.push_back({s, n, 0.0, seed});
+  for (const std::string& s : strategies)
+    for (double t : times)
+      for (int seed = 0; seed < a.seeds; ++seed) plan.push_back({s, 0, t, seed});
+  std::vector<StudyRun> runs;
+  std::vector<StudyImage> images;
+  int middleSpp = sppList[sppList.size() / 2];
+  std::map<std::string, double> secondsPerSpp;  // from the equal-samples runs, for the time budgets
+  int done = 0, skipped = 0;
+  for (StudyRun r : plan) {
+    ++done;
+    std::string key = runKey(r), json = a.out + "/runs/" + key + ".json", exr = a.out + "/runs/" + key + ".exr";
+    bool wantImage = r.timeBudget == 0 && r.spp == middleSpp && r.seed == 0;
+    if (fs::exists(json) && (!wantImage || fs::exists(exr))) {
+      std::ifstream f(json);
+      r = fromJson(nlohmann::json::parse(f));
+      ++skipped;
+      if (wantImage) images.push_back({r.strategy, r.spp, loadImage(exr)});
+    } else {
+      if (r.timeBudget > 0) {
+        double sps = secondsPerSpp.count(r.strategy) ? secondsPerSpp[r.strategy] : 0.0;
+        r.spp = sps > 0 ? std::max(1, int(r.timeBudget / sps)) : 1;
+      }
+      spdlog::info("study: [{}/{}] {} {} seed {}", done, plan.size(), r.strategy,
+                   r.timeBudget > 0 ? fmt::format("{} s ({} spp)", r.timeBudget, r.spp) : fmt::format("{} spp", r.spp),
+                   r.seed);
+      Rendered img = renderOnce(a, r.strategy, r.spp, uint32_t(17 + 7919 * r.seed));
+      ImageError e = imageError(img.image, ref);
+      r.seconds = img.seconds;
+      r.rmse = e.rmse;
+      r.relMse = e.relMse;
+      if (wantImage) {
+        saveImage(img.image, exr);
+        images.push_back({r.strategy, r.spp, img.image});
+      }
+      writeFileAtomically(json, toJson(r).dump(2));
+    }
+    if (r.timeBudget == 0 && r.spp > 0) {
+      double sps = r.seconds / r.spp;
+      if (r.spp == sppList.back() || !secondsPerSpp.count(r.strategy)) secondsPerSpp[r.strategy] = sps;
+    }
+    runs.push_back(r);
+  }
+  std::string csv = "strategy,spp,time_budget,seed,seconds,rmse,relmse\n";
+  nlohmann::json all = nlohmann::json::array();
+  for (const StudyRun& r : runs) {
+    csv += fmt::format("{},{},{},{},{:.6f},{:.8g},{:.8g}\n", r.strategy, r.spp, r.timeBudget, r.seed, r.seconds, r.rmse,
+                       r.relMse);
+    all.push_back(toJson(r));
+  }
+  writeFileAtomically(a.out + "/results.csv", csv);
+  writeFileAtomically(a.out + "/results.json", nlohmann::json{{"scene", a.scene}, {"runs", all}}.dump(2));
+  writeFileAtomically(a.out + "/report.html", studyReportHtml(a.scene, runs, ref, images, strategies));
+  spdlog::info("study: {} runs ({} already done) in {:.1f} s; wrote {}/report.html, results.csv, results.json",
+               runs.size(), skipped,
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+               fs::absolute(a.out).string());
+}
+
+}  // namespace
+
+void addStudyCommand(CLI::App& app) {
+  auto a = std::make_shared<StudyArgs>();
+  CLI::App* c = app.add_subcommand("study", "Compare environment strategies against a reference (RMSE, plots, report)");
+  c->add_option("scene", a->scene, "Scene file (.xml)")->required()->check(CLI::ExistingFile);
+  c->add_option("-o,--output", a->out, "Output folder (results.csv, results.json, report.html, runs/)")->required();
+  c->add_option("--strategies", a->strategies, "Comma-separated: uniform,cosine,bsdf,importance,alias,adaptive,mis,points-N");
+  c->add_option("--spp", a->spp, "Comma-separated sample counts (default 1,4,16,64,256)");
+  c->add_option("--time", a->times, "Comma-separated time budgets in seconds for equal-time runs");
+  c->add_option("--seeds", a->seeds, "Seeds per configuration (default 2)");
+  c->add_option("--reference", a->reference, "Reference image (.exr); default: rendered with mis");
+  c->add_option("--reference-spp", a->referenceSpp, "Samples for the rendered reference (default 4096)");
+  c->add_option("--integrator", a->integrator, "direct (default) or path");
+  c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
+  c->add_option("--threads", a->threads, "Worker threads (default: all cores)");
+  c->callback([a] { runStudy(*a); });
+}
+
+}  // namespace envgi::cli

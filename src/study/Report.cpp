@@ -1,0 +1,188 @@
+#include "study/Report.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "study/ErrorMetrics.h"
+
+namespace envgi {
+
+std::string base64(const std::string& in) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  out.reserve((in.size() + 2) / 3 * 4);
+  for (size_t i = 0; i < in.size(); i += 3) {
+    uint32_t v = uint32_t(uint8_t(in[i])) << 16;
+    if (i + 1 < in.size()) v |= uint32_t(uint8_t(in[i + 1])) << 8;
+    if (i + 2 < in.size()) v |= uint32_t(uint8_t(in[i + 2]));
+    out += t[(v >> 18) & 63];
+    out += t[(v >> 12) & 63];
+    out += i + 1 < in.size() ? t[(v >> 6) & 63] : '=';
+    out += i + 2 < in.size() ? t[v & 63] : '=';
+  }
+  return out;
+}
+
+namespace {
+
+const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
+
+std::string escape(const std::string& s) {
+  std::string o;
+  for (char c : s) o += c == '<' ? std::string("&lt;") : c == '>' ? std::string("&gt;") : c == '&' ? std::string("&amp;") : std::string(1, c);
+  return o;
+}
+
+std::string pngDataUri(const Image& img) {
+  return "data:image/png;base64," + base64(encodePng(img.width, img.height, toneMapImage(img, {})));
+}
+
+// |L(a) - L(ref)| / (L(ref) + 0.05) through a dark-blue, green, yellow, red ramp (0 to 1).
+std::string errorMapDataUri(const Image& a, const Image& ref) {
+  std::vector<unsigned char> rgb(size_t(a.width) * a.height * 3);
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      float la = luminance(a.at(x, y)), lr = luminance(ref.at(x, y));
+      float e = std::clamp(std::fabs(la - lr) / (lr + 0.05f), 0.f, 1.f);
+      float r = std::clamp(2.f * e - 0.5f, 0.f, 1.f), g = std::clamp(e < 0.75f ? 1.6f * e : 4.f * (1.f - e), 0.f, 1.f),
+            b = std::clamp(0.6f - 1.5f * e, 0.f, 1.f);
+      unsigned char* p = &rgb[(size_t(y) * a.width + x) * 3];
+      p[0] = (unsigned char)(r * 255.f);
+      p[1] = (unsigned char)(g * 255.f);
+      p[2] = (unsigned char)(b * 255.f);
+    }
+  return "data:image/png;base64," + base64(encodePng(a.width, a.height, rgb));
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+}  // namespace
+
+std::string svgLogLogPlot(const std::string& title, const std::string& xLabel, const std::string& yLabel,
+                          const std::vector<std::string>& names, const std::vector<std::vector<double>>& xs,
+                          const std::vector<std::vector<double>>& ys) {
+  const double W = 560, H = 360, L = 70, R = 150, T = 30, B = 50;
+  double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+  for (size_t s = 0; s < xs.size(); ++s)
+    for (size_t i = 0; i < xs[s].size(); ++i)
+      if (xs[s][i] > 0 && ys[s][i] > 0) {
+        x0 = std::min(x0, std::log10(xs[s][i]));
+        x1 = std::max(x1, std::log10(xs[s][i]));
+        y0 = std::min(y0, std::log10(ys[s][i]));
+        y1 = std::max(y1, std::log10(ys[s][i]));
+      }
+  if (!(x1 >= x0)) x0 = 0, x1 = 1;
+  if (!(y1 >= y0)) y0 = 0, y1 = 1;
+  x0 = std::floor(x0), x1 = std::max(std::ceil(x1), x0 + 1);
+  y0 = std::floor(y0), y1 = std::max(std::ceil(y1), y0 + 1);
+  auto px = [&](double v) { return L + (std::log10(v) - x0) / (x1 - x0) * (W - L - R); };
+  auto py = [&](double v) { return H - B - (std::log10(v) - y0) / (y1 - y0) * (H - T - B); };
+  std::string o = fmt::format(R"s(<svg xmlns="http://www.w3.org/2000/svg" width="{}" height="{}" font-family="sans-serif" font-size="12">)s", W, H);
+  o += fmt::format(R"s(<text x="{}" y="18" font-weight="bold">{}</text>)s", L, escape(title));
+  o += fmt::format(R"s(<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="#444"/>)s", L, T, W - L - R, H - T - B);
+  for (double e = x0; e <= x1 + 1e-9; e += 1) {
+    double x = L + (e - x0) / (x1 - x0) * (W - L - R);
+    o += fmt::format(R"s(<line x1="{0}" x2="{0}" y1="{1}" y2="{2}" stroke="#ddd"/><text x="{0}" y="{3}" text-anchor="middle">1e{4}</text>)s", x, T, H - B, H - B + 16, int(e));
+  }
+  for (double e = y0; e <= y1 + 1e-9; e += 1) {
+    double y = H - B - (e - y0) / (y1 - y0) * (H - T - B);
+    o += fmt::format(R"s(<line x1="{0}" x2="{1}" y1="{2}" y2="{2}" stroke="#ddd"/><text x="{3}" y="{4}" text-anchor="end">1e{5}</text>)s", L, W - R, y, L - 6, y + 4, int(e));
+  }
+  o += fmt::format(R"s(<text x="{}" y="{}" text-anchor="middle">{}</text>)s", L + (W - L - R) / 2, H - 10, escape(xLabel));
+  o += fmt::format(R"s(<text x="14" y="{}" transform="rotate(-90 14 {})" text-anchor="middle">{}</text>)s", T + (H - T - B) / 2, T + (H - T - B) / 2, escape(yLabel));
+  for (size_t s = 0; s < xs.size(); ++s) {
+    const char* c = kColours[s % 10];
+    std::string pts;
+    for (size_t i = 0; i < xs[s].size(); ++i)
+      if (xs[s][i] > 0 && ys[s][i] > 0) pts += fmt::format("{:.1f},{:.1f} ", px(xs[s][i]), py(ys[s][i]));
+    o += fmt::format(R"s(<polyline points="{}" fill="none" stroke="{}" stroke-width="2"/>)s", pts, c);
+    for (size_t i = 0; i < xs[s].size(); ++i)
+      if (xs[s][i] > 0 && ys[s][i] > 0) o += fmt::format(R"s(<circle cx="{:.1f}" cy="{:.1f}" r="3" fill="{}"/>)s", px(xs[s][i]), py(ys[s][i]), c);
+    o += fmt::format(R"s(<rect x="{}" y="{}" width="12" height="12" fill="{}"/><text x="{}" y="{}">{}</text>)s", W - R + 10, T + 18 * s, c, W - R + 28, T + 18 * s + 11, escape(names[s]));
+  }
+  return o + "</svg>";
+}
+
+std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun>& runs, const Image& reference,
+                            const std::vector<StudyImage>& images, const std::vector<std::string>& strategies) {
+  // Median over seeds for each (strategy, spp) and (strategy, time budget).
+  std::map<std::pair<std::string, int>, std::vector<double>> bySpp, secBySpp;
+  std::map<std::pair<std::string, double>, std::vector<double>> byTime, secByTime;
+  std::vector<int> sppList;
+  for (const StudyRun& r : runs) {
+    if (r.timeBudget > 0) {
+      byTime[{r.strategy, r.timeBudget}].push_back(r.rmse);
+      secByTime[{r.strategy, r.timeBudget}].push_back(r.seconds);
+    } else {
+      bySpp[{r.strategy, r.spp}].push_back(r.rmse);
+      secBySpp[{r.strategy, r.spp}].push_back(r.seconds);
+      if (std::find(sppList.begin(), sppList.end(), r.spp) == sppList.end()) sppList.push_back(r.spp);
+    }
+  }
+  std::sort(sppList.begin(), sppList.end());
+  std::vector<std::vector<double>> xs, ys, tx, ty;
+  for (const std::string& s : strategies) {
+    std::vector<double> x, y, a, b;
+    for (int n : sppList)
+      if (bySpp.count({s, n})) {
+        x.push_back(n);
+        y.push_back(median(bySpp[{s, n}]));
+      }
+    for (auto& [k, v] : byTime)
+      if (k.first == s) {
+        a.push_back(median(secByTime[k]));
+        b.push_back(median(v));
+      }
+    xs.push_back(x), ys.push_back(y), tx.push_back(a), ty.push_back(b);
+  }
+  std::string h = "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>envgi study: " + escape(scene) +
+                  "</title><style>body{font-family:sans-serif;margin:24px}table{border-collapse:collapse}"
+                  "td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}figure{display:inline-block;margin:6px}"
+                  "figcaption{font-size:12px;text-align:center}img{image-rendering:pixelated;width:192px}</style></head><body>";
+  h += "<h1>Strategies compared: " + escape(scene) + "</h1>";
+  h += "<p>RMSE against the reference, median over seeds. Lower is better; a slope of -1/2 on the "
+       "samples plot is an unbiased estimator's Monte Carlo rate, a flattening curve is bias (the "
+       "collapsed map, <code>points-N</code>).</p>";
+  h += svgLogLogPlot("RMSE against samples per pixel", "samples per pixel", "RMSE", strategies, xs, ys);
+  bool anyTime = !byTime.empty();
+  if (anyTime) h += svgLogLogPlot("RMSE against render time", "seconds", "RMSE", strategies, tx, ty);
+  h += "<h2>Images</h2><div>";
+  h += "<figure><img src=\"" + pngDataUri(reference) + "\"><figcaption>reference</figcaption></figure></div><div>";
+  for (const StudyImage& im : images)
+    h += fmt::format("<figure><img src=\"{}\"><figcaption>{} @ {} spp</figcaption></figure>", pngDataUri(im.image),
+                     escape(im.strategy), im.spp);
+  h += "</div><h3>Relative error |L - L<sub>ref</sub>| / (L<sub>ref</sub> + 0.05), 0 (blue) to 1 (red)</h3><div>";
+  for (const StudyImage& im : images)
+    h += fmt::format("<figure><img src=\"{}\"><figcaption>{} @ {} spp</figcaption></figure>",
+                     errorMapDataUri(im.image, reference), escape(im.strategy), im.spp);
+  h += "</div><h2>RMSE (median over seeds) and seconds</h2><table><tr><th>strategy</th>";
+  for (int n : sppList) h += fmt::format("<th>{} spp</th>", n);
+  h += "</tr>";
+  for (const std::string& s : strategies) {
+    h += "<tr><th>" + escape(s) + "</th>";
+    for (int n : sppList)
+      h += bySpp.count({s, n}) ? fmt::format("<td>{:.5f}<br><small>{:.2f} s</small></td>", median(bySpp[{s, n}]),
+                                             median(secBySpp[{s, n}]))
+                               : std::string("<td></td>");
+    h += "</tr>";
+  }
+  h += "</table>";
+  if (anyTime) {
+    h += "<h2>Equal time</h2><table><tr><th>strategy</th><th>budget (s)</th><th>seconds</th><th>spp</th><th>RMSE</th></tr>";
+    for (const StudyRun& r : runs)
+      if (r.timeBudget > 0)
+        h += fmt::format("<tr><th>{}</th><td>{}</td><td>{:.2f}</td><td>{}</td><td>{:.5f}</td></tr>", escape(r.strategy),
+                         r.timeBudget, r.seconds, r.spp, r.rmse);
+    h += "</table>";
+  }
+  return h + "</body></html>\n";
+}
+
+}  // namespace envgi

@@ -1,0 +1,37 @@
+// The study's report: a self-contained HTML page (inline SVG plots, images as data URIs) with
+// the convergence plots against samples and against time, the image grid and the table.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "image/Image.h"
+
+namespace envgi {
+
+struct StudyRun {
+  std::string strategy;
+  int spp = 0;
+  double timeBudget = 0.0;  // 0: an equal-samples run
+  int seed = 0;
+  double seconds = 0.0, rmse = 0.0, relMse = 0.0;
+};
+
+struct StudyImage {
+  std::string strategy;
+  int spp = 0;
+  Image image;
+};
+
+// Log-log plot of y against x, one polyline a series, as an SVG element.
+std::string svgLogLogPlot(const std::string& title, const std::string& xLabel, const std::string& yLabel,
+                          const std::vector<std::string>& names, const std::vector<std::vector<double>>& xs,
+                          const std::vector<std::vector<double>>& ys);
+
+// Bytes as base64 (data URIs for images inside the page).
+std::string base64(const std::string& bytes);
+
+std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun>& runs, const Image& reference,
+                            const std::vector<StudyImage>& images, const std::vector<std::string>& strategies);
+
+}  // namespace envgi

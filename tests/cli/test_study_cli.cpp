@@ -1,0 +1,62 @@
+// `envgi study` end to end: the outputs, convergence visible in them, resuming, bad input.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cli/CliRunner.h"
+
+using namespace envgi::test;
+namespace fs = std::filesystem;
+
+namespace {
+std::string buddha() { return std::string(ENVGI_SOURCE_DIR) + "/scenes/buddha.xml"; }
+}  // namespace
+
+TEST(StudyCli, WritesResultsAndResumes) {
+  TempDir d;
+  std::string out = d.file("study");
+  std::string args = "study " + buddha() + " -o " + out +
+                     " -D res=24 --spp 1,16 --seeds 1 --reference-spp 256 --strategies uniform,importance,points-8 --time 0.02";
+  CliResult r = runCli(args);
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* f : {"reference.exr", "results.csv", "results.json", "report.html"})
+    EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
+  std::string csv = slurp(out + "/results.csv");
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 3 * 2 + 3);  // header, spp runs, time runs
+  // The unbiased strategies converge: importance at 16 spp beats importance at 1.
+  auto rmseOf = [&](const std::string& prefix) {
+    size_t p = csv.find(prefix);
+    EXPECT_NE(p, std::string::npos) << prefix;
+    std::string line = csv.substr(p, csv.find('\n', p) - p);
+    return std::stod(line.substr(line.rfind(',', line.rfind(',') - 1) + 1));
+  };
+  EXPECT_LT(rmseOf("importance,16,"), rmseOf("importance,1,"));
+  std::string html = slurp(out + "/report.html");
+  EXPECT_NE(html.find("<svg"), std::string::npos);
+  EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
+  // Re-run: every run is found done.
+  CliResult again = runCli(args);
+  ASSERT_EQ(again.code, 0) << again.output;
+  EXPECT_NE(again.output.find("9 runs (9 already done)"), std::string::npos) << again.output;
+}
+
+TEST(StudyCli, BadInputIsOneErrorLine) {
+  TempDir d;
+  auto expectError = [&](const std::string& extra, const std::string& text) {
+    CliResult r = runCli("study " + buddha() + " -o " + d.file("s") + " -D res=16 --reference-spp 4 " + extra);
+    EXPECT_EQ(r.code, 1) << extra << ": " << r.output;
+    EXPECT_NE(r.output.find("envgi: error: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(text), std::string::npos) << r.output;
+  };
+  expectError("--strategies uniform,magic", "unknown strategy 'magic'");
+  expectError("--spp ,", "--spp is empty");
+  expectError("--spp 4,x", "not a positive sample count");
+  // A reference of the wrong size.
+  CliResult ok = runCli("render " + buddha() + " -o " + d.file("ref.exr") + " -D res=8 --spp 1 --no-progress");
+  ASSERT_EQ(ok.code, 0) << ok.output;
+  expectError("--reference " + d.file("ref.exr"), "is 8x8, the scene renders 16x16");
+  CliResult unwritable = runCli("study " + buddha() + " -o /proc/envgi_study -D res=16");
+  EXPECT_EQ(unwritable.code, 1) << unwritable.output;
+}

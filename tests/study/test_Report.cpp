@@ -1,0 +1,29 @@
+#include <gtest/gtest.h>
+
+#include "study/ErrorMetrics.h"
+#include "study/Report.h"
+
+using namespace envgi;
+
+TEST(StudyReport, ErrorMetricsOnKnownImages) {
+  Image a(2, 1), r(2, 1);
+  a.set(0, 0, Color(1.f));
+  r.set(0, 0, Color(0.f));
+  ImageError e = imageError(a, r);
+  EXPECT_NEAR(e.rmse, std::sqrt(3.0 / 6.0), 1e-9);
+  EXPECT_NEAR(e.relMse, 3.0 / 0.01 / 6.0, 1e-6);
+  EXPECT_EQ(imageError(r, r).rmse, 0.0);
+  EXPECT_THROW(imageError(Image(3, 1), r), std::runtime_error);
+}
+
+TEST(StudyReport, Base64AndSvg) {
+  EXPECT_EQ(base64("Man"), "TWFu");
+  EXPECT_EQ(base64("Ma"), "TWE=");
+  EXPECT_EQ(base64("M"), "TQ==");
+  std::string svg = svgLogLogPlot("t", "x", "y", {"a", "b"}, {{1, 4, 16}, {1, 4}}, {{1, 0.5, 0.25}, {0.3, 0.2}});
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  size_t lines = 0;
+  for (size_t p = svg.find("<polyline"); p != std::string::npos; p = svg.find("<polyline", p + 1)) ++lines;
+  EXPECT_EQ(lines, 2u);
+  EXPECT_NE(svg.find(">a<"), std::string::npos);
+}
