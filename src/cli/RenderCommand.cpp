@@ -83,6 +83,8 @@ void runRender(const RenderArgs& a) {
   if (!a.strategy.empty()) {
     if (a.strategy != "points") parseStrategyName(a.strategy == "mis" || a.strategy == "bsdf" ? "importance" : a.strategy);
     scene.integrator.strategy = a.strategy;
+    // The strategy's own sample counts (bsdf: BSDF samples only, mis: one of each), not the file's.
+    scene.integrator.emitterSamples = scene.integrator.bsdfSamples = -1;
   }
   if (a.points > 0) scene.integrator.pointCount = a.points;
   if (!a.pointMethod.empty()) {

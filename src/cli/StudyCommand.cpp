@@ -62,7 +62,10 @@ std::vector<double> positiveNumbers(const std::string& list, const std::string& 
 }
 
 // A strategy name of the study: a render strategy, or points-N (the collapsed map with N lights).
+// The sample counts are the strategy's own (bsdf: BSDF samples only; mis: one of each; the
+// others: one light sample), whatever the scene file asked for.
 void applyStrategy(const std::string& name, Scene& scene) {
+  scene.integrator.emitterSamples = scene.integrator.bsdfSamples = -1;
   static const std::vector<std::string> known = {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis"};
   if (name.rfind("points-", 0) == 0) {
     int n = 0;
