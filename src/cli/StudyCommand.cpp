@@ -115,7 +115,8 @@ std::string runKey(const StudyRun& r) {
 
 nlohmann::json toJson(const StudyRun& r) {
   return {{"strategy", r.strategy}, {"spp", r.spp},          {"time_budget", r.timeBudget}, {"seed", r.seed},
-          {"seconds", r.seconds},   {"rmse", r.rmse},        {"relmse", r.relMse}};
+          {"seconds", r.seconds},   {"rmse", r.rmse},        {"relmse", r.relMse},
+          {"worst_region_rmse", r.worstRegionRmse}};
 }
 
 StudyRun fromJson(const nlohmann::json& j) {
@@ -127,6 +128,7 @@ StudyRun fromJson(const nlohmann::json& j) {
   r.seconds = j.at("seconds");
   r.rmse = j.at("rmse");
   r.relMse = j.at("relmse");
+  r.worstRegionRmse = j.value("worst_region_rmse", 0.0);
   return r;
 }
 
@@ -211,6 +213,7 @@ void runStudy(const StudyArgs& a) {
       r.seconds = img.seconds;
       r.rmse = e.rmse;
       r.relMse = e.relMse;
+      r.worstRegionRmse = e.worstRegionRmse;
       if (wantImage) {
         saveImage(img.image, exr);
         images.push_back({r.strategy, r.spp, img.image});
@@ -223,11 +226,11 @@ void runStudy(const StudyArgs& a) {
     }
     runs.push_back(r);
   }
-  std::string csv = "strategy,spp,time_budget,seed,seconds,rmse,relmse\n";
+  std::string csv = "strategy,spp,time_budget,seed,seconds,rmse,relmse,worst_region_rmse\n";
   nlohmann::json all = nlohmann::json::array();
   for (const StudyRun& r : runs) {
-    csv += fmt::format("{},{},{},{},{:.6f},{:.8g},{:.8g}\n", r.strategy, r.spp, r.timeBudget, r.seed, r.seconds, r.rmse,
-                       r.relMse);
+    csv += fmt::format("{},{},{},{},{:.6f},{:.8g},{:.8g},{:.8g}\n", r.strategy, r.spp, r.timeBudget, r.seed, r.seconds,
+                       r.rmse, r.relMse, r.worstRegionRmse);
     all.push_back(toJson(r));
   }
   writeFileAtomically(a.out + "/results.csv", csv);

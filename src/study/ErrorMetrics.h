@@ -1,6 +1,8 @@
 // Image error against a reference, as the paper's Figure 9 and the study report measure it.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -11,6 +13,7 @@ namespace envgi {
 struct ImageError {
   double rmse = 0.0;    // root mean squared error over all channels
   double relMse = 0.0;  // mean of (a - r)^2 / (r^2 + 0.01): relative, tolerant of black pixels
+  double worstRegionRmse = 0.0;  // the largest RMSE over a 4x4 grid of regions: local error
 };
 
 inline ImageError imageError(const Image& a, const Image& ref) {
@@ -27,6 +30,21 @@ inline ImageError imageError(const Image& a, const Image& ref) {
   double n = double(a.rgb.size());
   e.rmse = n > 0 ? std::sqrt(se / n) : 0.0;
   e.relMse = n > 0 ? rel / n : 0.0;
+  const int g = 4;
+  for (int ry = 0; ry < g; ++ry)
+    for (int rx = 0; rx < g; ++rx) {
+      int x0 = rx * a.width / g, x1 = (rx + 1) * a.width / g, y0 = ry * a.height / g, y1 = (ry + 1) * a.height / g;
+      double s2 = 0.0;
+      size_t cnt = 0;
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x)
+          for (int k = 0; k < 3; ++k) {
+            double d = double(a.at(x, y)[k]) - double(ref.at(x, y)[k]);
+            s2 += d * d;
+            ++cnt;
+          }
+      if (cnt > 0) e.worstRegionRmse = std::max(e.worstRegionRmse, std::sqrt(s2 / double(cnt)));
+    }
   return e;
 }
 

@@ -175,11 +175,12 @@ std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun
   }
   h += "</table>";
   if (anyTime) {
-    h += "<h2>Equal time</h2><table><tr><th>strategy</th><th>budget (s)</th><th>seconds</th><th>spp</th><th>RMSE</th></tr>";
+    h += "<h2>Equal time</h2><table><tr><th>strategy</th><th>budget (s)</th><th>seconds</th><th>spp</th><th>RMSE</th>"
+         "<th>worst of 4x4 regions</th></tr>";
     for (const StudyRun& r : runs)
       if (r.timeBudget > 0)
-        h += fmt::format("<tr><th>{}</th><td>{}</td><td>{:.2f}</td><td>{}</td><td>{:.5f}</td></tr>", escape(r.strategy),
-                         r.timeBudget, r.seconds, r.spp, r.rmse);
+        h += fmt::format("<tr><th>{}</th><td>{}</td><td>{:.2f}</td><td>{}</td><td>{:.5f}</td><td>{:.5f}</td></tr>",
+                         escape(r.strategy), r.timeBudget, r.seconds, r.spp, r.rmse, r.worstRegionRmse);
     h += "</table>";
   }
   return h + "</body></html>\n";

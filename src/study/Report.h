@@ -14,7 +14,7 @@ struct StudyRun {
   int spp = 0;
   double timeBudget = 0.0;  // 0: an equal-samples run
   int seed = 0;
-  double seconds = 0.0, rmse = 0.0, relMse = 0.0;
+  double seconds = 0.0, rmse = 0.0, relMse = 0.0, worstRegionRmse = 0.0;
 };
 
 struct StudyImage {

@@ -29,8 +29,10 @@ TEST(StudyCli, WritesResultsAndResumes) {
   auto rmseOf = [&](const std::string& prefix) {
     size_t p = csv.find(prefix);
     EXPECT_NE(p, std::string::npos) << prefix;
-    std::string line = csv.substr(p, csv.find('\n', p) - p);
-    return std::stod(line.substr(line.rfind(',', line.rfind(',') - 1) + 1));
+    std::stringstream line(csv.substr(p, csv.find('\n', p) - p));
+    std::string field;
+    for (int i = 0; i < 6; ++i) std::getline(line, field, ',');  // strategy,spp,time,seed,seconds,rmse
+    return std::stod(field);
   };
   EXPECT_LT(rmseOf("importance,16,"), rmseOf("importance,1,"));
   std::string html = slurp(out + "/report.html");

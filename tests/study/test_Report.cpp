@@ -13,6 +13,12 @@ TEST(StudyReport, ErrorMetricsOnKnownImages) {
   EXPECT_NEAR(e.rmse, std::sqrt(3.0 / 6.0), 1e-9);
   EXPECT_NEAR(e.relMse, 3.0 / 0.01 / 6.0, 1e-6);
   EXPECT_EQ(imageError(r, r).rmse, 0.0);
+  // All the error in one pixel of a 4x4 image: the worst region holds it alone.
+  Image b(4, 4), z(4, 4);
+  b.set(3, 0, Color(2.f));
+  ImageError eb = imageError(b, z);
+  EXPECT_NEAR(eb.rmse, std::sqrt(12.0 / 48.0), 1e-9);
+  EXPECT_NEAR(eb.worstRegionRmse, 2.0, 1e-9);
   EXPECT_THROW(imageError(Image(3, 1), r), std::runtime_error);
 }
 
