@@ -10,17 +10,11 @@
 #include "core/Files.h"
 #include "envmap/EnvironmentMap.h"
 #include "sampling/Sampler.h"
+#include "scene/StrategyNames.h"
 
 namespace envgi::cli {
 
-int parseStrategyName(const std::string& name) {
-  if (name == "uniform") return int(EnvStrategy::Uniform);
-  if (name == "cosine") return int(EnvStrategy::Cosine);
-  if (name == "importance") return int(EnvStrategy::Importance);
-  if (name == "alias") return int(EnvStrategy::Alias);
-  if (name == "adaptive") return int(EnvStrategy::Adaptive);
-  throw std::runtime_error("unknown strategy '" + name + "' (uniform, cosine, importance, alias, adaptive)");
-}
+int parseStrategyName(const std::string& name) { return int(findStrategy(name, true).env); }
 
 namespace {
 

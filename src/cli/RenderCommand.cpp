@@ -15,6 +15,7 @@
 #include "gpu/CudaExecutor.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
+#include "scene/StrategyNames.h"
 
 namespace envgi::cli {
 
@@ -81,7 +82,7 @@ void runRender(const RenderArgs& a) {
     scene.integrator.type = a.integrator;
   }
   if (!a.strategy.empty()) {
-    if (a.strategy != "points") parseStrategyName(a.strategy == "mis" || a.strategy == "bsdf" ? "importance" : a.strategy);
+    findStrategy(a.strategy);
     scene.integrator.strategy = a.strategy;
     // The strategy's own sample counts (bsdf: BSDF samples only, mis: one of each), not the file's.
     scene.integrator.emitterSamples = scene.integrator.bsdfSamples = -1;
@@ -181,7 +182,7 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("-o,--output", a->output, "Output image (.exr, .pfm, .hdr or .png)")->required();
   c->add_option("--spp", a->spp, "Samples per pixel, or passes for sppm (default: the scene's)")->check(CLI::PositiveNumber);
   c->add_option("--integrator", a->integrator, "path | direct | photon | sppm (overrides the scene)");
-  c->add_option("--strategy", a->strategy, "Environment strategy: uniform|cosine|bsdf|importance|alias|adaptive|mis|points");
+  c->add_option("--strategy", a->strategy, "Environment strategy: " + strategyNameList());
   c->add_option("--points", a->points, "points: directional lights in the collapsed map (default 64)")->check(CLI::PositiveNumber);
   c->add_option("--point-method", a->pointMethod, "points: sample (Algorithm 1 draws, power L/pdf/N) | mediancut");
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");

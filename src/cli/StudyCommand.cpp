@@ -19,6 +19,7 @@
 #include "core/Files.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
+#include "scene/StrategyNames.h"
 #include "study/ErrorMetrics.h"
 #include "study/Report.h"
 
@@ -66,7 +67,6 @@ std::vector<double> positiveNumbers(const std::string& list, const std::string& 
 // others: one light sample), whatever the scene file asked for.
 void applyStrategy(const std::string& name, Scene& scene) {
   scene.integrator.emitterSamples = scene.integrator.bsdfSamples = -1;
-  static const std::vector<std::string> known = {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis"};
   if (name.rfind("points-", 0) == 0) {
     int n = 0;
     try {
@@ -78,9 +78,8 @@ void applyStrategy(const std::string& name, Scene& scene) {
     scene.integrator.pointCount = n;
     return;
   }
-  if (std::find(known.begin(), known.end(), name) == known.end())
-    throw std::runtime_error("unknown strategy '" + name +
-                             "' (uniform, cosine, bsdf, importance, alias, adaptive, mis, points-N)");
+  if (name == "points" || findStrategy(name).env == EnvStrategy::Points)
+    throw std::runtime_error("strategy 'points': name its size, points-N");
   scene.integrator.strategy = name;
 }
 

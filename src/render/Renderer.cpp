@@ -11,6 +11,7 @@
 #include "render/CpuExecutor.h"
 #include "integrators/PhotonIntegrator.h"
 #include "render/SppmExecutor.h"
+#include "scene/StrategyNames.h"
 #include "photon/PhotonShooter.h"
 
 namespace envgi {
@@ -19,17 +20,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-EnvStrategy strategyOf(const std::string& s) {
-  if (s == "uniform") return EnvStrategy::Uniform;
-  if (s == "cosine") return EnvStrategy::Cosine;
-  if (s == "alias") return EnvStrategy::Alias;
-  if (s == "adaptive") return EnvStrategy::Adaptive;
-  if (s == "importance") return EnvStrategy::Importance;
-  if (s == "points") return EnvStrategy::Points;
-  // mis (and path's default): Algorithm 1's density drawn through the alias table, which
-  // bench_envmap measures 1.6x faster than the binary search.
-  return EnvStrategy::Alias;
-}
+EnvStrategy strategyOf(const std::string& s) { return findStrategy(s).env; }
 
 void logPhotonStats(const PhotonShootStats& st) {
   spdlog::info("photon pass: {} global photons stored ({} emitted), {} caustic ({} emitted), {:.2f} s tracing, "
@@ -76,9 +67,9 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
   k.path.envStrategy = strategyOf(is.strategy);
   k.direct.hideEmitters = is.hideEmitters;
   k.direct.envStrategy = strategyOf(is.strategy);
-  k.direct.emitterSamples = is.emitterSamples >= 0 ? is.emitterSamples : (is.strategy == "bsdf" ? 0 : 1);
-  k.direct.bsdfSamples =
-      is.bsdfSamples >= 0 ? is.bsdfSamples : ((is.strategy == "mis" || is.strategy == "bsdf") ? 1 : 0);
+  const StrategyName& sn = findStrategy(is.strategy);
+  k.direct.emitterSamples = is.emitterSamples >= 0 ? is.emitterSamples : sn.emitterSamples;
+  k.direct.bsdfSamples = is.bsdfSamples >= 0 ? is.bsdfSamples : sn.bsdfSamples;
   if (k.type == SampleIntegratorType::Direct && k.direct.emitterSamples + k.direct.bsdfSamples == 0)
     throw std::runtime_error("direct integrator: no samples");
   // A compensated map density is zero where L is below its mean: only with BSDF samples beside

@@ -1,4 +1,5 @@
 #include "scene/SceneLoader.h"
+#include "scene/StrategyNames.h"
 
 #include <fmt/format.h>
 #include <pugixml.hpp>
@@ -405,9 +406,11 @@ class Loader {
     } else {
       fail(f, n, fmt::format("unknown integrator type '{}' (path, direct, photon, sppm)", type));
     }
-    static const std::set<std::string> strategies = {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis", "points"};
-    if (!strategies.count(s.strategy))
-      fail(f, n, fmt::format("unknown strategy '{}' (uniform, cosine, bsdf, importance, alias, adaptive, mis, points)", s.strategy));
+    try {
+      findStrategy(s.strategy);
+    } catch (const std::runtime_error& e) {
+      fail(f, n, e.what());
+    }
     if (s.pointCount < 1) fail(f, n, "point_count must be at least 1");
     if (s.pointMethod != "sample" && s.pointMethod != "mediancut")
       fail(f, n, fmt::format("unknown point_method '{}' (sample, mediancut)", s.pointMethod));
