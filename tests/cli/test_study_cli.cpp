@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "cli/CliRunner.h"
+#include "image/Image.h"
 
 using namespace envgi::test;
 namespace fs = std::filesystem;
@@ -59,6 +60,10 @@ TEST(StudyCli, BadInputIsOneErrorLine) {
   CliResult ok = runCli("render " + buddha() + " -o " + d.file("ref.exr") + " -D res=8 --spp 1 --no-progress");
   ASSERT_EQ(ok.code, 0) << ok.output;
   expectError("--reference " + d.file("ref.exr"), "is 8x8, the scene renders 16x16");
+  envgi::Image nan(16, 16);
+  nan.rgb[5] = NAN;
+  envgi::saveImage(nan, d.file("nan.pfm"));
+  expectError("--reference " + d.file("nan.pfm"), "has NaN or infinite pixels");
   CliResult unwritable = runCli("study " + buddha() + " -o /proc/envgi_study -D res=16");
   EXPECT_EQ(unwritable.code, 1) << unwritable.output;
 }
