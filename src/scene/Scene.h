@@ -29,7 +29,7 @@ struct ShapeEntry {
 };
 
 struct IntegratorSettings {
-  std::string type = "path";  // path | direct
+  std::string type = "path";  // path | direct | photon | sppm
   int maxDepth = -1;          // -1: unbounded (Russian roulette ends paths)
   int rrDepth = 5;
   bool hideEmitters = false;
@@ -70,7 +70,8 @@ class Scene {
   SamplerSettings sampler;
   std::string sourcePath;
 
-  // Builds the views, the light list and the bounds; call once after loading.
+  // Builds the views, the light list, the bounds and (points strategy) the collapsed map;
+  // call after loading and again after changing any of the above.
   void finalize();
   const SceneView& view() const { return view_; }
   size_t triangleCount() const;

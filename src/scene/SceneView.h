@@ -16,7 +16,6 @@ struct MeshView {
   int triangleCount = 0;
   int bsdf = 0;
   int lightOffset = -1;  // index of triangle 0 in the light list, -1 when not emissive
-  bool flipNormals = false;
 };
 
 struct SphereView {
@@ -37,7 +36,7 @@ struct LightPrim {
 
 struct SurfaceInteraction {
   Vec3f p;
-  Vec3f ng;  // geometric normal (after flip_normals)
+  Vec3f ng;  // geometric normal (flip_normals applied: meshes by winding, spheres by flag)
   Frame shading;
   Vec2f uv;
   int bsdf = 0;
@@ -81,10 +80,6 @@ struct SceneView {
         if (lengthSq(n) > 0.f) ns = normalize(n);
         if (dot(ns, ng) < 0.f) ng = -ng;  // geometric normal agrees with the mesh's own normals
       }
-      if (m.flipNormals) {
-        ng = -ng;
-        ns = -ns;
-      }
       si.ng = ng;
       si.shading = Frame::fromNormal(ns);
       si.uv = m.uvs ? m.uvs[i0] * b0 + m.uvs[i1] * b1 + m.uvs[i2] * b2 : Vec2f(b1, b2);
@@ -112,7 +107,7 @@ struct SceneView {
   }
 };
 
-// Uniform point on a light primitive; returns position, normal and area pdf.
+// Uniform point on a light primitive: its position and normal (the area pdf is 1 / area).
 ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2f u, Vec3f* p, Vec3f* n) {
   if (lp.geomId < sc.meshCount) {
     const MeshView& m = sc.meshes[lp.geomId];
@@ -125,7 +120,7 @@ ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2
       Vec3f ns = m.normals[i0] + m.normals[i1] + m.normals[i2];
       if (dot(ns, ng) < 0.f) ng = -ng;
     }
-    *n = m.flipNormals ? -ng : ng;
+    *n = ng;
   } else {
     const SphereView& s = sc.spheres[lp.geomId - sc.meshCount];
     Vec3f d = sampleUniformSphere(u);
