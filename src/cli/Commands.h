@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "sampling/Sampler.h"
+
 namespace envgi::cli {
 
 void addEnvmapCommands(CLI::App& app);
@@ -18,5 +20,8 @@ std::map<std::string, std::string> parseDefines(const std::vector<std::string>& 
 
 // A map strategy's name (scene/StrategyNames.h, map strategies only) as an EnvStrategy; throws on others.
 int parseStrategyName(const std::string& name);
+
+// A sample sequence's name (independent|stratified|sobol); throws on others.
+SamplerType parseSamplerName(const std::string& name);
 
 }  // namespace envgi::cli

@@ -16,6 +16,13 @@ namespace envgi::cli {
 
 int parseStrategyName(const std::string& name) { return int(findStrategy(name, true).env); }
 
+SamplerType parseSamplerName(const std::string& name) {
+  if (name == "independent") return SamplerType::Independent;
+  if (name == "stratified") return SamplerType::Stratified;
+  if (name == "sobol") return SamplerType::Sobol;
+  throw std::runtime_error("unknown sampler '" + name + "' (independent, stratified, sobol)");
+}
+
 namespace {
 
 struct SampleArgs {
@@ -30,10 +37,7 @@ std::vector<EnvSample> drawSamples(const EnvironmentMap& env, const SampleArgs& 
   EnvStrategy s = EnvStrategy(parseStrategyName(a.strategy));
   EnvironmentMapView v = env.view();
   Sampler smp;
-  smp.type = a.sampler == "independent" ? SamplerType::Independent
-             : a.sampler == "stratified" ? SamplerType::Stratified
-             : a.sampler == "sobol"      ? SamplerType::Sobol
-                                         : throw std::runtime_error("unknown sampler '" + a.sampler + "'");
+  smp.type = parseSamplerName(a.sampler);
   smp.spp = uint32_t(a.count);
   smp.seed = a.seed;
   std::vector<EnvSample> out(a.count);

@@ -82,24 +82,12 @@ void runRender(const RenderArgs& a) {
     scene.integrator.type = a.integrator;
   }
   if (!a.strategy.empty()) {
-    findStrategy(a.strategy);
-    scene.integrator.strategy = a.strategy;
-    // The strategy's own sample counts (bsdf: BSDF samples only, mis: one of each), not the file's.
-    scene.integrator.emitterSamples = scene.integrator.bsdfSamples = -1;
+    setStrategy(scene.integrator, a.strategy);
   }
   if (a.points > 0) scene.integrator.pointCount = a.points;
-  if (!a.pointMethod.empty()) {
-    if (a.pointMethod != "sample" && a.pointMethod != "mediancut")
-      throw std::runtime_error("unknown point method '" + a.pointMethod + "' (sample, mediancut)");
-    scene.integrator.pointMethod = a.pointMethod;
-  }
+  if (!a.pointMethod.empty()) scene.integrator.pointMethod = a.pointMethod;  // Scene::finalize checks it
   if (a.seed >= 0) scene.sampler.seed = uint32_t(a.seed);
-  if (!a.sampler.empty()) {
-    if (a.sampler == "independent") scene.sampler.type = SamplerType::Independent;
-    else if (a.sampler == "stratified") scene.sampler.type = SamplerType::Stratified;
-    else if (a.sampler == "sobol") scene.sampler.type = SamplerType::Sobol;
-    else throw std::runtime_error("unknown sampler '" + a.sampler + "' (independent, stratified, sobol)");
-  }
+  if (!a.sampler.empty()) scene.sampler.type = parseSamplerName(a.sampler);
   scene.finalize();
   bool cuda = chooseCuda(a, scene.integrator.type);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

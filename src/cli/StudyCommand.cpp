@@ -62,11 +62,9 @@ std::vector<double> positiveNumbers(const std::string& list, const std::string& 
   return out;
 }
 
-// A strategy name of the study: a render strategy, or points-N (the collapsed map with N lights).
-// The sample counts are the strategy's own (bsdf: BSDF samples only; mis: one of each; the
-// others: one light sample), whatever the scene file asked for.
+// A strategy name of the study: a render strategy, or points-N (the collapsed map with N
+// lights), each with its own sample counts (setStrategy) whatever the scene file asked for.
 void applyStrategy(const std::string& name, Scene& scene) {
-  scene.integrator.emitterSamples = scene.integrator.bsdfSamples = -1;
   if (name.rfind("points-", 0) == 0) {
     int n = 0;
     try {
@@ -74,13 +72,13 @@ void applyStrategy(const std::string& name, Scene& scene) {
     } catch (...) {
     }
     if (n < 1) throw std::runtime_error("strategy '" + name + "': points-N needs a positive N");
-    scene.integrator.strategy = "points";
+    setStrategy(scene.integrator, "points");
     scene.integrator.pointCount = n;
     return;
   }
-  if (name == "points" || findStrategy(name).env == EnvStrategy::Points)
+  if (findStrategy(name).env == EnvStrategy::Points)
     throw std::runtime_error("strategy 'points': name its size, points-N");
-  scene.integrator.strategy = name;
+  setStrategy(scene.integrator, name);
 }
 
 struct Rendered {
@@ -88,14 +86,13 @@ struct Rendered {
   double seconds = 0.0;
 };
 
-Rendered renderOnce(const StudyArgs& a, const std::string& strategy, int spp, uint32_t seed) {
-  Scene scene;
-  loadScene(a.scene, parseDefines(a.defines), scene);
-  scene.integrator.type = a.integrator;
+// One run on the study's scene: loaded and traced by Embree once, re-finalised per run for
+// its strategy and seed (finalize keeps the vertex buffers Embree reads in place).
+Rendered renderOnce(const StudyArgs& a, Scene& scene, const EmbreeAccel& accel, const std::string& strategy, int spp,
+                    uint32_t seed) {
   applyStrategy(strategy, scene);
   scene.sampler.seed = seed;
   scene.finalize();
-  EmbreeAccel accel(scene);
   RenderOptions o;
   o.spp = spp;
   o.progress = false;
@@ -146,10 +143,12 @@ void runStudy(const StudyArgs& a) {
   if (a.seeds < 1) throw std::runtime_error("--seeds must be at least 1");
   if (a.integrator != "direct" && a.integrator != "path")
     throw std::runtime_error("--integrator must be direct or path");
-  {
-    Scene probe;
-    for (const std::string& s : strategies) applyStrategy(s, probe);  // names checked before any work
-  }
+  Scene scene;
+  loadScene(a.scene, parseDefines(a.defines), scene);
+  scene.integrator.type = a.integrator;
+  for (const std::string& s : strategies) applyStrategy(s, scene);  // names checked before any work
+  scene.finalize();
+  EmbreeAccel accel(scene);
   fs::create_directories(a.out + "/runs");
   std::string probe = a.out + "/.write_test";
   writeFileAtomically(probe, "ok");  // an unwritable folder fails here, before any rendering
@@ -163,20 +162,16 @@ void runStudy(const StudyArgs& a) {
     spdlog::info("study: reference {}", refPath);
   } else {
     spdlog::info("study: rendering the reference, mis at {} spp", a.referenceSpp);
-    Rendered r = renderOnce(a, "mis", a.referenceSpp, 1000003u);
+    Rendered r = renderOnce(a, scene, accel, "mis", a.referenceSpp, 1000003u);
     ref = r.image;
     saveImage(ref, refPath);
     spdlog::info("study: reference done in {:.1f} s", r.seconds);
   }
   for (float v : ref.rgb)
     if (!std::isfinite(v)) throw std::runtime_error("reference '" + refPath + "' has NaN or infinite pixels");
-  {
-    Scene s;
-    loadScene(a.scene, parseDefines(a.defines), s);
-    if (s.camera.width != ref.width || s.camera.height != ref.height)
-      throw std::runtime_error(fmt::format("reference '{}' is {}x{}, the scene renders {}x{}", refPath, ref.width,
-                                           ref.height, s.camera.width, s.camera.height));
-  }
+  if (scene.camera.width != ref.width || scene.camera.height != ref.height)
+    throw std::runtime_error(fmt::format("reference '{}' is {}x{}, the scene renders {}x{}", refPath, ref.width,
+                                         ref.height, scene.camera.width, scene.camera.height));
 
   std::vector<StudyRun> plan;
   for (const std::string& s : strategies)
@@ -207,7 +202,7 @@ void runStudy(const StudyArgs& a) {
       spdlog::info("study: [{}/{}] {} {} seed {}", done, plan.size(), r.strategy,
                    r.timeBudget > 0 ? fmt::format("{} s ({} spp)", r.timeBudget, r.spp) : fmt::format("{} spp", r.spp),
                    r.seed);
-      Rendered img = renderOnce(a, r.strategy, r.spp, uint32_t(17 + 7919 * r.seed));
+      Rendered img = renderOnce(a, scene, accel, r.strategy, r.spp, uint32_t(17 + 7919 * r.seed));
       ImageError e = imageError(img.image, ref);
       r.seconds = img.seconds;
       r.rmse = e.rmse;

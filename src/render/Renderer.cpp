@@ -64,10 +64,10 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
   k.path.maxDepth = is.maxDepth;
   k.path.rrDepth = is.rrDepth;
   k.path.hideEmitters = is.hideEmitters;
-  k.path.envStrategy = strategyOf(is.strategy);
-  k.direct.hideEmitters = is.hideEmitters;
-  k.direct.envStrategy = strategyOf(is.strategy);
   const StrategyName& sn = findStrategy(is.strategy);
+  k.path.envStrategy = sn.env;
+  k.direct.hideEmitters = is.hideEmitters;
+  k.direct.envStrategy = sn.env;
   k.direct.emitterSamples = is.emitterSamples >= 0 ? is.emitterSamples : sn.emitterSamples;
   k.direct.bsdfSamples = is.bsdfSamples >= 0 ? is.bsdfSamples : sn.bsdfSamples;
   if (k.type == SampleIntegratorType::Direct && k.direct.emitterSamples + k.direct.bsdfSamples == 0)

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "envmap/EnvironmentMapView.h"
+#include "scene/Scene.h"
 
 namespace envgi {
 
@@ -39,6 +40,14 @@ inline const StrategyName& findStrategy(const std::string& name, bool mapOnly = 
   for (const StrategyName& n : kStrategyNames)
     if (name == n.name && (!mapOnly || n.mapOnly)) return n;
   throw std::runtime_error("unknown strategy '" + name + "' (" + strategyNameList(mapOnly) + ")");
+}
+
+// Sets the integrator's strategy by name (checked against the table) with the strategy's own
+// sample counts (bsdf: BSDF samples only, mis: one of each), not those the scene file set.
+inline void setStrategy(IntegratorSettings& s, const std::string& name) {
+  findStrategy(name);
+  s.strategy = name;
+  s.emitterSamples = s.bsdfSamples = -1;
 }
 
 }  // namespace envgi
