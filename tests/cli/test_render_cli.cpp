@@ -174,6 +174,20 @@ TEST(RenderCli, SamplerVersionAndParseErrors) {
   EXPECT_EQ(s.code, 0) << s.output;
   EXPECT_NE(s.output.find("stratified sampler"), std::string::npos) << s.output;
   EXPECT_EQ(runCli("render " + scene + " -o " + d.file("t.exr") + " --sampler halton").code, 1);
+  // The collapsed map's options and the device index: bad values are one error line, no file.
+  for (std::string bad : {"--strategy points --point-method bogus", "--strategy magic", "--points 0", "--gpu -1"}) {
+    CliResult b = runCli("render " + scene + " -o " + d.file("bad.exr") + " --no-progress " + bad);
+    EXPECT_NE(b.code, 0) << bad;
+    // One error line (the scene's own loader warning may come before it).
+    size_t at = b.output.find("envgi: error: ");
+    ASSERT_NE(at, std::string::npos) << bad << ": " << b.output;
+    EXPECT_EQ(b.output.find("envgi: error: ", at + 1), std::string::npos) << bad << ": " << b.output;
+    EXPECT_EQ(b.output.find('\n', at), b.output.size() - 1) << bad << ": " << b.output;
+    EXPECT_FALSE(fs::exists(d.file("bad.exr"))) << bad;
+  }
+  CliResult pts = runCli("render " + scene + " -o " + d.file("p.exr") + " --no-progress --strategy points --points 8 "
+                         "--point-method mediancut");
+  EXPECT_EQ(pts.code, 0) << pts.output;
   CliResult v = runCli("--version");
   EXPECT_EQ(v.code, 0);
   EXPECT_EQ(v.output.rfind("envgi ", 0), 0u) << v.output;

@@ -56,6 +56,11 @@ TEST(StudyCli, BadInputIsOneErrorLine) {
   expectError("--strategies uniform,magic", "unknown strategy 'magic'");
   expectError("--spp ,", "--spp is empty");
   expectError("--spp 4,x", "not a positive sample count");
+  expectError("--time 0", "not a positive number of seconds");
+  expectError("--seeds 0", "--seeds must be at least 1");
+  expectError("--integrator photon", "--integrator must be direct or path");
+  expectError("--strategies points", "name its size, points-N");
+  expectError("--strategies points-0", "points-N needs a positive N");
   // A reference of the wrong size.
   CliResult ok = runCli("render " + buddha() + " -o " + d.file("ref.exr") + " -D res=8 --spp 1 --no-progress");
   ASSERT_EQ(ok.code, 0) << ok.output;
