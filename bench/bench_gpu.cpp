@@ -102,9 +102,9 @@ int main(int argc, char** argv) {
       loadScene(test::bundledScenesDir() + "/buddha.xml", defs, s);
       if (!mesh.empty()) test::frameLargestMesh(s);
       s.camera.width = s.camera.height = res;
-      s.integrator.type = "path";
-      s.integrator.maxDepth = 8;
-      s.integrator.strategy = "mis";
+      s.integrator.type = IntegratorType::Path;
+      s.integrator.path.maxDepth = 8;
+      s.integrator.env.strategy = "mis";
       for (Bsdf& b : s.bsdfs) {
         b = Bsdf{};
         b.type = BsdfType::RoughConductor;

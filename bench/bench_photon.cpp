@@ -5,7 +5,7 @@
 #include <benchmark/benchmark.h>
 
 #include "render/SppmExecutor.h"
-#include "photon/PhotonShooter.h"
+#include "render/PhotonShooter.h"
 #include "sampling/Pcg32.h"
 #include "scene/SceneLoader.h"
 

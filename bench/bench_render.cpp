@@ -43,8 +43,8 @@ struct Fixture {
     std::map<std::string, std::string> defs = {{"res", "256"}, {"spp", "4"}};
     if (const char* m = std::getenv("ENVGI_BENCH_MESH")) defs["mesh"] = m;
     loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/buddha.xml", defs, scene);
-    scene.integrator.type = "path";
-    scene.integrator.maxDepth = 4;
+    scene.integrator.type = IntegratorType::Path;
+    scene.integrator.path.maxDepth = 4;
     scene.finalize();
     accel = std::make_unique<EmbreeAccel>(scene);
     // Record the rays of one full render, in the order the path tracer makes them.

@@ -18,10 +18,7 @@ void addStudyCommand(CLI::App& app);
 // -D name=value pairs into a map; throws on a pair without '='.
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds);
 
-// A map strategy's name (scene/StrategyNames.h, map strategies only) as an EnvStrategy; throws on others.
+// A map strategy's name (scene/NameTables.h, map strategies only) as an EnvStrategy; throws on others.
 int parseStrategyName(const std::string& name);
-
-// A sample sequence's name (independent|stratified|sobol); throws on others.
-SamplerType parseSamplerName(const std::string& name);
 
 }  // namespace envgi::cli

@@ -10,18 +10,12 @@
 #include "core/Files.h"
 #include "envmap/EnvironmentMap.h"
 #include "sampling/Sampler.h"
-#include "scene/StrategyNames.h"
+#include "scene/NameTables.h"
 
 namespace envgi::cli {
 
 int parseStrategyName(const std::string& name) { return int(findStrategy(name, true).env); }
 
-SamplerType parseSamplerName(const std::string& name) {
-  if (name == "independent") return SamplerType::Independent;
-  if (name == "stratified") return SamplerType::Stratified;
-  if (name == "sobol") return SamplerType::Sobol;
-  throw std::runtime_error("unknown sampler '" + name + "' (independent, stratified, sobol)");
-}
 
 namespace {
 
@@ -37,7 +31,7 @@ std::vector<EnvSample> drawSamples(const EnvironmentMap& env, const SampleArgs& 
   EnvStrategy s = EnvStrategy(parseStrategyName(a.strategy));
   EnvironmentMapView v = env.view();
   Sampler smp;
-  smp.type = parseSamplerName(a.sampler);
+  smp.type = findSampler(a.sampler);
   smp.spp = uint32_t(a.count);
   smp.seed = a.seed;
   std::vector<EnvSample> out(a.count);
@@ -52,7 +46,7 @@ void addSampleOptions(CLI::App* c, SampleArgs& a) {
   c->add_option("map", a.map, "Lat-long map (.hdr, .exr, .pfm)")->required();
   c->add_option("--count,-n", a.count, "Number of samples")->check(CLI::PositiveNumber);
   c->add_option("--strategy,-s", a.strategy, "uniform|cosine|importance|alias|adaptive (cosine is about +Y)");
-  c->add_option("--sampler", a.sampler, "independent|stratified|sobol");
+  c->add_option("--sampler", a.sampler, nameList(kSamplerNames));
   c->add_option("--seed", a.seed, "Seed");
   c->add_flag("--mis-compensation", a.misCompensation, "Sample max(L - mean, 0) (Karlik et al. 2019)");
 }

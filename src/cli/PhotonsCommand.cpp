@@ -8,7 +8,7 @@
 
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
-#include "photon/PhotonShooter.h"
+#include "render/PhotonShooter.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
 
@@ -29,7 +29,7 @@ void runPhotons(const PhotonsArgs& a) {
   Scene scene;
   loadScene(a.scene, defs, scene);
   scene.integrator = IntegratorSettings{};
-  scene.integrator.type = "direct";
+  scene.integrator.type = IntegratorType::Direct;
   scene.finalize();
   EmbreeAccel accel(scene);
   PhotonShootSettings ps;

@@ -15,7 +15,7 @@
 #include "gpu/CudaExecutor.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
-#include "scene/StrategyNames.h"
+#include "scene/NameTables.h"
 
 namespace envgi::cli {
 
@@ -44,11 +44,12 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
 }
 
 // cpu, cuda or auto (CUDA when a device is present and the integrator has GPU kernels).
-bool chooseCuda(const RenderArgs& a, const std::string& integrator) {
+bool chooseCuda(const RenderArgs& a, IntegratorType type) {
   if (a.device != "cpu" && a.device != "cuda" && a.device != "auto")
     throw std::runtime_error("unknown device '" + a.device + "' (cpu, cuda, auto)");
   if (a.device == "cpu") return false;
-  bool kernels = integrator == "path" || integrator == "direct";
+  bool kernels = hasSampleKernel(type);
+  std::string integrator = integratorName(type);
   std::string why;
   int n = gpu::deviceCount(&why);
   if (a.device == "cuda") {
@@ -77,17 +78,15 @@ void runRender(const RenderArgs& a) {
   Scene scene;
   loadScene(a.scene, parseDefines(a.defines), scene);
   if (!a.integrator.empty()) {
-    if (a.integrator != "path" && a.integrator != "direct" && a.integrator != "photon" && a.integrator != "sppm")
-      throw std::runtime_error("unknown integrator '" + a.integrator + "' (path, direct, photon, sppm)");
-    scene.integrator.type = a.integrator;
+    scene.integrator.type = findIntegrator(a.integrator);
   }
   if (!a.strategy.empty()) {
-    setStrategy(scene.integrator, a.strategy);
+    scene.integrator.setStrategy(a.strategy);
   }
-  if (a.points > 0) scene.integrator.pointCount = a.points;
-  if (!a.pointMethod.empty()) scene.integrator.pointMethod = a.pointMethod;  // Scene::finalize checks it
+  if (a.points > 0) scene.integrator.env.pointCount = a.points;
+  if (!a.pointMethod.empty()) scene.integrator.env.pointMethod = a.pointMethod;  // Scene::finalize checks it
   if (a.seed >= 0) scene.sampler.seed = uint32_t(a.seed);
-  if (!a.sampler.empty()) scene.sampler.type = parseSamplerName(a.sampler);
+  if (!a.sampler.empty()) scene.sampler.type = findSampler(a.sampler);
   scene.finalize();
   bool cuda = chooseCuda(a, scene.integrator.type);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -119,9 +118,8 @@ void runRender(const RenderArgs& a) {
   RenderStats st;
   const IntegratorSettings& is = scene.integrator;
   spdlog::info("rendering {}x{} with '{}' (strategy {}), {} spp, {} sampler", scene.camera.width, scene.camera.height,
-               is.type, is.strategy, a.spp > 0 ? a.spp : scene.sampler.sampleCount,
-               scene.sampler.type == SamplerType::Independent ? "independent"
-               : scene.sampler.type == SamplerType::Stratified ? "stratified" : "sobol");
+               integratorName(is.type), is.env.strategy, a.spp > 0 ? a.spp : scene.sampler.sampleCount,
+               samplerName(scene.sampler.type));
   Image img;
   if (cuda) {
     Bvh bvh(scene);
@@ -169,7 +167,7 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("scene", a->scene, "Scene file (.xml)")->required()->check(CLI::ExistingFile);
   c->add_option("-o,--output", a->output, "Output image (.exr, .pfm, .hdr or .png)")->required();
   c->add_option("--spp", a->spp, "Samples per pixel, or passes for sppm (default: the scene's)")->check(CLI::PositiveNumber);
-  c->add_option("--integrator", a->integrator, "path | direct | photon | sppm (overrides the scene)");
+  c->add_option("--integrator", a->integrator, "Integrator: " + nameList(kIntegratorNames) + " (overrides the scene)");
   c->add_option("--strategy", a->strategy, "Environment strategy: " + strategyNameList());
   c->add_option("--points", a->points, "points: directional lights in the collapsed map (default 64)")->check(CLI::PositiveNumber);
   c->add_option("--point-method", a->pointMethod, "points: sample (Algorithm 1 draws, power L/pdf/N) | mediancut");
@@ -183,7 +181,7 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("--checkpoint", a->checkpoint, "Seconds between writes of the image so far (0: never)");
   c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
   c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(CLI::NonNegativeNumber);
-  c->add_option("--sampler", a->sampler, "Sample sequence: independent | stratified | sobol (overrides the scene)");
+  c->add_option("--sampler", a->sampler, "Sample sequence: " + nameList(kSamplerNames) + " (overrides the scene)");
   c->callback([a] { runRender(*a); });
 }
 

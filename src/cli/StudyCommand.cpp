@@ -19,7 +19,7 @@
 #include "core/Files.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
-#include "scene/StrategyNames.h"
+#include "scene/NameTables.h"
 #include "study/ErrorMetrics.h"
 #include "study/Report.h"
 
@@ -72,13 +72,13 @@ void applyStrategy(const std::string& name, Scene& scene) {
     } catch (...) {
     }
     if (n < 1) throw std::runtime_error("strategy '" + name + "': points-N needs a positive N");
-    setStrategy(scene.integrator, "points");
-    scene.integrator.pointCount = n;
+    scene.integrator.setStrategy("points");
+    scene.integrator.env.pointCount = n;
     return;
   }
   if (findStrategy(name).env == EnvStrategy::Points)
     throw std::runtime_error("strategy 'points': name its size, points-N");
-  setStrategy(scene.integrator, name);
+  scene.integrator.setStrategy(name);
 }
 
 struct Rendered {
@@ -141,11 +141,11 @@ void runStudy(const StudyArgs& a) {
   if (strategies.empty()) throw std::runtime_error("--strategies is empty");
   if (sppList.empty()) throw std::runtime_error("--spp is empty");
   if (a.seeds < 1) throw std::runtime_error("--seeds must be at least 1");
-  if (a.integrator != "direct" && a.integrator != "path")
-    throw std::runtime_error("--integrator must be direct or path");
+  IntegratorType integrator = findIntegrator(a.integrator);
+  if (!hasSampleKernel(integrator)) throw std::runtime_error("--integrator must be direct or path");
   Scene scene;
   loadScene(a.scene, parseDefines(a.defines), scene);
-  scene.integrator.type = a.integrator;
+  scene.integrator.type = integrator;
   for (const std::string& s : strategies) applyStrategy(s, scene);  // names checked before any work
   scene.finalize();
   EmbreeAccel accel(scene);

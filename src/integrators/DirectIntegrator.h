@@ -4,9 +4,7 @@
 // estimator of the other, so the paper's strategies can be compared on the same image.
 #pragma once
 
-#include "lights/LightSampling.h"
-#include "sampling/Mis.h"
-#include "sampling/Sampler.h"
+#include "integrators/NextEvent.h"
 
 namespace envgi {
 
@@ -30,21 +28,8 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
   Vec3f axis = cosineAxis(si, wo);
   float nE = float(emitterSamples), nB = float(bsdfSamples);
 
-  for (int i = 0; i < emitterSamples; ++i) {
-    float uSel = smp.get1D();
-    Vec2f uL = smp.get2D(), uL2 = smp.get2D();
-    LightSample ls;
-    if (bsdfIsDelta(bsdf) || !sampleLight(sc, si, axis, strategy, uSel, uL, uL2, &ls)) continue;
-    Vec3f wiLocal = si.shading.toLocal(ls.dir);
-    Color f = bsdfEval(bsdf, woLocal, wiLocal);
-    if (isBlack(f) || isBlack(ls.radiance)) continue;
-    Vec3f o = offsetRayOrigin(si.p, si.ng, ls.dir, si.t);
-    float tMax = ls.environment ? INFINITY : ls.dist * (1.f - 1e-4f) - length(o - si.p);
-    ++*rayCount;
-    if (tracer.occluded(o, ls.dir, tMax)) continue;
-    float w = nB > 0.f && !ls.delta ? powerHeuristic(nE, ls.pdf, nB, bsdfPdf(bsdf, woLocal, wiLocal)) : 1.f;
-    L += f * ls.radiance * (w / (ls.pdf * nE));
-  }
+  for (int i = 0; i < emitterSamples; ++i)
+    L += sampleLd(sc, tracer, si, bsdf, woLocal, axis, strategy, nE, nB, smp, rayCount);
 
   for (int j = 0; j < bsdfSamples; ++j) {
     BsdfSample bs;

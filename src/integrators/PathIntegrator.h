@@ -1,17 +1,19 @@
 // Unidirectional path tracing with next-event estimation of the environment map and the
 // area lights, MIS (power heuristic) against BSDF sampling, and Russian roulette. Written
-// once for any tracer with intersect() and occluded(): Embree on the CPU, a BVH on the GPU.
+// once for any tracer with intersect() and occluded(): Embree or envgi's BVH on the CPU, the
+// BVH on the GPU.
 #pragma once
 
-#include "lights/LightSampling.h"
-#include "sampling/Mis.h"
-#include "sampling/Sampler.h"
+#include "integrators/NextEvent.h"
+#include "sampling/Roulette.h"
+#include "scene/IntegratorSettings.h"
 
 namespace envgi {
 
+// Made from PathSettings (scene/IntegratorSettings.h), whose comments say what each means.
 struct PathParams {
-  int maxDepth = -1;  // Mitsuba's meaning: 1 = emitters seen directly, 2 = direct lighting, -1 = unbounded
-  int rrDepth = 5;
+  int maxDepth = -1;
+  int rrDepth = kRouletteDepth;
   bool hideEmitters = false;
   EnvStrategy envStrategy = EnvStrategy::Importance;
 };
@@ -48,24 +50,8 @@ ENVGI_HD Color pathTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sam
     Vec3f woLocal = si.shading.toLocal(wo);
     Vec3f axis = cosineAxis(si, wo);
 
-    // Next-event estimation; the sample dimensions are drawn whatever happens, so sequences
-    // stay aligned across pixels.
-    float uSel = smp.get1D();
-    Vec2f uL = smp.get2D(), uL2 = smp.get2D();
-    LightSample ls;
-    if (!bsdfIsDelta(bsdf) && sampleLight(sc, si, axis, pp.envStrategy, uSel, uL, uL2, &ls)) {
-      Vec3f wiLocal = si.shading.toLocal(ls.dir);
-      Color f = bsdfEval(bsdf, woLocal, wiLocal);
-      if (!isBlack(f) && !isBlack(ls.radiance)) {
-        Vec3f o = offsetRayOrigin(si.p, si.ng, ls.dir, si.t);
-        float tMax = ls.environment ? INFINITY : ls.dist * (1.f - 1e-4f) - length(o - si.p);
-        ++*rayCount;
-        if (!tracer.occluded(o, ls.dir, tMax)) {
-          float w = ls.delta ? 1.f : powerHeuristic(1.f, ls.pdf, 1.f, bsdfPdf(bsdf, woLocal, wiLocal));
-          L += beta * f * ls.radiance * (w / ls.pdf);
-        }
-      }
-    }
+    // Next-event estimation, weighted against this bounce's BSDF sample.
+    L += beta * sampleLd(sc, tracer, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, rayCount);
 
     BsdfSample bs;
     float uc = smp.get1D();
@@ -82,11 +68,7 @@ ENVGI_HD Color pathTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sam
     ray.d = wi;
     ray.tMax = INFINITY;
 
-    if (depth >= pp.rrDepth) {
-      float q = fminf(maxComponent(beta), 0.95f);
-      if (smp.get1D() >= q) break;
-      beta = beta / q;
-    }
+    if (depth >= pp.rrDepth && !russianRoulette(&beta, smp.get1D(), kRouletteMaxSurvival)) break;
   }
   return L;
 }

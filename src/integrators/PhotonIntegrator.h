@@ -7,13 +7,15 @@
 
 #include "integrators/DirectIntegrator.h"
 #include "photon/PhotonMap.h"
+#include "sampling/Roulette.h"
 
 namespace envgi {
 
 struct PhotonRenderParams {
   PhotonLookup global, caustic;
-  int gatherSamples = 32;
-  int maxDepth = 16;             // specular/glossy chain length from the camera
+  int gatherSamples = 8;
+  int maxDepth = kSpecularChainDepth;  // specular/glossy chain length from the camera
+  int rrDepth = kRouletteDepth;
   float glossyThreshold = 0.3f;  // rough lobes sharper than this are followed, not estimated
   bool hideEmitters = false;
   EnvStrategy strategy = EnvStrategy::Alias;
@@ -28,8 +30,12 @@ ENVGI_INLINE bool isDiffuseLike(const Bsdf& b, float glossyThreshold) {
     // Rough glass is followed like glass: its light comes mostly through it, which irradiance
     // on its surface cannot stand for.
     case BsdfType::RoughConductor: return b.alpha >= glossyThreshold;
-    default: return false;
+    case BsdfType::Conductor:
+    case BsdfType::Dielectric:
+    case BsdfType::ThinDielectric:
+    case BsdfType::RoughDielectric: return false;
   }
+  return false;
 }
 
 // Lambertian-equivalent albedo of a diffuse-like BSDF, for the precomputed irradiance that
@@ -46,8 +52,12 @@ ENVGI_INLINE Color diffuseAlbedo(const Bsdf& b) {
     }
     case BsdfType::RoughConductor:
       return b.specularReflectance * (b.perfectMirror ? Color(1.f) : fresnelConductor(1.f, b.eta, b.k));
-    default: return Color(0.f);
+    case BsdfType::Conductor:
+    case BsdfType::Dielectric:
+    case BsdfType::ThinDielectric:
+    case BsdfType::RoughDielectric: return Color(0.f);
   }
+  return Color(0.f);
 }
 
 template <class Tracer>
@@ -117,11 +127,7 @@ Color photonTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& s
     countEmission = bs.delta;  // after a glossy bounce, directLighting counted the emitters
     Vec3f wi = si.shading.toWorld(bs.wi);
     ray = Ray{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};
-    if (depth >= 4) {
-      float q = fminf(maxComponent(beta), 0.95f);
-      if (smp.get1D() >= q) break;
-      beta = beta / q;
-    }
+    if (depth + 1 >= pp.rrDepth && !russianRoulette(&beta, smp.get1D(), kRouletteMaxSurvival)) break;
   }
   return L;
 }

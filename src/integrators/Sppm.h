@@ -8,6 +8,7 @@
 #include "integrators/DirectIntegrator.h"
 #include "photon/HashGrid.h"
 #include "photon/PhotonTracing.h"
+#include "scene/IntegratorSettings.h"
 #include "scene/SceneView.h"
 
 namespace envgi {
@@ -78,7 +79,7 @@ struct SppmParams {
   size_t photonsPerPass = 100000;
   float initialRadius = 0.f;  // 0: 1% of the scene's bounding-sphere radius
   float alpha = 2.f / 3.f;
-  int maxDepth = 16;
+  int maxDepth = kSpecularChainDepth;
   uint32_t seed = 0;
   EnvStrategy strategy = EnvStrategy::Alias;
 };

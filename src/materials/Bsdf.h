@@ -126,9 +126,12 @@ ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
       Color spec = b.specularReflectance * (F * d.D(m) * d.G(wo, wi) / (4.f * wo.z));
       return spec + detail::plasticDiffuse(b, wo, wi);
     }
-    default:
-      return Color(0.f);  // pure delta lobes
+    case BsdfType::Conductor:
+    case BsdfType::Dielectric:
+    case BsdfType::ThinDielectric:
+      break;  // pure delta lobes
   }
+  return Color(0.f);
 }
 
 ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
@@ -164,9 +167,12 @@ ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
       float spec = GGX{b.alpha}.visiblePdf(wo, m) / (4.f * std::fabs(dot(wo, m)));
       return ps * spec + (1.f - ps) * cosineHemispherePdf(wi.z);
     }
-    default:
-      return 0.f;
+    case BsdfType::Conductor:
+    case BsdfType::Dielectric:
+    case BsdfType::ThinDielectric:
+      break;  // pure delta lobes
   }
+  return 0.f;
 }
 
 namespace detail {

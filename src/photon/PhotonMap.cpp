@@ -1,7 +1,6 @@
 #include "photon/PhotonMap.h"
 
 #include <nanoflann.hpp>
-#include <tbb/parallel_for.h>
 
 namespace envgi {
 
@@ -44,36 +43,42 @@ size_t PhotonMap::bytes() const {
          m * (sizeof(IrradiancePoint) + sizeof(Photon) + sizeof(uint32_t)) + m / 16 * 48;
 }
 
-void PhotonMap::precomputeIrradiance(int k, float maxRadius, int stride) {
+size_t PhotonMap::beginIrradiance(int stride) {
   irr_.clear();
   irrPhotons_.clear();
   irrIndex_.reset();
-  if (!index_ || stride < 1) return;
-  size_t count = (photons_.size() + size_t(stride) - 1) / size_t(stride);
-  irr_.resize(count);
-  size_t kk = size_t(std::min(std::max(k, 1), 512));
+  irrStride_ = stride;
+  if (!index_ || stride < 1) return 0;
+  irr_.resize((photons_.size() + size_t(stride) - 1) / size_t(stride));
+  return irr_.size();
+}
+
+void PhotonMap::estimateIrradiance(size_t i, int k, float maxRadius) {
+  const Photon& c = photons_[i * size_t(irrStride_)];
+  size_t kk = size_t(std::min(std::max(k, 1), kMaxPhotonLookup));
   float maxR2 = maxRadius * maxRadius;
-  tbb::parallel_for(size_t(0), count, [&](size_t i) {
-    const Photon& c = photons_[i * size_t(stride)];
-    uint32_t idx[512];
-    float d2[512];
-    float q[3] = {c.p.x, c.p.y, c.p.z};
-    size_t found = index_->tree.knnSearch(q, kk, idx, d2);
-    Color sum(0.f);
-    float r2 = 0.f;
-    size_t kept = 0;
-    for (size_t j = 0; j < found; ++j) {
-      if (d2[j] > maxR2) continue;
-      const Photon& ph = photons_[idx[j]];
-      r2 = fmaxf(r2, d2[j]);
-      ++kept;
-      if (dot(ph.n, c.n) > 0.9f) sum += ph.power;  // same side of the same surface
-    }
-    if (kept < kk) r2 = maxR2;
-    irr_[i] = {c.p, c.n, kept > 0 ? sum / (kPi * r2) : Color(0.f), r2};
-  });
-  irrPhotons_.resize(count);
-  for (size_t i = 0; i < count; ++i) irrPhotons_[i].p = irr_[i].p;
+  uint32_t idx[kMaxPhotonLookup];
+  float d2[kMaxPhotonLookup];
+  float q[3] = {c.p.x, c.p.y, c.p.z};
+  size_t found = index_->tree.knnSearch(q, kk, idx, d2);
+  Color sum(0.f);
+  float r2 = 0.f;
+  size_t kept = 0;
+  for (size_t j = 0; j < found; ++j) {
+    if (d2[j] > maxR2) continue;
+    const Photon& ph = photons_[idx[j]];
+    r2 = fmaxf(r2, d2[j]);
+    ++kept;
+    if (dot(ph.n, c.n) > kSameSurfaceCos) sum += ph.power;
+  }
+  if (kept < kk) r2 = maxR2;
+  irr_[i] = {c.p, c.n, kept > 0 ? sum / (kPi * r2) : Color(0.f), r2};
+}
+
+void PhotonMap::endIrradiance() {
+  if (irr_.empty()) return;
+  irrPhotons_.resize(irr_.size());
+  for (size_t i = 0; i < irr_.size(); ++i) irrPhotons_[i].p = irr_[i].p;
   irrIndex_ = std::make_unique<Index>(&irrPhotons_);
 }
 
@@ -87,7 +92,7 @@ Color PhotonMap::irradiance(Vec3f p, Vec3f n) const {
   // where no photons arrived must not borrow irradiance from a distant surface.
   for (size_t j = 0; j < found; ++j) {
     const IrradiancePoint& ip = irr_[idx[j]];
-    if (d2[j] <= ip.r2 && dot(ip.n, n) > 0.9f) return ip.e;
+    if (d2[j] <= ip.r2 && dot(ip.n, n) > kSameSurfaceCos) return ip.e;
   }
   return Color(0.f);
 }
@@ -97,9 +102,9 @@ Color PhotonMap::estimate(const SceneView& sc, const SurfaceInteraction& si, Vec
   const Bsdf& bsdf = sc.bsdfs[si.bsdf];
   Vec3f woLocal = si.shading.toLocal(woWorld);
   size_t k = size_t(q.k);
-  uint32_t idx[512];
-  float d2[512];
-  if (k > 512) k = 512;
+  uint32_t idx[kMaxPhotonLookup];
+  float d2[kMaxPhotonLookup];
+  if (k > size_t(kMaxPhotonLookup)) k = size_t(kMaxPhotonLookup);
   float query[3] = {si.p.x, si.p.y, si.p.z};
   size_t found = index_->tree.knnSearch(query, k, idx, d2);
   float maxR2 = q.maxRadius * q.maxRadius;

@@ -6,8 +6,13 @@
 #include <vector>
 
 #include "photon/PhotonTracing.h"
+#include "scene/IntegratorSettings.h"
 
 namespace envgi {
+
+// Photons and irradiance points count as on the surface being shaded when their normals are
+// this close to its normal (not the far side of a thin wall, not a nearby crease).
+inline constexpr float kSameSurfaceCos = 0.9f;
 
 struct PhotonLookup {
   int k = 120;              // photons in the estimate
@@ -34,8 +39,12 @@ class PhotonMap {
   Color estimate(const SceneView& sc, const SurfaceInteraction& si, Vec3f woWorld, const PhotonLookup& q) const;
 
   // Christensen's precomputation: irradiance from the k nearest photons at every stride-th
-  // photon, so that a final-gather ray needs one nearest-neighbour lookup, not k.
-  void precomputeIrradiance(int k, float maxRadius, int stride);
+  // photon, so that a final-gather ray needs one nearest-neighbour lookup, not k. Three steps,
+  // so that the caller picks the threads: begin (returns how many points), estimate each point
+  // (any order, any thread), then end (builds their kd-tree).
+  size_t beginIrradiance(int stride);
+  void estimateIrradiance(size_t i, int k, float maxRadius);
+  void endIrradiance();
   // Irradiance near p on a surface facing n: that of the nearest precomputed point facing the
   // same way whose estimate radius covers p, zero where none does.
   Color irradiance(Vec3f p, Vec3f n) const;
@@ -52,6 +61,7 @@ class PhotonMap {
   std::vector<IrradiancePoint> irr_;
   std::vector<Photon> irrPhotons_;  // positions of irr_, for their own kd-tree
   std::unique_ptr<Index> irrIndex_;
+  int irrStride_ = 0;
 };
 
 }  // namespace envgi

@@ -4,6 +4,7 @@
 // Host/device: the store callback and the tracer are template parameters.
 #pragma once
 
+#include "sampling/Roulette.h"
 #include "sampling/Sampler.h"
 #include "scene/SceneView.h"
 
@@ -90,9 +91,8 @@ ENVGI_HD int tracePhoton(const SceneView& sc, const Tracer& tracer, Ray ray, Col
     Color w = adjointWeight(bsdf, woLocal, bs);
     specularOnly = specularOnly && bs.delta;
     // Russian roulette by albedo: survivors keep roughly the same power.
-    float q = fminf(1.f, maxComponent(w));
-    if (!(q > 0.f) || smp.get1D() >= q) break;
-    power = power * w / q;
+    if (!russianRoulette(&w, smp.get1D(), 1.f)) break;
+    power = power * w;
     Vec3f d = si.shading.toWorld(bs.wi);
     ray.o = offsetRayOrigin(si.p, si.ng, d, si.t);
     ray.d = d;

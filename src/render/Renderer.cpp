@@ -11,16 +11,14 @@
 #include "render/CpuExecutor.h"
 #include "integrators/PhotonIntegrator.h"
 #include "render/SppmExecutor.h"
-#include "scene/StrategyNames.h"
-#include "photon/PhotonShooter.h"
+#include "scene/NameTables.h"
+#include "render/PhotonShooter.h"
 
 namespace envgi {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-EnvStrategy strategyOf(const std::string& s) { return findStrategy(s).env; }
 
 void logPhotonStats(const PhotonShootStats& st) {
   spdlog::info("photon pass: {} global photons stored ({} emitted), {} caustic ({} emitted), {:.2f} s tracing, "
@@ -31,15 +29,15 @@ void logPhotonStats(const PhotonShootStats& st) {
 }
 
 Image renderSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
-  const IntegratorSettings& is = scene.integrator;
+  const SppmSettings& ss = scene.integrator.sppm;
   SppmParams sp;
-  sp.photonsPerPass = is.photonCount;
-  sp.initialRadius = is.initialRadius;
-  sp.alpha = is.alpha;
-  sp.maxDepth = is.maxDepth > 0 ? is.maxDepth : 16;
+  sp.photonsPerPass = ss.photonCount;
+  sp.initialRadius = ss.initialRadius;
+  sp.alpha = ss.alpha;
+  sp.maxDepth = ss.maxDepth;
   sp.seed = scene.sampler.seed;
-  sp.strategy = strategyOf(is.strategy);
-  int passes = opts.spp > 0 ? opts.spp : is.passes;
+  sp.strategy = findStrategy(scene.integrator.env.strategy).env;
+  int passes = opts.spp > 0 ? opts.spp : ss.passes;
   if (passes <= 0) throw std::runtime_error("sppm: passes must be positive");
   SppmExecutor ex(scene, accel, sp, opts.threads);
   Image img = renderPasses(ex, scene.view().camera.width, scene.view().camera.height, passes, opts, stats);
@@ -51,25 +49,69 @@ Image renderSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptio
   return img;
 }
 
+Image renderPhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
+  const PhotonSettings& ps = scene.integrator.photon;
+  const SceneView& sc = scene.view();
+  int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
+  if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
+  float sceneRadius = makePhotonEmitter(scene).radius;
+  PhotonShootSettings shoot;
+  shoot.globalPhotons = ps.globalPhotons;
+  shoot.causticPhotons = ps.causticPhotons;
+  shoot.maxDepth = ps.maxDepth;
+  shoot.irradianceRadius = ps.globalRadius(sceneRadius);
+  shoot.causticIrradianceRadius = ps.causticRadius(sceneRadius);
+  shoot.irradianceStride = ps.gatherSamples > 0 ? 4 : 0;
+  shoot.seed = scene.sampler.seed;
+  shoot.progress = opts.progress;
+  PhotonMap globalMap, causticMap;
+  PhotonShootStats pst;
+  shootPhotons(scene, accel, shoot, &globalMap, &causticMap, &pst);
+  logPhotonStats(pst);
+  PhotonRenderParams php;
+  php.global.k = php.caustic.k = ps.lookupSize;
+  php.global.maxRadius = ps.globalRadius(sceneRadius);
+  php.caustic.maxRadius = ps.causticRadius(sceneRadius);
+  php.global.coneFilter = php.caustic.coneFilter = ps.coneFilter;
+  php.gatherSamples = ps.gatherSamples;
+  php.maxDepth = ps.maxDepth;
+  php.rrDepth = ps.rrDepth;
+  php.hideEmitters = ps.hideEmitters;
+  php.strategy = findStrategy(scene.integrator.env.strategy).env;
+  EmbreeTracer embree{&accel};
+  auto photon = [&](const Ray& ray, Sampler& smp, uint64_t* rays) {
+    return photonTrace(sc, embree, ray, smp, globalMap, causticMap, php, rays);
+  };
+  SampleSequence seq{scene.sampler.type, uint32_t(spp), scene.sampler.seed};
+  CpuExecutor<decltype(photon)> ex(sc.camera, seq, photon, opts.threads, opts.varianceOut != nullptr, "cpu",
+                                   opts.tileSize);
+  return renderPasses(ex, sc.camera.width, sc.camera.height, spp, opts, stats);
+}
+
 }  // namespace
 
 KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
   const IntegratorSettings& is = scene.integrator;
   KernelSettings k;
-  if (is.type == "path") k.type = SampleIntegratorType::Path;
-  else if (is.type == "direct") k.type = SampleIntegratorType::Direct;
-  else throw std::runtime_error("integrator '" + is.type + "' has no per-sample kernel (path and direct do)");
+  switch (is.type) {
+    case IntegratorType::Path: k.type = SampleIntegratorType::Path; break;
+    case IntegratorType::Direct: k.type = SampleIntegratorType::Direct; break;
+    case IntegratorType::Photon:
+    case IntegratorType::Sppm:
+      throw std::runtime_error(std::string("integrator '") + integratorName(is.type) +
+                               "' has no per-sample kernel (path and direct do)");
+  }
   k.spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
   if (k.spp <= 0) throw std::runtime_error("samples per pixel must be positive");
-  k.path.maxDepth = is.maxDepth;
-  k.path.rrDepth = is.rrDepth;
-  k.path.hideEmitters = is.hideEmitters;
-  const StrategyName& sn = findStrategy(is.strategy);
+  const StrategyName& sn = findStrategy(is.env.strategy);
+  k.path.maxDepth = is.path.maxDepth;
+  k.path.rrDepth = is.path.rrDepth;
+  k.path.hideEmitters = is.path.hideEmitters;
   k.path.envStrategy = sn.env;
-  k.direct.hideEmitters = is.hideEmitters;
+  k.direct.hideEmitters = is.direct.hideEmitters;
   k.direct.envStrategy = sn.env;
-  k.direct.emitterSamples = is.emitterSamples >= 0 ? is.emitterSamples : sn.emitterSamples;
-  k.direct.bsdfSamples = is.bsdfSamples >= 0 ? is.bsdfSamples : sn.bsdfSamples;
+  k.direct.emitterSamples = is.direct.emitterSamples >= 0 ? is.direct.emitterSamples : sn.emitterSamples;
+  k.direct.bsdfSamples = is.direct.bsdfSamples >= 0 ? is.direct.bsdfSamples : sn.bsdfSamples;
   if (k.type == SampleIntegratorType::Direct && k.direct.emitterSamples + k.direct.bsdfSamples == 0)
     throw std::runtime_error("direct integrator: no samples");
   // A compensated map density is zero where L is below its mean: only with BSDF samples beside
@@ -147,41 +189,13 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
 Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
   const SceneView& sc = scene.view();
   const Camera& cam = sc.camera;
-  const IntegratorSettings& is = scene.integrator;
-  if (is.type == "sppm") return renderSppm(scene, accel, opts, stats);
-  bool keepVar = opts.varianceOut != nullptr;
-  EmbreeTracer embree{&accel};
-  if (is.type == "photon") {
-    int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
-    if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
-    PhotonMap globalMap, causticMap;
-    PhotonRenderParams php;
-    float radius = makePhotonEmitter(scene).radius;
-    PhotonShootSettings ps;
-    ps.irradianceRadius = is.maxRadius > 0.f ? is.maxRadius : 0.05f * radius;
-    ps.irradianceStride = is.gatherSamples > 0 ? 4 : 0;
-    ps.globalPhotons = is.globalPhotons;
-    ps.causticPhotons = is.causticPhotons;
-    ps.seed = scene.sampler.seed;
-    ps.progress = opts.progress;
-    PhotonShootStats pst;
-    shootPhotons(scene, accel, ps, &globalMap, &causticMap, &pst);
-    logPhotonStats(pst);
-    php.global.k = php.caustic.k = is.lookupSize;
-    php.global.maxRadius = is.maxRadius > 0.f ? is.maxRadius : 0.05f * radius;
-    php.caustic.maxRadius = 0.25f * php.global.maxRadius;
-    php.global.coneFilter = php.caustic.coneFilter = is.coneFilter;
-    php.gatherSamples = is.gatherSamples;
-    php.maxDepth = is.maxDepth > 0 ? is.maxDepth : 16;
-    php.hideEmitters = is.hideEmitters;
-    php.strategy = strategyOf(is.strategy);
-    auto photon = [&](const Ray& ray, Sampler& smp, uint64_t* rays) {
-      return photonTrace(sc, embree, ray, smp, globalMap, causticMap, php, rays);
-    };
-    SampleSequence seq{scene.sampler.type, uint32_t(spp), scene.sampler.seed};
-    CpuExecutor<decltype(photon)> ex(cam, seq, photon, opts.threads, keepVar, "cpu", opts.tileSize);
-    return renderPasses(ex, cam.width, cam.height, spp, opts, stats);
+  switch (scene.integrator.type) {
+    case IntegratorType::Sppm: return renderSppm(scene, accel, opts, stats);
+    case IntegratorType::Photon: return renderPhoton(scene, accel, opts, stats);
+    case IntegratorType::Path:
+    case IntegratorType::Direct: break;
   }
+  bool keepVar = opts.varianceOut != nullptr;
   KernelSettings k = kernelSettings(scene, opts);
   if (opts.cpuTracer == CpuTracer::Bvh) {
     Bvh bvh(scene);
@@ -189,7 +203,7 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
     CpuExecutor<decltype(integ)> ex(cam, k.sequence, integ, opts.threads, keepVar, "cpu (envgi BVH)", opts.tileSize);
     return renderPasses(ex, cam.width, cam.height, k.spp, opts, stats);
   }
-  SampleIntegrator<EmbreeTracer> integ{k.type, k.path, k.direct, &sc, embree};
+  SampleIntegrator<EmbreeTracer> integ{k.type, k.path, k.direct, &sc, EmbreeTracer{&accel}};
   CpuExecutor<decltype(integ)> ex(cam, k.sequence, integ, opts.threads, keepVar, "cpu", opts.tileSize);
   return renderPasses(ex, cam.width, cam.height, k.spp, opts, stats);
 }

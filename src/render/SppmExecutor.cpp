@@ -87,7 +87,7 @@ void SppmExecutor::iteration(int pass, PassCounters* counters) {
       tbb::parallel_for(size_t(0), chunks, [&](size_t ci) {
         Sampler smp;
         smp.type = SamplerType::Independent;
-        smp.seed = s.seed ^ 0x85ebca6bu;
+        smp.seed = s.seed ^ kSppmPhotonStream;
         uint64_t localHits = 0;
         for (size_t j = ci * chunk; j < std::min(s.photonsPerPass, (ci + 1) * chunk); ++j) {
           smp.start(uint64_t(pass) * s.photonsPerPass + j, 1);

@@ -7,7 +7,7 @@
 
 #include "accel/EmbreeAccel.h"
 #include "integrators/Sppm.h"
-#include "photon/PhotonShooter.h"
+#include "render/PhotonShooter.h"
 #include "render/PassExecutor.h"
 
 #include <tbb/task_arena.h>

@@ -5,6 +5,9 @@
 
 namespace envgi {
 
+// 32 random bits to a float in [0,1): the top 24 become the mantissa, so 1.0 never comes out.
+ENVGI_INLINE float bitsToFloat01(uint32_t v) { return float(v >> 8) * 0x1p-24f; }
+
 struct Pcg32 {
   uint64_t state = 0x853c49e6748fea9bULL;
   uint64_t inc = 0xda3e39cb94b95bdbULL;
@@ -26,8 +29,7 @@ struct Pcg32 {
     uint32_t rot = uint32_t(old >> 59u);
     return (xorshifted >> rot) | (xorshifted << ((~rot + 1u) & 31));
   }
-  // Uniform in [0,1): 24 random mantissa bits, so 1.0 is never returned.
-  ENVGI_HD float nextFloat() { return float(nextUInt() >> 8) * 0x1p-24f; }
+  ENVGI_HD float nextFloat() { return bitsToFloat01(nextUInt()); }
 };
 
 // 64-bit mixing hash (splitmix64 finaliser), for deriving seeds from pixel and dimension.

@@ -51,10 +51,11 @@ ENVGI_INLINE uint32_t permutationElement(uint32_t i, uint32_t l, uint32_t p) {
   return (i + p) % l;
 }
 
-ENVGI_INLINE float bitsToFloat01(uint32_t v) {
-  float f = float(v >> 8) * 0x1p-24f;
-  return f;
-}
+// Salts that give each use of a pixel's hash its own stream.
+inline constexpr uint32_t kSobolShuffle1D = 0x5bd1e995u, kSobolShuffle2D = 0x68e31da4u;
+inline constexpr uint32_t kOwenSeedX = 0x1234567u, kOwenSeedY = 0x89abcdeu;
+// Photon emission draws from its own streams of the scene's seed, never the camera's.
+inline constexpr uint32_t kPhotonMapStream = 0x9e3779b9u, kSppmPhotonStream = 0x85ebca6bu;
 
 struct Sampler {
   SamplerType type = SamplerType::Independent;
@@ -83,12 +84,12 @@ struct Sampler {
       }
       case SamplerType::Sobol: {
         uint32_t h = uint32_t(hashCombine(pixelHash, d));
-        uint32_t i = permutationElement(index % spp, spp, h ^ 0x5bd1e995u);
+        uint32_t i = permutationElement(index % spp, spp, h ^ kSobolShuffle1D);
         return bitsToFloat01(owenScramble(sobolDim0(i), h));
       }
-      default:
-        return rng.nextFloat();
+      case SamplerType::Independent: break;
     }
+    return rng.nextFloat();
   }
 
   ENVGI_HD Vec2f get2D() {
@@ -110,15 +111,14 @@ struct Sampler {
       case SamplerType::Sobol: {
         // Independent shuffles per dimension pair decorrelate the pairs (Burley 2020).
         uint32_t h = uint32_t(hashCombine(pixelHash, d));
-        uint32_t i = permutationElement(index % spp, spp, h ^ 0x68e31da4u);
-        uint32_t s0 = uint32_t(mixBits(h ^ 0x1234567u)), s1 = uint32_t(mixBits(h ^ 0x89abcdeu));
+        uint32_t i = permutationElement(index % spp, spp, h ^ kSobolShuffle2D);
+        uint32_t s0 = uint32_t(mixBits(h ^ kOwenSeedX)), s1 = uint32_t(mixBits(h ^ kOwenSeedY));
         return {bitsToFloat01(owenScramble(sobolDim0(i), s0)), bitsToFloat01(owenScramble(sobolDim1(i), s1))};
       }
-      default: {
-        float a = rng.nextFloat();
-        return {a, rng.nextFloat()};
-      }
+      case SamplerType::Independent: break;
     }
+    float a = rng.nextFloat();
+    return {a, rng.nextFloat()};
   }
 };
 

@@ -49,13 +49,11 @@ ENVGI_INLINE Vec2f sampleFilter(FilterType f, Vec2f u) {
       auto tent = [](float x) { return x < 0.5f ? std::sqrt(2.f * x) - 1.f : 1.f - std::sqrt(2.f - 2.f * x); };
       return {tent(u.x), tent(u.y)};
     }
-    case FilterType::Gaussian:
-    default: {
-      float r = 0.5f * std::sqrt(-2.f * std::log(fmaxf(1.f - u.x, 1e-12f)));
-      float phi = 2.f * kPi * u.y;
-      return {r * std::cos(phi), r * std::sin(phi)};
-    }
+    case FilterType::Gaussian: break;
   }
+  float r = 0.5f * std::sqrt(-2.f * std::log(fmaxf(1.f - u.x, 1e-12f)));
+  float phi = 2.f * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi)};
 }
 
 }  // namespace envgi

@@ -9,11 +9,11 @@ namespace envgi {
 void Scene::finalize() {
   if (bsdfs.empty()) bsdfs.push_back(Bsdf{});
   // The collapsed map, for the points strategy: made here so every device reads the same lights.
-  if (env && integrator.strategy == "points") {
-    if (integrator.pointMethod == "mediancut") env->setPoints(collapseByMedianCut(*env, integrator.pointCount));
-    else if (integrator.pointMethod == "sample")
-      env->setPoints(collapseByWeightedSampling(*env, integrator.pointCount, sampler.seed));
-    else throw std::runtime_error("unknown point_method '" + integrator.pointMethod + "' (sample, mediancut)");
+  if (env && integrator.env.strategy == "points") {
+    if (integrator.env.pointMethod == "mediancut") env->setPoints(collapseByMedianCut(*env, integrator.env.pointCount));
+    else if (integrator.env.pointMethod == "sample")
+      env->setPoints(collapseByWeightedSampling(*env, integrator.env.pointCount, sampler.seed));
+    else throw std::runtime_error("unknown point_method '" + integrator.env.pointMethod + "' (sample, mediancut)");
   }
   // Embree reads vertices with 16-byte loads: keep one element of slack after the last one.
   for (TriangleMesh& m : meshes) m.positions.reserve(m.positions.size() + 1);

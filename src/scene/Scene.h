@@ -8,6 +8,7 @@
 
 #include "envmap/EnvironmentMap.h"
 #include "sampling/Sampler.h"
+#include "scene/IntegratorSettings.h"
 #include "scene/SceneView.h"
 #include "scene/TriangleMesh.h"
 
@@ -26,30 +27,6 @@ struct ShapeEntry {
   int bsdf = 0;
   bool emissive = false;
   Color radiance;
-};
-
-struct IntegratorSettings {
-  std::string type = "path";  // path | direct | photon | sppm
-  int maxDepth = -1;          // -1: unbounded (Russian roulette ends paths)
-  int rrDepth = 5;
-  bool hideEmitters = false;
-  int emitterSamples = -1;    // direct: -1 = default for the strategy
-  int bsdfSamples = -1;
-  std::string strategy = "mis";  // uniform|cosine|bsdf|importance|alias|adaptive|mis|points
-  int pointCount = 64;                // points: lights in the collapsed map
-  std::string pointMethod = "sample"; // points: sample (Algorithm 1 draws) | mediancut
-  // photon (Jensen's two passes; names after Mitsuba 0.6's photon mapper)
-  size_t globalPhotons = 250000;
-  size_t causticPhotons = 250000;
-  int lookupSize = 120;
-  float maxRadius = 0.f;  // 0: 5% of the scene's bounding-sphere radius (caustics: a quarter)
-  int gatherSamples = 8;  // final-gather rays per camera sample
-  bool coneFilter = false;
-  // sppm
-  int passes = 64;
-  size_t photonCount = 100000;  // per pass
-  float initialRadius = 0.f;    // 0: 1% of the bounding-sphere radius
-  float alpha = 2.f / 3.f;
 };
 
 struct SamplerSettings {

@@ -1,5 +1,4 @@
 #include "scene/SceneLoader.h"
-#include "scene/StrategyNames.h"
 
 #include <fmt/format.h>
 #include <pugixml.hpp>
@@ -12,6 +11,8 @@
 #include <stdexcept>
 
 #include "materials/BsdfFactory.h"
+#include "scene/NameTables.h"
+#include "scene/Properties.h"
 
 namespace envgi {
 
@@ -127,13 +128,9 @@ class Loader {
 
   float parseFloat(const SourceFile* f, pugi::xml_node n, const std::string& s) const {
     try {
-      size_t used = 0;
-      float v = std::stof(s, &used);
-      while (used < s.size() && std::isspace((unsigned char)s[used])) ++used;
-      if (used != s.size() || !std::isfinite(v)) throw std::invalid_argument("trailing");
-      return v;
-    } catch (const std::exception&) {
-      fail(f, n, fmt::format("'{}' is not a number", s));
+      return parseFloatValue(s);
+    } catch (const std::runtime_error& e) {
+      fail(f, n, e.what());
     }
   }
   std::vector<float> parseList(const SourceFile* f, pugi::xml_node n, const std::string& s) const {
@@ -195,24 +192,21 @@ class Loader {
     Prop* x = find(p, name);
     if (!x) return def;
     expectTag(f, *x, {"integer"});
-    std::string s = attr(f, x->node, "value");
     try {
-      size_t used = 0;
-      long v = std::stol(s, &used);
-      if (used != s.size()) throw std::invalid_argument("trailing");
-      return int(v);
-    } catch (const std::exception&) {
-      fail(f, x->node, fmt::format("'{}' is not an integer", s));
+      return parseIntValue(attr(f, x->node, "value"));
+    } catch (const std::runtime_error& e) {
+      fail(f, x->node, e.what());
     }
   }
   bool getBool(const SourceFile* f, Props& p, const std::string& name, bool def) {
     Prop* x = find(p, name);
     if (!x) return def;
     expectTag(f, *x, {"boolean"});
-    std::string s = attr(f, x->node, "value");
-    if (s == "true" || s == "1") return true;
-    if (s == "false" || s == "0") return false;
-    fail(f, x->node, fmt::format("'{}' is not a boolean", s));
+    try {
+      return parseBoolValue(attr(f, x->node, "value"));
+    } catch (const std::runtime_error& e) {
+      fail(f, x->node, e.what());
+    }
   }
   std::string getString(const SourceFile* f, Props& p, const std::string& name, const std::string& def) {
     Prop* x = find(p, name);
@@ -360,65 +354,27 @@ class Loader {
     checkAttrs(f, n, {"type", "id", "name"});
     std::string type = attr(f, n, "type");
     Props p = collectProps(f, n);
-    IntegratorSettings& s = scene_.integrator;
-    s.type = type;
-    if (type == "path") {
-      s.maxDepth = getInt(f, p, "max_depth", -1);
-      s.rrDepth = getInt(f, p, "rr_depth", 5);
-      s.hideEmitters = getBool(f, p, "hide_emitters", false);
-      s.strategy = getString(f, p, "strategy", "mis");
-      s.pointCount = getInt(f, p, "point_count", 64);
-      s.pointMethod = getString(f, p, "point_method", "sample");
-    } else if (type == "direct") {
-      int shading = getInt(f, p, "shading_samples", -1);
-      s.emitterSamples = getInt(f, p, "emitter_samples", shading);
-      s.bsdfSamples = getInt(f, p, "bsdf_samples", shading);
-      s.hideEmitters = getBool(f, p, "hide_emitters", false);
-      s.strategy = getString(f, p, "strategy", "mis");
-      s.pointCount = getInt(f, p, "point_count", 64);
-      s.pointMethod = getString(f, p, "point_method", "sample");
-    } else if (type == "photon" || type == "photonmapper") {
-      s.type = "photon";
-      s.maxDepth = getInt(f, p, "max_depth", 16);
-      s.hideEmitters = getBool(f, p, "hide_emitters", false);
-      s.strategy = getString(f, p, "strategy", "mis");
-      int g = getInt(f, p, "global_photons", 250000), c = getInt(f, p, "caustic_photons", 250000);
-      if (g < 0 || c < 0) fail(f, n, "photon counts must not be negative");
-      s.globalPhotons = size_t(g);
-      s.causticPhotons = size_t(c);
-      s.lookupSize = getInt(f, p, "lookup_size", 120);
-      if (s.lookupSize < 1 || s.lookupSize > 512) fail(f, n, "lookup_size must be between 1 and 512");
-      s.maxRadius = getFloat(f, p, "max_radius", 0.f);
-      s.gatherSamples = getInt(f, p, "gather_samples", 8);
-      s.coneFilter = getBool(f, p, "cone_filter", false);
-      if (s.maxRadius < 0.f || s.gatherSamples < 0) fail(f, n, "max_radius and gather_samples must not be negative");
-    } else if (type == "sppm") {
-      s.maxDepth = getInt(f, p, "max_depth", 16);
-      s.strategy = getString(f, p, "strategy", "mis");
-      s.passes = getInt(f, p, "passes", 64);
-      int pc = getInt(f, p, "photon_count", 100000);
-      s.initialRadius = getFloat(f, p, "initial_radius", 0.f);
-      s.alpha = getFloat(f, p, "alpha", 2.f / 3.f);
-      if (s.passes < 1 || pc < 1) fail(f, n, "passes and photon_count must be positive");
-      if (!(s.alpha > 0.f && s.alpha < 1.f)) fail(f, n, "alpha must be in (0, 1)");
-      if (s.initialRadius < 0.f) fail(f, n, "initial_radius must not be negative");
-      s.photonCount = size_t(pc);
-    } else {
-      fail(f, n, fmt::format("unknown integrator type '{}' (path, direct, photon, sppm)", type));
-    }
     try {
-      findStrategy(s.strategy);
+      Properties props = scalarProperties(f, n, p);
+      scene_.integrator = IntegratorSettings::fromProperties(findIntegrator(type), props);
+      for (const auto& [name, where] : props.unused())
+        warnOnce(fmt::format("{}: property '{}' of integrator '{}' is not supported and was ignored", where, name, type));
     } catch (const std::runtime_error& e) {
-      fail(f, n, e.what());
+      rethrowAt(f, n, e);
     }
-    if (s.pointCount < 1) fail(f, n, "point_count must be at least 1");
-    if (s.pointMethod != "sample" && s.pointMethod != "mediancut")
-      fail(f, n, fmt::format("unknown point_method '{}' (sample, mediancut)", s.pointMethod));
-    if (s.maxDepth < -1 || s.maxDepth == 0) fail(f, n, "max_depth must be -1 or at least 1");
-    if (s.emitterSamples < -1 || s.bsdfSamples < -1) fail(f, n, "sample counts must not be negative");
-    warnUnused(f, p, "integrator '" + type + "'");
     for (pugi::xml_node c : n.children())
       if (c.type() == pugi::node_element && !isPropTag(c.name())) fail(f, c, fmt::format("unexpected <{}> in <integrator>", c.name()));
+  }
+
+  // A plugin's properties as plain values, each with its own file and line.
+  Properties scalarProperties(const SourceFile* f, pugi::xml_node n, Props& p) {
+    Properties out(fmt::format("{}:{}", f->path, f->lineOf(n.offset_debug())));
+    for (auto& [name, prop] : p) {
+      prop.used = true;
+      out.set(name, prop.tag, attr(f, prop.node, "value", false),
+              fmt::format("{}:{}", f->path, f->lineOf(prop.node.offset_debug())));
+    }
+    return out;
   }
 
   static bool isPropTag(const std::string& t) {
@@ -496,10 +452,11 @@ class Loader {
       if (tag == "rfilter") {
         checkAttrs(f, c, {"type", "name", "id"});
         std::string t = attr(f, c, "type");
-        if (t == "box") cam.filter = FilterType::Box;
-        else if (t == "tent") cam.filter = FilterType::Tent;
-        else if (t == "gaussian") cam.filter = FilterType::Gaussian;
-        else fail(f, c, fmt::format("unknown rfilter type '{}' (box, tent, gaussian)", t));
+        try {
+          cam.filter = findName(kFilterNames, t, "rfilter type");
+        } catch (const std::runtime_error& e) {
+          fail(f, c, e.what());
+        }
         Props fp = collectProps(f, c);
         warnUnused(f, fp, "rfilter");
       } else if (!isPropTag(tag)) {
@@ -512,10 +469,11 @@ class Loader {
     checkAttrs(f, n, {"type", "id", "name"});
     std::string type = attr(f, n, "type");
     SamplerSettings& s = scene_.sampler;
-    if (type == "independent") s.type = SamplerType::Independent;
-    else if (type == "stratified" || type == "multijitter") s.type = SamplerType::Stratified;
-    else if (type == "ldsampler" || type == "sobol" || type == "orthogonal") s.type = SamplerType::Sobol;
-    else fail(f, n, fmt::format("unknown sampler type '{}' (independent, stratified, ldsampler)", type));
+    try {
+      s.type = findSampler(type);
+    } catch (const std::runtime_error& e) {
+      fail(f, n, e.what());
+    }
     Props p = collectProps(f, n);
     s.sampleCount = getInt(f, p, "sample_count", 4);
     s.seed = uint32_t(getInt(f, p, "seed", 0));

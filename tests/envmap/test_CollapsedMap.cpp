@@ -60,10 +60,10 @@ TEST(CollapsedMap, ImageApproachesTheUnbiasedOneAsNGrows) {
   auto scene = test::sphereOnFloor(floor, floor, 3.f, skyWithSun(), Vec3f(0, 2.5f, 5.f), Vec3f(0, 0.6f, 0), 24, 40.f);
   auto run = [&](const std::string& strategy, int n, const std::string& method, int spp) {
     scene->integrator = IntegratorSettings{};
-    scene->integrator.type = "direct";
-    scene->integrator.strategy = strategy;
-    scene->integrator.pointCount = n;
-    scene->integrator.pointMethod = method;
+    scene->integrator.type = IntegratorType::Direct;
+    scene->integrator.env.strategy = strategy;
+    scene->integrator.env.pointCount = n;
+    scene->integrator.env.pointMethod = method;
     scene->finalize();
     EmbreeAccel accel(*scene);
     RenderOptions o;
@@ -87,8 +87,8 @@ TEST(CollapsedMap, ImageApproachesTheUnbiasedOneAsNGrows) {
   mirror.perfectMirror = true;
   scene->bsdfs[1] = mirror;
   scene->integrator = IntegratorSettings{};
-  scene->integrator.type = "path";
-  scene->integrator.strategy = "points";
+  scene->integrator.type = IntegratorType::Path;
+  scene->integrator.env.strategy = "points";
   scene->finalize();
   EmbreeAccel accel(*scene);
   RenderOptions o;

@@ -10,6 +10,7 @@
 #include "gpu/CudaExecutor.h"
 #include "gpu/GpuSceneFiles.h"
 #include "render/Renderer.h"
+#include "scene/NameTables.h"
 #include "scene/SceneLoader.h"
 #include "support/RegionZTest.h"
 
@@ -60,8 +61,8 @@ TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
     Scene s;
     loadScene(test::bundledScenesDir() + "/" + c.scene + ".xml", {}, s);
     s.camera.width = s.camera.height = kRes;
-    s.integrator.type = c.integrator;
-    s.integrator.strategy = c.strategy;
+    s.integrator.type = findIntegrator(c.integrator);
+    s.integrator.env.strategy = c.strategy;
     s.sampler.seed = 1;
     s.finalize();
     Result cpu = renderOn(false, s, 128);

@@ -5,6 +5,7 @@
 
 #include "support/ChiSquare.h"
 #include "support/TestScenes.h"
+#include "scene/NameTables.h"
 
 using namespace envgi;
 
@@ -39,9 +40,9 @@ struct Result {
 
 Result run(Scene& s, const std::string& integrator, const std::string& strategy, uint32_t seed) {
   s.integrator = IntegratorSettings{};
-  s.integrator.type = integrator;
-  s.integrator.strategy = strategy;
-  if (integrator == "path") s.integrator.maxDepth = 2;
+  s.integrator.type = findIntegrator(integrator);
+  s.integrator.env.strategy = strategy;
+  if (integrator == "path") s.integrator.path.maxDepth = 2;
   s.sampler.seed = seed;
   s.finalize();
   EmbreeAccel accel(s);

@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "support/CausticScene.h"
+#include "scene/NameTables.h"
 
 using namespace envgi;
 
@@ -16,8 +17,8 @@ struct Timed {
 };
 
 Timed run(Scene& s, const std::string& type, int spp) {
-  s.integrator.type = type;
-  s.integrator.maxDepth = type == "path" ? 16 : s.integrator.maxDepth;
+  s.integrator.type = findIntegrator(type);
+  s.integrator.path.maxDepth = 16;
   s.sampler.sampleCount = spp;
   s.sampler.type = SamplerType::Independent;
   s.finalize();
@@ -57,9 +58,9 @@ void equalTime(bool chrome) {
   }
   ASSERT_GT(region.size(), 10u);
   // Many cheap passes: each pass is also one camera sample (direct light, anti-aliasing).
-  s.integrator.passes = 512;
-  s.integrator.photonCount = 25000;
-  s.integrator.maxDepth = 16;
+  s.integrator.sppm.passes = 512;
+  s.integrator.sppm.photonCount = 25000;
+  s.integrator.sppm.maxDepth = 16;
   Timed sppm = run(s, "sppm", -1);
   Timed probe = run(s, "path", 16);
   int spp = std::max(1, int(16.0 * sppm.seconds / probe.seconds));

@@ -8,9 +8,10 @@
 #include "integrators/Sppm.h"
 #include "materials/BsdfFactory.h"
 #include "photon/HashGrid.h"
-#include "photon/PhotonShooter.h"
+#include "render/PhotonShooter.h"
 #include "sampling/Pcg32.h"
 #include "support/TestScenes.h"
+#include "scene/NameTables.h"
 
 using namespace envgi;
 
@@ -105,7 +106,10 @@ TEST(PhotonMapEstimate, UniformDensityGivesDiffuseRadiance) {
     }
     EXPECT_NEAR(mean, 0.5 / kPi * E, 0.015 * 0.5 / kPi * E) << "cone " << cone << ", mean of " << lookups;
   }
-  map.precomputeIrradiance(200, 0.5f, 4);
+  size_t points = map.beginIrradiance(4);
+  EXPECT_EQ(points, (map.size() + 3) / 4);
+  for (size_t i = 0; i < points; ++i) map.estimateIrradiance(i, 200, 0.5f);
+  map.endIrradiance();
   EXPECT_NEAR(map.irradiance(si.p, Vec3f(0, 0, 1)).x, E, 0.1f * E);
   EXPECT_EQ(map.irradiance(si.p, Vec3f(0, 0, -1)).x, 0.f) << "the back side has no irradiance point";
   // The lookup is bounded by the radius each point was estimated over: 100 units away, where no
@@ -150,9 +154,9 @@ TEST(PhotonIntegrators, BlackMapShootsNothingAndRendersBlack) {
   shootPhotons(*scene, accel, ps, &g, &c, nullptr);
   EXPECT_EQ(g.size() + c.size(), 0u);
   for (const char* type : {"photon", "sppm"}) {
-    scene->integrator.type = type;
-    scene->integrator.passes = 3;
-    scene->integrator.photonCount = 1000;
+    scene->integrator.type = findIntegrator(type);
+    scene->integrator.sppm.passes = 3;
+    scene->integrator.sppm.photonCount = 1000;
     RenderOptions o;
     o.progress = false;
     RenderStats st;
@@ -196,13 +200,13 @@ TEST(PhotonEmission, CompensatedMapStillEmitsEverywhere) {
     double mean = sum[k] / n, se = std::sqrt(std::max(0.0, sumSq[k] / n - mean * mean) / n);
     EXPECT_NEAR(mean, power[k], 5.0 * se + 1e-6) << "channel " << k;
   }
-  scene->integrator.type = "direct";
-  scene->integrator.strategy = "importance";
+  scene->integrator.type = IntegratorType::Direct;
+  scene->integrator.env.strategy = "importance";
   EmbreeAccel accel(*scene);
   RenderOptions ro;
   ro.progress = false;
   EXPECT_THROW(render(*scene, accel, ro, nullptr), std::runtime_error);
-  scene->integrator.strategy = "mis";
+  scene->integrator.env.strategy = "mis";
   EXPECT_NO_THROW(render(*scene, accel, ro, nullptr));
 }
 
@@ -250,11 +254,11 @@ TEST(PhotonIntegrators, EmissiveClosedBoxGivesLeOverOneMinusRho) {
   };
   for (Run r : {Run{"path", 64, 0.01}, Run{"sppm", 64, 0.02}, Run{"photon", 8, 0.03}}) {
     s->integrator = IntegratorSettings{};
-    s->integrator.type = r.type;
-    s->integrator.photonCount = 20000;
-    s->integrator.globalPhotons = 100000;
-    s->integrator.causticPhotons = 1000;
-    s->integrator.gatherSamples = 8;
+    s->integrator.type = findIntegrator(r.type);
+    s->integrator.sppm.photonCount = 20000;
+    s->integrator.photon.globalPhotons = 100000;
+    s->integrator.photon.causticPhotons = 1000;
+    s->integrator.photon.gatherSamples = 8;
     s->finalize();
     RenderOptions o;
     o.progress = false;

@@ -4,6 +4,7 @@
 
 #include "materials/BsdfFactory.h"
 #include "support/CausticScene.h"
+#include "scene/NameTables.h"
 
 using namespace envgi;
 
@@ -26,7 +27,7 @@ std::unique_ptr<Scene> diffuseScene(bool glassSphere) {
 }
 
 Image run(Scene& s, const std::string& type, int spp, std::vector<float>* var = nullptr) {
-  s.integrator.type = type;
+  s.integrator.type = findIntegrator(type);
   s.sampler.sampleCount = spp;
   s.finalize();
   EmbreeAccel accel(s);
@@ -45,8 +46,8 @@ TEST(PhotonConsistency, SppmMatchesPathOnDiffuseScene) {
   auto scene = diffuseScene(false);
   std::vector<float> var;
   Image ref = run(*scene, "path", 1024, &var);
-  scene->integrator.passes = 128;
-  scene->integrator.photonCount = 20000;
+  scene->integrator.sppm.passes = 128;
+  scene->integrator.sppm.photonCount = 20000;
   Image sppm = run(*scene, "sppm", -1);
   for (int ry = 0; ry < 16; ry += 4)
     for (int rx = 0; rx < 16; rx += 4) {
@@ -65,9 +66,9 @@ TEST(PhotonConsistency, PhotonErrorFallsWithPhotonCount) {
   auto scene = diffuseScene(false);
   Image ref = run(*scene, "path", 1024);
   auto rmse = [&](size_t photons) {
-    scene->integrator.globalPhotons = photons;
-    scene->integrator.causticPhotons = photons / 4;
-    scene->integrator.gatherSamples = 0;  // read the global map directly: the photon error shows
+    scene->integrator.photon.globalPhotons = photons;
+    scene->integrator.photon.causticPhotons = photons / 4;
+    scene->integrator.photon.gatherSamples = 0;  // read the global map directly: the photon error shows
     Image img = run(*scene, "photon", 16);
     double e = 0;
     for (size_t i = 0; i < img.rgb.size(); ++i) e += sqr(img.rgb[i] - ref.rgb[i]);
@@ -88,11 +89,11 @@ TEST(PhotonConsistency, CausticAppearsUnderGlass) {
   ASSERT_GT(ring.size(), 20u);
   for (const char* type : {"sppm", "photon"}) {
     Scene& s = *cs.scene;
-    s.integrator.passes = 24;
-    s.integrator.photonCount = 100000;
-    s.integrator.globalPhotons = 20000;
-    s.integrator.causticPhotons = 100000;
-    s.integrator.gatherSamples = 2;
+    s.integrator.sppm.passes = 24;
+    s.integrator.sppm.photonCount = 100000;
+    s.integrator.photon.globalPhotons = 20000;
+    s.integrator.photon.causticPhotons = 100000;
+    s.integrator.photon.gatherSamples = 2;
     Image img = run(s, type, 4);
     double a = test::meanLum(img, focus), b = test::meanLum(img, ring);
     EXPECT_GT(a, 1.5 * b) << type << ": caustic " << a << " vs surround " << b;
@@ -116,12 +117,12 @@ TEST(PhotonConsistency, SmoothPlasticReflectsLitSurfaces) {
   auto scene = test::sphereOnFloor(floor, ball, 4.f, std::move(sky), Vec3f(0, 1.2f, 5.f), Vec3f(0, 0.6f, 0), 16, 40.f);
   std::vector<float> var;
   Image ref = run(*scene, "path", 1024, &var);
-  scene->integrator.passes = 256;
-  scene->integrator.photonCount = 40000;
+  scene->integrator.sppm.passes = 256;
+  scene->integrator.sppm.photonCount = 40000;
   Image sppm = run(*scene, "sppm", -1);
-  scene->integrator.globalPhotons = 100000;
-  scene->integrator.causticPhotons = 20000;
-  scene->integrator.gatherSamples = 8;
+  scene->integrator.photon.globalPhotons = 100000;
+  scene->integrator.photon.causticPhotons = 20000;
+  scene->integrator.photon.gatherSamples = 8;
   Image photon = run(*scene, "photon", 64);
   for (int ry = 0; ry < 16; ry += 4)
     for (int rx = 0; rx < 16; rx += 4) {

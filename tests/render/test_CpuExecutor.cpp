@@ -8,6 +8,7 @@
 #include "support/RegionZTest.h"
 #include "support/ChiSquare.h"
 #include "support/TestScenes.h"
+#include "scene/NameTables.h"
 
 using namespace envgi;
 
@@ -42,8 +43,8 @@ TEST(CpuExecutor, BvhKernelsMatchEmbreeOnBundledScenes) {
       Scene s;
       loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/" + name + ".xml", {{"res", "48"}}, s);
       s.camera.width = s.camera.height = 48;  // scenes without a res parameter too
-      s.integrator.type = integrator;
-      if (integrator == "direct") s.integrator.strategy = "mis";
+      s.integrator.type = findIntegrator(integrator);
+      if (integrator == "direct") s.integrator.env.strategy = "mis";
       s.sampler.seed = 3;
       s.finalize();
       Result a = run(s, CpuTracer::Embree, 32);

@@ -68,10 +68,10 @@ TEST(SceneLoader, SensorFilmSamplerIntegrator) {
   EXPECT_EQ(s.sampler.type, SamplerType::Stratified);
   EXPECT_EQ(s.sampler.sampleCount, 9);
   EXPECT_EQ(s.sampler.seed, 4u);
-  EXPECT_EQ(s.integrator.type, "direct");
-  EXPECT_EQ(s.integrator.emitterSamples, 3);
-  EXPECT_EQ(s.integrator.bsdfSamples, 0);
-  EXPECT_EQ(s.integrator.strategy, "adaptive");
+  EXPECT_EQ(s.integrator.type, IntegratorType::Direct);
+  EXPECT_EQ(s.integrator.direct.emitterSamples, 3);
+  EXPECT_EQ(s.integrator.direct.bsdfSamples, 0);
+  EXPECT_EQ(s.integrator.env.strategy, "adaptive");
   ASSERT_TRUE(s.env);
   EXPECT_NEAR(s.env->view().eval(Vec3f(0, 1, 0)).x, 0.25f, 1e-6f);
   // The camera looks from +z towards the origin: the centre ray goes along -z.
@@ -139,7 +139,7 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
       {"<shape type=\"sphere\"><float name=\"radius\" value=\"1.5x\"/></shape>", "'1.5x' is not a number"},
       {"<shape type=\"sphere\"><float name=\"radius\" valeu=\"1\"/></shape>", "unexpected attribute 'valeu'"},
       {"<shape type=\"sphere\"><ref id=\"nothing\"/></shape>", "unknown BSDF id 'nothing'"},
-      {"<integrator type=\"bdpt\"/>", "unknown integrator type 'bdpt'"},
+      {"<integrator type=\"bdpt\"/>", "unknown integrator 'bdpt' (path, direct, photon, sppm)"},
       {"<integrator type=\"direct\"><string name=\"strategy\" value=\"magic\"/></integrator>", "unknown strategy 'magic'"},
       {"<emitter type=\"envmap\"><string name=\"filename\" value=\"missing.exr\"/></emitter>", "cannot open image"},
       {"<shape type=\"sphere\"><float name=\"radius\" value=\"$undefined\"/></shape>", "undefined parameter '$undefined'"},

@@ -20,8 +20,8 @@ inline std::unique_ptr<Scene> furnaceScene(const Bsdf& b, int res, int spp) {
   s->camera.filter = FilterType::Box;
   s->sampler.sampleCount = spp;
   s->sampler.type = SamplerType::Sobol;
-  s->integrator.type = "path";
-  s->integrator.maxDepth = 64;
+  s->integrator.type = IntegratorType::Path;
+  s->integrator.path.maxDepth = 64;
   s->finalize();
   return s;
 }

@@ -1,4 +1,4 @@
-#include "photon/PhotonShooter.h"
+#include "render/PhotonShooter.h"
 
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
@@ -44,7 +44,7 @@ void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShoo
     tbb::parallel_for(0, chunks, [&](int ci) {
       Sampler smp;
       smp.type = SamplerType::Independent;
-      smp.seed = s.seed ^ 0x9e3779b9u;
+      smp.seed = s.seed ^ kPhotonMapStream;
       for (int j = 0; j < chunk; ++j) {
         uint64_t id = emitted + uint64_t(ci) * chunk + j;
         smp.start(id, 0);
@@ -95,8 +95,13 @@ void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShoo
   global->build(std::move(g));
   caustic->build(std::move(c));
   if (s.irradianceStride > 0) {
-    global->precomputeIrradiance(s.irradianceLookup, s.irradianceRadius, s.irradianceStride);
-    caustic->precomputeIrradiance(s.irradianceLookup, 0.25f * s.irradianceRadius, s.irradianceStride);
+    auto precompute = [&](PhotonMap* map, float radius) {
+      size_t n = map->beginIrradiance(s.irradianceStride);
+      tbb::parallel_for(size_t(0), n, [&](size_t i) { map->estimateIrradiance(i, s.irradianceLookup, radius); });
+      map->endIrradiance();
+    };
+    precompute(global, s.irradianceRadius);
+    precompute(caustic, s.causticIrradianceRadius);
   }
   if (stats) {
     stats->traceSeconds = std::chrono::duration<double>(t1 - t0).count();

@@ -1,5 +1,6 @@
-// The first pass on the CPU: shoots photons in deterministic batches until the global and
-// caustic maps hold the requested counts, then builds both kd-trees.
+// The photon map's first pass on the CPU (Embree, oneTBB): shoots photons in deterministic
+// batches until the global and caustic maps hold the requested counts, then builds both
+// kd-trees.
 #pragma once
 
 #include "accel/EmbreeAccel.h"
@@ -11,7 +12,7 @@ namespace envgi {
 struct PhotonShootSettings {
   size_t globalPhotons = 250000;   // stored photons wanted in the global map (0: none)
   size_t causticPhotons = 250000;  // and in the caustic map
-  int maxDepth = 16;
+  int maxDepth = kSpecularChainDepth;
   uint32_t seed = 0;
   bool progress = true;
   // Precomputed irradiance (Christensen 1999) at every stride-th photon, for final-gather
@@ -19,6 +20,7 @@ struct PhotonShootSettings {
   int irradianceStride = 0;
   int irradianceLookup = 64;
   float irradianceRadius = 0.1f;
+  float causticIrradianceRadius = 0.025f;
 };
 
 struct PhotonShootStats {

@@ -1,0 +1,104 @@
+#include "scene/IntegratorSettings.h"
+
+#include "scene/NameTables.h"
+
+namespace envgi {
+
+EnvSamplingSettings EnvSamplingSettings::fromProperties(Properties& p) {
+  EnvSamplingSettings s;
+  s.strategy = p.getString("strategy", s.strategy);
+  s.pointCount = p.getInt("point_count", s.pointCount);
+  s.pointMethod = p.getString("point_method", s.pointMethod);
+  try {
+    findStrategy(s.strategy);
+  } catch (const std::runtime_error& e) {
+    p.fail(e.what());
+  }
+  if (s.pointCount < 1) p.fail("point_count must be at least 1");
+  if (s.pointMethod != "sample" && s.pointMethod != "mediancut")
+    p.fail("unknown point_method '" + s.pointMethod + "' (sample, mediancut)");
+  return s;
+}
+
+static int readMaxDepth(Properties& p, int def) {
+  int d = p.getInt("max_depth", def);
+  if (d < -1 || d == 0) p.fail("max_depth must be -1 or at least 1");
+  return d;
+}
+
+// The path-length and emitter properties that path and photon share (Mitsuba's names); the
+// pointers hold the defaults on entry.
+static void readPathProperties(Properties& p, int* maxDepth, int* rrDepth, bool* hideEmitters) {
+  *maxDepth = readMaxDepth(p, *maxDepth);
+  *rrDepth = p.getInt("rr_depth", *rrDepth);
+  *hideEmitters = p.getBool("hide_emitters", *hideEmitters);
+  if (*rrDepth < 1) p.fail("rr_depth must be at least 1");
+}
+
+PathSettings PathSettings::fromProperties(Properties& p) {
+  PathSettings s;
+  readPathProperties(p, &s.maxDepth, &s.rrDepth, &s.hideEmitters);
+  return s;
+}
+
+DirectSettings DirectSettings::fromProperties(Properties& p) {
+  DirectSettings s;
+  int shading = p.getInt("shading_samples", -1);
+  s.emitterSamples = p.getInt("emitter_samples", shading);
+  s.bsdfSamples = p.getInt("bsdf_samples", shading);
+  s.hideEmitters = p.getBool("hide_emitters", s.hideEmitters);
+  if (s.emitterSamples < -1 || s.bsdfSamples < -1) p.fail("sample counts must not be negative");
+  return s;
+}
+
+PhotonSettings PhotonSettings::fromProperties(Properties& p) {
+  PhotonSettings s;
+  readPathProperties(p, &s.maxDepth, &s.rrDepth, &s.hideEmitters);
+  int g = p.getInt("global_photons", int(s.globalPhotons)), c = p.getInt("caustic_photons", int(s.causticPhotons));
+  if (g < 0 || c < 0) p.fail("photon counts must not be negative");
+  s.globalPhotons = size_t(g);
+  s.causticPhotons = size_t(c);
+  s.lookupSize = p.getInt("lookup_size", s.lookupSize);
+  if (s.lookupSize < 1 || s.lookupSize > kMaxPhotonLookup)
+    p.fail("lookup_size must be between 1 and " + std::to_string(kMaxPhotonLookup));
+  s.maxRadius = p.getFloat("max_radius", s.maxRadius);
+  s.gatherSamples = p.getInt("gather_samples", s.gatherSamples);
+  s.coneFilter = p.getBool("cone_filter", s.coneFilter);
+  if (s.maxRadius < 0.f || s.gatherSamples < 0) p.fail("max_radius and gather_samples must not be negative");
+  return s;
+}
+
+SppmSettings SppmSettings::fromProperties(Properties& p) {
+  SppmSettings s;
+  s.maxDepth = readMaxDepth(p, s.maxDepth);
+  s.passes = p.getInt("passes", s.passes);
+  int pc = p.getInt("photon_count", int(s.photonCount));
+  s.initialRadius = p.getFloat("initial_radius", s.initialRadius);
+  s.alpha = p.getFloat("alpha", s.alpha);
+  if (s.passes < 1 || pc < 1) p.fail("passes and photon_count must be positive");
+  if (!(s.alpha > 0.f && s.alpha < 1.f)) p.fail("alpha must be in (0, 1)");
+  if (s.initialRadius < 0.f) p.fail("initial_radius must not be negative");
+  s.photonCount = size_t(pc);
+  return s;
+}
+
+IntegratorSettings IntegratorSettings::fromProperties(IntegratorType type, Properties& p) {
+  IntegratorSettings s;
+  s.type = type;
+  s.env = EnvSamplingSettings::fromProperties(p);
+  switch (type) {
+    case IntegratorType::Path: s.path = PathSettings::fromProperties(p); break;
+    case IntegratorType::Direct: s.direct = DirectSettings::fromProperties(p); break;
+    case IntegratorType::Photon: s.photon = PhotonSettings::fromProperties(p); break;
+    case IntegratorType::Sppm: s.sppm = SppmSettings::fromProperties(p); break;
+  }
+  return s;
+}
+
+void IntegratorSettings::setStrategy(const std::string& name) {
+  findStrategy(name);
+  env.strategy = name;
+  direct.emitterSamples = direct.bsdfSamples = -1;
+}
+
+}  // namespace envgi
