@@ -74,10 +74,10 @@ Image renderPhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOpt
   php.caustic.maxRadius = ps.causticRadius(sceneRadius);
   php.global.coneFilter = php.caustic.coneFilter = ps.coneFilter;
   php.gatherSamples = ps.gatherSamples;
-  php.maxDepth = ps.maxDepth;
-  php.rrDepth = ps.rrDepth;
-  php.hideEmitters = ps.hideEmitters;
-  php.strategy = findStrategy(scene.integrator.env.strategy).env;
+  php.chain.maxDepth = ps.maxDepth;
+  php.chain.rrDepth = ps.rrDepth;
+  php.chain.hideEmitters = ps.hideEmitters;
+  php.chain.strategy = findStrategy(scene.integrator.env.strategy).env;
   EmbreeTracer embree{&accel};
   auto photon = [&](const Ray& ray, Sampler& smp, uint64_t* rays) {
     return photonTrace(sc, embree, ray, smp, globalMap, causticMap, php, rays);

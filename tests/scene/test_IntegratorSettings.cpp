@@ -65,9 +65,9 @@ TEST(IntegratorSettings, KernelDefaultsAgreeWithSettings) {
   EXPECT_EQ(path.env.strategy, "mis");
   IntegratorSettings photon = IntegratorSettings::fromProperties(IntegratorType::Photon, none);
   EXPECT_EQ(photon.photon.gatherSamples, PhotonRenderParams{}.gatherSamples);
-  EXPECT_EQ(photon.photon.maxDepth, PhotonRenderParams{}.maxDepth);
+  EXPECT_EQ(photon.photon.maxDepth, PhotonRenderParams{}.chain.maxDepth);
   EXPECT_EQ(photon.photon.maxDepth, PhotonShootSettings{}.maxDepth);
-  EXPECT_EQ(photon.photon.rrDepth, PhotonRenderParams{}.rrDepth);
+  EXPECT_EQ(photon.photon.rrDepth, PhotonRenderParams{}.chain.rrDepth);
   IntegratorSettings sppm = IntegratorSettings::fromProperties(IntegratorType::Sppm, none);
   EXPECT_EQ(sppm.sppm.maxDepth, SppmParams{}.maxDepth);
   EXPECT_EQ(sppm.sppm.photonCount, SppmParams{}.photonsPerPass);
