@@ -10,6 +10,7 @@
 #include "accel/Bvh.h"
 #include "render/CpuExecutor.h"
 #include "integrators/PhotonIntegrator.h"
+#include "render/IlluminationGridBuilder.h"
 #include "render/SppmExecutor.h"
 #include "scene/NameTables.h"
 #include "render/PhotonShooter.h"
@@ -26,6 +27,44 @@ void logPhotonStats(const PhotonShootStats& st) {
                st.storedGlobal, st.emittedGlobal, st.storedCaustic, st.emittedCaustic, st.traceSeconds,
                st.buildSeconds, st.bytes / 1e6,
                st.storedGlobal + st.storedCaustic > 0 ? st.bytes / (st.storedGlobal + st.storedCaustic) : 0);
+}
+
+// Shoots the global and caustic maps for the photon and grid integrators, with precomputed
+// irradiance (stride 4) when final gathers will read it.
+void shootMaps(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, const PhotonSettings& ps,
+               bool precompute, PhotonMap* globalMap, PhotonMap* causticMap) {
+  float sceneRadius = makePhotonEmitter(scene).radius;
+  PhotonShootSettings shoot;
+  shoot.globalPhotons = ps.globalPhotons;
+  shoot.causticPhotons = ps.causticPhotons;
+  shoot.maxDepth = ps.maxDepth;
+  shoot.irradianceRadius = ps.globalRadius(sceneRadius);
+  shoot.causticIrradianceRadius = ps.causticRadius(sceneRadius);
+  shoot.irradianceStride = precompute ? 4 : 0;
+  shoot.seed = scene.sampler.seed;
+  shoot.progress = opts.progress;
+  PhotonShootStats pst;
+  shootPhotons(scene, accel, shoot, globalMap, causticMap, &pst);
+  logPhotonStats(pst);
+}
+
+ChainParams chainParams(const Scene& scene, int maxDepth, int rrDepth, bool hideEmitters) {
+  ChainParams c;
+  c.maxDepth = maxDepth;
+  c.rrDepth = rrDepth;
+  c.hideEmitters = hideEmitters;
+  c.strategy = findStrategy(scene.integrator.env.strategy).env;
+  return c;
+}
+
+// Camera passes on the CPU for an integrator that has done its own preparation.
+template <class Integrator>
+Image renderCameraPasses(const Scene& scene, const Integrator& integ, int spp, const RenderOptions& opts,
+                         RenderStats* stats) {
+  const Camera& cam = scene.view().camera;
+  SampleSequence seq{scene.sampler.type, uint32_t(spp), scene.sampler.seed};
+  CpuExecutor<Integrator> ex(cam, seq, integ, opts.threads, opts.varianceOut != nullptr, "cpu", opts.tileSize);
+  return renderPasses(ex, cam.width, cam.height, spp, opts, stats);
 }
 
 Image renderSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
@@ -49,43 +88,55 @@ Image renderSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptio
   return img;
 }
 
+// Photon maps, the grid filled from them, then the camera passes; the grid is not refined
+// while the passes run.
+Image renderGrid(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
+  const GridSettings& gs = scene.integrator.grid;
+  const SceneView& sc = scene.view();
+  int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
+  if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
+  PhotonSettings maps;  // the photon integrator's lookup radii, the grid's photon counts
+  maps.globalPhotons = gs.globalPhotons;
+  maps.causticPhotons = gs.causticPhotons;
+  maps.maxDepth = gs.maxDepth;
+  PhotonMap globalMap, causticMap;
+  shootMaps(scene, accel, opts, maps, true, &globalMap, &causticMap);
+  GridParams gp;
+  gp.chain = chainParams(scene, gs.maxDepth, gs.rrDepth, gs.hideEmitters);
+  IlluminationGrid grid = makeIlluminationGrid(scene, gs.resolution);
+  GridBuildStats gst;
+  gatherIntoGrid(grid, scene, accel, globalMap, causticMap, gp.chain, scene.sampler.seed, 0, gs.gatherRays, &gst);
+  const IlluminationGridView& gv = grid.view();
+  spdlog::info("grid: {}x{}x{} points ({} inside geometry), {} gather rays each, {:.2f} M rays in {:.2f} s, {:.1f} MB",
+               gv.nx, gv.ny, gv.nz, gst.insidePoints, gs.gatherRays, gst.rays / 1e6, gst.seconds, grid.bytes() / 1e6);
+  EmbreeTracer embree{&accel};
+  auto caustics = [&](Vec3f p, Vec3f n) { return causticMap.irradiance(p, n); };
+  auto integ = [&](const Ray& ray, Sampler& smp, uint64_t* rays) {
+    return gridTrace(sc, embree, ray, smp, gv, caustics, gp, rays);
+  };
+  return renderCameraPasses(scene, integ, spp, opts, stats);
+}
+
 Image renderPhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
   const PhotonSettings& ps = scene.integrator.photon;
   const SceneView& sc = scene.view();
   int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
   if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
-  float sceneRadius = makePhotonEmitter(scene).radius;
-  PhotonShootSettings shoot;
-  shoot.globalPhotons = ps.globalPhotons;
-  shoot.causticPhotons = ps.causticPhotons;
-  shoot.maxDepth = ps.maxDepth;
-  shoot.irradianceRadius = ps.globalRadius(sceneRadius);
-  shoot.causticIrradianceRadius = ps.causticRadius(sceneRadius);
-  shoot.irradianceStride = ps.gatherSamples > 0 ? 4 : 0;
-  shoot.seed = scene.sampler.seed;
-  shoot.progress = opts.progress;
   PhotonMap globalMap, causticMap;
-  PhotonShootStats pst;
-  shootPhotons(scene, accel, shoot, &globalMap, &causticMap, &pst);
-  logPhotonStats(pst);
+  shootMaps(scene, accel, opts, ps, ps.gatherSamples > 0, &globalMap, &causticMap);
+  float sceneRadius = makePhotonEmitter(scene).radius;
   PhotonRenderParams php;
   php.global.k = php.caustic.k = ps.lookupSize;
   php.global.maxRadius = ps.globalRadius(sceneRadius);
   php.caustic.maxRadius = ps.causticRadius(sceneRadius);
   php.global.coneFilter = php.caustic.coneFilter = ps.coneFilter;
   php.gatherSamples = ps.gatherSamples;
-  php.chain.maxDepth = ps.maxDepth;
-  php.chain.rrDepth = ps.rrDepth;
-  php.chain.hideEmitters = ps.hideEmitters;
-  php.chain.strategy = findStrategy(scene.integrator.env.strategy).env;
+  php.chain = chainParams(scene, ps.maxDepth, ps.rrDepth, ps.hideEmitters);
   EmbreeTracer embree{&accel};
   auto photon = [&](const Ray& ray, Sampler& smp, uint64_t* rays) {
     return photonTrace(sc, embree, ray, smp, globalMap, causticMap, php, rays);
   };
-  SampleSequence seq{scene.sampler.type, uint32_t(spp), scene.sampler.seed};
-  CpuExecutor<decltype(photon)> ex(sc.camera, seq, photon, opts.threads, opts.varianceOut != nullptr, "cpu",
-                                   opts.tileSize);
-  return renderPasses(ex, sc.camera.width, sc.camera.height, spp, opts, stats);
+  return renderCameraPasses(scene, photon, spp, opts, stats);
 }
 
 }  // namespace
@@ -98,6 +149,7 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
     case IntegratorType::Direct: k.type = SampleIntegratorType::Direct; break;
     case IntegratorType::Photon:
     case IntegratorType::Sppm:
+    case IntegratorType::Grid:
       throw std::runtime_error(std::string("integrator '") + integratorName(is.type) +
                                "' has no per-sample kernel (path and direct do)");
   }
@@ -192,6 +244,7 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
   switch (scene.integrator.type) {
     case IntegratorType::Sppm: return renderSppm(scene, accel, opts, stats);
     case IntegratorType::Photon: return renderPhoton(scene, accel, opts, stats);
+    case IntegratorType::Grid: return renderGrid(scene, accel, opts, stats);
     case IntegratorType::Path:
     case IntegratorType::Direct: break;
   }

@@ -82,6 +82,20 @@ SppmSettings SppmSettings::fromProperties(Properties& p) {
   return s;
 }
 
+GridSettings GridSettings::fromProperties(Properties& p) {
+  GridSettings s;
+  readPathProperties(p, &s.maxDepth, &s.rrDepth, &s.hideEmitters);
+  s.resolution = p.getInt("resolution", s.resolution);
+  s.gatherRays = p.getInt("gather_rays", s.gatherRays);
+  int g = p.getInt("global_photons", int(s.globalPhotons)), c = p.getInt("caustic_photons", int(s.causticPhotons));
+  if (s.resolution < 2 || s.resolution > 512) p.fail("resolution must be between 2 and 512");
+  if (s.gatherRays < 1) p.fail("gather_rays must be positive");
+  if (g < 0 || c < 0) p.fail("photon counts must not be negative");
+  s.globalPhotons = size_t(g);
+  s.causticPhotons = size_t(c);
+  return s;
+}
+
 IntegratorSettings IntegratorSettings::fromProperties(IntegratorType type, Properties& p) {
   IntegratorSettings s;
   s.type = type;
@@ -91,6 +105,7 @@ IntegratorSettings IntegratorSettings::fromProperties(IntegratorType type, Prope
     case IntegratorType::Direct: s.direct = DirectSettings::fromProperties(p); break;
     case IntegratorType::Photon: s.photon = PhotonSettings::fromProperties(p); break;
     case IntegratorType::Sppm: s.sppm = SppmSettings::fromProperties(p); break;
+    case IntegratorType::Grid: s.grid = GridSettings::fromProperties(p); break;
   }
   return s;
 }

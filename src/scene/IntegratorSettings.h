@@ -11,7 +11,7 @@
 
 namespace envgi {
 
-enum class IntegratorType : int { Path = 0, Direct = 1, Photon = 2, Sppm = 3 };
+enum class IntegratorType : int { Path = 0, Direct = 1, Photon = 2, Sppm = 3, Grid = 4 };
 
 // Chains of mirror and glass bounces (from the camera in photon and sppm, and from a light)
 // end here.
@@ -70,6 +70,19 @@ struct SppmSettings {
   static SppmSettings fromProperties(Properties& p);
 };
 
+// The paper's grid of illumination coefficients: photon maps, then gather rays from every grid
+// point, then per pixel direct light plus the grid's interpolated indirect light.
+struct GridSettings {
+  int resolution = 32;          // grid points along the scene's longest side (others in proportion)
+  int gatherRays = 128;         // rays from each grid point
+  size_t globalPhotons = 200000;
+  size_t causticPhotons = 50000;
+  int maxDepth = kSpecularChainDepth;
+  int rrDepth = kRouletteDepth;
+  bool hideEmitters = false;
+  static GridSettings fromProperties(Properties& p);
+};
+
 struct IntegratorSettings {
   IntegratorType type = IntegratorType::Path;
   EnvSamplingSettings env;
@@ -77,6 +90,7 @@ struct IntegratorSettings {
   DirectSettings direct;
   PhotonSettings photon;
   SppmSettings sppm;
+  GridSettings grid;
 
   // Reads the settings `type` takes (and the environment's); the others keep their defaults.
   static IntegratorSettings fromProperties(IntegratorType type, Properties& p);

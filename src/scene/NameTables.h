@@ -46,6 +46,7 @@ const char* nameOf(const Named<E> (&table)[N], E value) {
 inline constexpr Named<IntegratorType> kIntegratorNames[] = {
     {"path", IntegratorType::Path, false},     {"direct", IntegratorType::Direct, false},
     {"photon", IntegratorType::Photon, false}, {"sppm", IntegratorType::Sppm, false},
+    {"grid", IntegratorType::Grid, false},
     {"photonmapper", IntegratorType::Photon, true},
 };
 

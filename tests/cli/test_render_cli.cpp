@@ -124,16 +124,21 @@ TEST(CliPhotons, DrawsPhotonsAndRejectsBadInput) {
   EXPECT_FALSE(fs::exists(d.file("q.png")));
 }
 
-TEST(CliRender, PhotonAndSppmIntegrators) {
+TEST(CliRender, PhotonSppmAndGridIntegrators) {
   TempDir d;
   std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml";
-  for (const char* integ : {"photon", "sppm"}) {
-    CliResult r = runCli(std::string("render ") + scene + " -o " + d.file("c.exr") + " --integrator " + integ +
+  for (std::string integ : {"photon", "sppm", "grid"}) {
+    CliResult r = runCli("render " + scene + " -o " + d.file("c.exr") + " --integrator " + integ +
                          " --spp 2 -D res=24 --no-progress");
     ASSERT_EQ(r.code, 0) << r.output;
-    EXPECT_NE(r.output.find(std::string(integ) == "sppm" ? "sppm: 2 passes" : "photon pass:"), std::string::npos)
+    EXPECT_NE(r.output.find(integ == "sppm" ? "sppm: 2 passes" : integ == "grid" ? "gather rays each" : "photon pass:"),
+              std::string::npos)
         << r.output;
   }
+  std::ofstream(d.file("grid.xml")) << R"(<scene version="3.0.0"><integrator type="grid"><integer name="resolution" value="1"/></integrator></scene>)";
+  CliResult badGrid = runCli("render " + d.file("grid.xml") + " -o " + d.file("x.exr"));
+  EXPECT_NE(badGrid.code, 0);
+  EXPECT_NE(badGrid.output.find("resolution must be between 2 and 512"), std::string::npos) << badGrid.output;
   std::ofstream(d.file("bad.xml")) << R"(<scene version="3.0.0"><integrator type="sppm"><float name="alpha" value="1.5"/></integrator></scene>)";
   CliResult bad = runCli("render " + d.file("bad.xml") + " -o " + d.file("x.exr"));
   EXPECT_NE(bad.code, 0);

@@ -114,6 +114,7 @@ TEST(IntegratorSettings, RefusesBadValuesAtThePluginsLine) {
   EXPECT_EQ(errorOf(IntegratorType::Sppm, with("alpha", "float", "1")), "s.xml:2: alpha must be in (0, 1)");
   EXPECT_EQ(errorOf(IntegratorType::Direct, with("emitter_samples", "integer", "-2")),
             "s.xml:2: sample counts must not be negative");
+  EXPECT_EQ(errorOf(IntegratorType::Grid, with("gather_rays", "integer", "0")), "s.xml:2: gather_rays must be positive");
   EXPECT_EQ(errorOf(IntegratorType::Path, with("point_method", "string", "kmeans")),
             "s.xml:2: unknown point_method 'kmeans' (sample, mediancut)");
 }
@@ -145,7 +146,7 @@ TEST(NameTables, NamesRoundTripAndUnknownNamesAreErrors) {
   }
   for (const auto& n : kFilterNames) EXPECT_EQ(findName(kFilterNames, n.name, "rfilter type"), n.value);
   for (const auto& n : kStrategyNames) EXPECT_STREQ(findStrategy(n.name).name, n.name);
-  EXPECT_EQ(nameList(kIntegratorNames), "path, direct, photon, sppm");
+  EXPECT_EQ(nameList(kIntegratorNames), "path, direct, photon, sppm, grid");
   EXPECT_EQ(nameList(kSamplerNames), "independent, stratified, sobol");
   EXPECT_EQ(findIntegrator("photonmapper"), IntegratorType::Photon);
   EXPECT_EQ(findSampler("ldsampler"), SamplerType::Sobol);

@@ -139,7 +139,7 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
       {"<shape type=\"sphere\"><float name=\"radius\" value=\"1.5x\"/></shape>", "'1.5x' is not a number"},
       {"<shape type=\"sphere\"><float name=\"radius\" valeu=\"1\"/></shape>", "unexpected attribute 'valeu'"},
       {"<shape type=\"sphere\"><ref id=\"nothing\"/></shape>", "unknown BSDF id 'nothing'"},
-      {"<integrator type=\"bdpt\"/>", "unknown integrator 'bdpt' (path, direct, photon, sppm)"},
+      {"<integrator type=\"bdpt\"/>", "unknown integrator 'bdpt' (path, direct, photon, sppm, grid)"},
       {"<integrator type=\"direct\"><string name=\"strategy\" value=\"magic\"/></integrator>", "unknown strategy 'magic'"},
       {"<emitter type=\"envmap\"><string name=\"filename\" value=\"missing.exr\"/></emitter>", "cannot open image"},
       {"<shape type=\"sphere\"><float name=\"radius\" value=\"$undefined\"/></shape>", "undefined parameter '$undefined'"},

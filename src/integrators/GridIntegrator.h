@@ -1,0 +1,68 @@
+// The paper's interactive method as an integrator (`grid`): camera paths follow mirrors and
+// glass to the first diffuse-like surface, which gets direct light from the map (Algorithm 1,
+// shadow rays, MIS) and indirect light from the illumination grid, trilinearly interpolated,
+// times its albedo / pi. The grid's points are filled by gridGather: rays from each point
+// that read the photon maps one bounce away. Host/device except the photon lookups, which the
+// caller passes in.
+#pragma once
+
+#include "integrators/SpecularChain.h"
+#include "photon/IlluminationGrid.h"
+#include "sampling/Warp.h"
+
+namespace envgi {
+
+struct GridParams {
+  ChainParams chain;
+};
+
+// causticIrradiance(p, n) -> Color: irradiance by light that came through mirrors and glass
+// (the caustic photon map's precomputed irradiance on the CPU).
+template <class Tracer, class CausticIrradiance>
+ENVGI_HD Color gridTrace(const SceneView& sc, const Tracer& tracer, const Ray& ray, Sampler& smp,
+                         const IlluminationGridView& grid, const CausticIrradiance& causticIrradiance,
+                         const GridParams& gp, uint64_t* rays) {
+  auto estimate = [&](const SurfaceInteraction& si, Vec3f wo, Sampler&, uint64_t*) {
+    Vec3f n = faceForward(si.shading.n, wo);
+    Color E = grid.irradiance(si.p, n) + causticIrradiance(si.p, faceForward(si.ng, wo));
+    return diffuseAlbedo(sc.bsdfs[si.bsdf]) * kInvPi * E;
+  };
+  return traceSpecularChain(sc, tracer, ray, smp, gp.chain, estimate, rays);
+}
+
+// Indirect radiance arriving at a grid point from direction ray.d: light that has left a
+// diffuse-like surface at least once, hitRadiance(si, wi, smp, rays) (direct light there plus
+// photon irradiance). Sharp glossy lobes are followed; mirrors and glass end the ray, since
+// what comes through them is a caustic, which the caustic map gives per pixel far less noisily
+// than a few hundred rays a point could. Emitters and the map seen from the point are direct
+// light, which the pixel adds itself. *backFace: the first surface was met from behind (the
+// point is inside something).
+template <class Tracer, class HitRadiance>
+ENVGI_HD Color gridGather(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& smp, const ChainParams& cp,
+                          const HitRadiance& hitRadiance, bool* backFace, uint64_t* rays) {
+  Color beta(1.f);
+  *backFace = false;
+  for (int depth = 0; depth < cp.maxDepth; ++depth) {
+    Hit h;
+    ++*rays;
+    if (!tracer.intersect(ray, &h)) return Color(0.f);
+    SurfaceInteraction si = sc.interaction(ray, h);
+    const Bsdf& bsdf = sc.bsdfs[si.bsdf];
+    if (depth == 0 && dot(si.ng, ray.d) > 0.f && !bsdf.twoSided && !bsdfTransmits(bsdf)) {
+      *backFace = true;
+      return Color(0.f);
+    }
+    if (isDiffuseLike(bsdf, cp.glossyThreshold)) return beta * hitRadiance(si, ray.d, smp, rays);
+    BsdfSample bs;
+    float uc = smp.get1D();
+    Vec2f ub = smp.get2D();
+    if (!bsdfSample(bsdf, si.shading.toLocal(-ray.d), uc, ub, &bs) || bs.delta) return Color(0.f);
+    beta *= bs.weight;
+    if (isBlack(beta)) return Color(0.f);
+    Vec3f wi = si.shading.toWorld(bs.wi);
+    ray = Ray{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};
+  }
+  return Color(0.f);
+}
+
+}  // namespace envgi

@@ -1,0 +1,99 @@
+// The paper's grid of illumination coefficients (Section 3, its GPU steps): incident indirect
+// radiance at the points of a regular n_x x n_y x n_z grid over the scene, stored as L1
+// spherical harmonics (4 RGB coefficients a point), read per pixel by trilinear interpolation
+// and turned into irradiance for the shading normal (Ramamoorthi and Hanrahan 2001: the
+// clamped cosine's SH weights are pi and 2 pi / 3). L1 holds a hemisphere of uniform light
+// exactly, so a point beside a wall keeps which side its light comes from.
+#pragma once
+
+#include <vector>
+
+#include "core/Vec.h"
+
+namespace envgi {
+
+struct ShL1 {
+  Color c[4];  // Y00, Y1-1 (y), Y10 (z), Y11 (x)
+};
+
+// The real SH basis up to l = 1 at unit direction d.
+ENVGI_INLINE void shL1Basis(Vec3f d, float y[4]) {
+  y[0] = 0.282094792f;
+  y[1] = 0.488602512f * d.y;
+  y[2] = 0.488602512f * d.z;
+  y[3] = 0.488602512f * d.x;
+}
+
+// Irradiance for normal n from the SH of incident radiance, clamped at zero (L1 rings).
+ENVGI_INLINE Color shL1Irradiance(const ShL1& s, Vec3f n) {
+  float y[4];
+  shL1Basis(n, y);
+  const float a0 = kPi, a1 = 2.f * kPi / 3.f;
+  Color e = s.c[0] * (a0 * y[0]) + (s.c[1] * y[1] + s.c[2] * y[2] + s.c[3] * y[3]) * a1;
+  return Color(fmaxf(e.x, 0.f), fmaxf(e.y, 0.f), fmaxf(e.z, 0.f));
+}
+
+struct IlluminationGridView {
+  Vec3f lo;             // the grid's first point
+  Vec3f spacing;        // between neighbouring points
+  int nx = 0, ny = 0, nz = 0;
+  const ShL1* sh = nullptr;       // per point, incident radiance
+  const float* weight = nullptr;  // per point: 1 where it sees the scene from outside, 0 inside
+                                  // an object or a wall (its light would leak through)
+
+  ENVGI_HD Vec3f point(int i, int j, int k) const {
+    return lo + Vec3f(spacing.x * float(i), spacing.y * float(j), spacing.z * float(k));
+  }
+  ENVGI_HD int index(int i, int j, int k) const { return (k * ny + j) * nx + i; }
+
+  // Irradiance at p for normal n: the 8 surrounding points' SH, trilinearly weighted; points
+  // inside geometry or behind the surface count less, so light leaks less through walls.
+  ENVGI_HD Color irradiance(Vec3f p, Vec3f n) const {
+    Vec3f g((p.x - lo.x) / spacing.x, (p.y - lo.y) / spacing.y, (p.z - lo.z) / spacing.z);
+    int i0 = clampi(int(floorf(g.x)), 0, nx - 2), j0 = clampi(int(floorf(g.y)), 0, ny - 2),
+        k0 = clampi(int(floorf(g.z)), 0, nz - 2);
+    float fx = clampf(g.x - float(i0), 0.f, 1.f), fy = clampf(g.y - float(j0), 0.f, 1.f),
+          fz = clampf(g.z - float(k0), 0.f, 1.f);
+    Color sum(0.f);
+    float wsum = 0.f;
+    for (int c = 0; c < 8; ++c) {
+      int di = c & 1, dj = (c >> 1) & 1, dk = (c >> 2) & 1;
+      int idx = index(i0 + di, j0 + dj, k0 + dk);
+      float w = (di ? fx : 1.f - fx) * (dj ? fy : 1.f - fy) * (dk ? fz : 1.f - fz) * weight[idx];
+      // A point behind the surface sees the other side of it: weight it down smoothly.
+      Vec3f toPoint = point(i0 + di, j0 + dj, k0 + dk) - p;
+      float len = length(toPoint);
+      float facing = len > 0.f ? 0.5f * (1.f + dot(toPoint, n) / len) : 1.f;
+      w *= facing * facing + 0.05f;
+      if (w <= 0.f) continue;
+      sum += shL1Irradiance(sh[idx], n) * w;
+      wsum += w;
+    }
+    return wsum > 0.f ? sum / wsum : Color(0.f);
+  }
+};
+
+// The grid on the host: running sums of gather rays per point, averaged on request.
+class IlluminationGrid {
+ public:
+  // A grid of the given resolution (at least 2 a side) spanning [lo, hi].
+  IlluminationGrid(Vec3f lo, Vec3f hi, int nx, int ny, int nz);
+  size_t pointCount() const { return size_t(view_.nx) * view_.ny * view_.nz; }
+  Vec3f point(size_t i) const;
+  // Adds n gather rays' radiance projected on SH (already summed) to point i; backHits of them
+  // met a surface from behind. Thread-safe for distinct i.
+  void accumulate(size_t i, const ShL1& sum, int n, int backHits);
+  // Averages the sums into the coefficients kernels read.
+  void finish();
+  const IlluminationGridView& view() const { return view_; }
+  int raysPerPoint() const { return count_.empty() ? 0 : count_[0]; }
+  size_t bytes() const;
+
+ private:
+  std::vector<ShL1> sum_, sh_;
+  std::vector<int> count_, back_;
+  std::vector<float> weight_;
+  IlluminationGridView view_;
+};
+
+}  // namespace envgi
