@@ -1,9 +1,10 @@
 // Photon mapping costs on the Cornell box: photons traced per second and the time of the
 // first pass as the count grows (1e5 to 1e7), radiance lookups per second, bytes per stored
-// photon, and SPPM passes.
+// photon, SPPM passes, and the grid integrator's frame time on the buddha at 512^2.
 // Run: build/bin/envgi_bench_photon --benchmark_repetitions=3 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include "render/GridExecutor.h"
 #include "render/SppmExecutor.h"
 #include "render/PhotonShooter.h"
 #include "sampling/Pcg32.h"
@@ -98,5 +99,39 @@ static void BM_SppmPass(benchmark::State& state) {
   state.counters["photon_s"] = st.photonSeconds;
 }
 BENCHMARK(BM_SppmPass)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The grid integrator on the bundled buddha at 512^2: the one-off photon pass and grid fill,
+// then milliseconds per 1-spp frame (the interactive cost once the grid exists).
+static void BM_GridFrame(benchmark::State& state) {
+  static Scene scene;
+  static std::unique_ptr<EmbreeAccel> accel;
+  static std::unique_ptr<GridExecutor> ex;
+  if (!ex) {
+    loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/buddha.xml", {{"res", "512"}}, scene);
+    scene.finalize();
+    accel = std::make_unique<EmbreeAccel>(scene);
+    GridExecutorSettings s;
+    s.photons.globalPhotons = 200000;
+    s.photons.causticPhotons = 50000;
+    s.photons.irradianceStride = 4;
+    s.photons.irradianceRadius = 0.05f * makePhotonEmitter(scene).radius;
+    s.photons.causticIrradianceRadius = 0.25f * s.photons.irradianceRadius;
+    s.photons.progress = false;
+    s.params.chain.strategy = EnvStrategy::Alias;
+    SampleSequence seq{SamplerType::Sobol, 1024, 0};
+    ex = std::make_unique<GridExecutor>(scene, *accel, s, seq, 0, false, 16);
+  }
+  Progress quiet(1, false);
+  int frame = 0;
+  PassCounters c;
+  for (auto _ : state) {
+    ex->runPass(frame, frame + 1, quiet, &c);
+    ++frame;
+  }
+  state.counters["grid_fill_s"] = ex->gridStats().seconds;
+  state.counters["photon_trace_s"] = ex->photonStats().traceSeconds;
+  state.counters["Mrays/s"] = benchmark::Counter(double(c.rays) / 1e6, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_GridFrame)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 BENCHMARK_MAIN();

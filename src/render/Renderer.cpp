@@ -10,7 +10,7 @@
 #include "accel/Bvh.h"
 #include "render/CpuExecutor.h"
 #include "integrators/PhotonIntegrator.h"
-#include "render/IlluminationGridBuilder.h"
+#include "render/GridExecutor.h"
 #include "render/SppmExecutor.h"
 #include "scene/NameTables.h"
 #include "render/PhotonShooter.h"
@@ -29,10 +29,10 @@ void logPhotonStats(const PhotonShootStats& st) {
                st.storedGlobal + st.storedCaustic > 0 ? st.bytes / (st.storedGlobal + st.storedCaustic) : 0);
 }
 
-// Shoots the global and caustic maps for the photon and grid integrators, with precomputed
-// irradiance (stride 4) when final gathers will read it.
-void shootMaps(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, const PhotonSettings& ps,
-               bool precompute, PhotonMap* globalMap, PhotonMap* causticMap) {
+// The first pass for the photon and grid integrators, with precomputed irradiance (stride 4)
+// when final gathers will read it.
+PhotonShootSettings photonShootSettings(const Scene& scene, const RenderOptions& opts, const PhotonSettings& ps,
+                                        bool precompute) {
   float sceneRadius = makePhotonEmitter(scene).radius;
   PhotonShootSettings shoot;
   shoot.globalPhotons = ps.globalPhotons;
@@ -43,9 +43,7 @@ void shootMaps(const Scene& scene, const EmbreeAccel& accel, const RenderOptions
   shoot.irradianceStride = precompute ? 4 : 0;
   shoot.seed = scene.sampler.seed;
   shoot.progress = opts.progress;
-  PhotonShootStats pst;
-  shootPhotons(scene, accel, shoot, globalMap, causticMap, &pst);
-  logPhotonStats(pst);
+  return shoot;
 }
 
 ChainParams chainParams(const Scene& scene, int maxDepth, int rrDepth, bool hideEmitters) {
@@ -88,33 +86,30 @@ Image renderSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptio
   return img;
 }
 
-// Photon maps, the grid filled from them, then the camera passes; the grid is not refined
-// while the passes run.
 Image renderGrid(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
   const GridSettings& gs = scene.integrator.grid;
-  const SceneView& sc = scene.view();
   int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
   if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
   PhotonSettings maps;  // the photon integrator's lookup radii, the grid's photon counts
   maps.globalPhotons = gs.globalPhotons;
   maps.causticPhotons = gs.causticPhotons;
   maps.maxDepth = gs.maxDepth;
-  PhotonMap globalMap, causticMap;
-  shootMaps(scene, accel, opts, maps, true, &globalMap, &causticMap);
-  GridParams gp;
-  gp.chain = chainParams(scene, gs.maxDepth, gs.rrDepth, gs.hideEmitters);
-  IlluminationGrid grid = makeIlluminationGrid(scene, gs.resolution);
-  GridBuildStats gst;
-  gatherIntoGrid(grid, scene, accel, globalMap, causticMap, gp.chain, scene.sampler.seed, 0, gs.gatherRays, &gst);
-  const IlluminationGridView& gv = grid.view();
+  GridExecutorSettings ge;
+  ge.photons = photonShootSettings(scene, opts, maps, true);
+  ge.params.chain = chainParams(scene, gs.maxDepth, gs.rrDepth, gs.hideEmitters);
+  ge.resolution = gs.resolution;
+  ge.gatherRays = gs.gatherRays;
+  ge.seed = scene.sampler.seed;
+  SampleSequence seq{scene.sampler.type, uint32_t(spp), scene.sampler.seed};
+  GridExecutor ex(scene, accel, ge, seq, opts.threads, opts.varianceOut != nullptr, opts.tileSize);
+  logPhotonStats(ex.photonStats());
+  const GridBuildStats& gst = ex.gridStats();
+  const IlluminationGridView& gv = ex.grid().view();
   spdlog::info("grid: {}x{}x{} points ({} inside geometry), {} gather rays each, {:.2f} M rays in {:.2f} s, {:.1f} MB",
-               gv.nx, gv.ny, gv.nz, gst.insidePoints, gs.gatherRays, gst.rays / 1e6, gst.seconds, grid.bytes() / 1e6);
-  EmbreeTracer embree{&accel};
-  auto caustics = [&](Vec3f p, Vec3f n) { return causticMap.irradiance(p, n); };
-  auto integ = [&](const Ray& ray, Sampler& smp, uint64_t* rays) {
-    return gridTrace(sc, embree, ray, smp, gv, caustics, gp, rays);
-  };
-  return renderCameraPasses(scene, integ, spp, opts, stats);
+               gv.nx, gv.ny, gv.nz, gst.insidePoints, gs.gatherRays, gst.rays / 1e6, gst.seconds,
+               ex.grid().bytes() / 1e6);
+  const Camera& cam = scene.view().camera;
+  return renderPasses(ex, cam.width, cam.height, spp, opts, stats);
 }
 
 Image renderPhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
@@ -123,7 +118,9 @@ Image renderPhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOpt
   int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
   if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
   PhotonMap globalMap, causticMap;
-  shootMaps(scene, accel, opts, ps, ps.gatherSamples > 0, &globalMap, &causticMap);
+  PhotonShootStats pst;
+  shootPhotons(scene, accel, photonShootSettings(scene, opts, ps, ps.gatherSamples > 0), &globalMap, &causticMap, &pst);
+  logPhotonStats(pst);
   float sceneRadius = makePhotonEmitter(scene).radius;
   PhotonRenderParams php;
   php.global.k = php.caustic.k = ps.lookupSize;
