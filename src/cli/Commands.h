@@ -14,6 +14,7 @@ void addEnvmapCommands(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addPhotonsCommand(CLI::App& app);
 void addStudyCommand(CLI::App& app);
+void addCompareCommand(CLI::App& app);
 
 // -D name=value pairs into a map; throws on a pair without '='.
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds);

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   envgi::cli::addRenderCommand(app);
   envgi::cli::addPhotonsCommand(app);
   envgi::cli::addStudyCommand(app);
+  envgi::cli::addCompareCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -201,3 +201,30 @@ TEST(RenderCli, SamplerVersionAndParseErrors) {
   EXPECT_EQ(missing.output.rfind("envgi: error: ", 0), 0u) << missing.output;
   EXPECT_EQ(std::count(missing.output.begin(), missing.output.end(), '\n'), 1) << missing.output;
 }
+
+// compare: an image against itself has no error, a noisier one has some, a wrong size is one
+// error line and no table.
+TEST(CliCompare, ErrorsAgainstAReference) {
+  TempDir d;
+  std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml";
+  ASSERT_EQ(runCli("render " + scene + " -o " + d.file("a.pfm") + " --spp 8 -D res=16 --no-progress").code, 0);
+  ASSERT_EQ(runCli("render " + scene + " -o " + d.file("b.pfm") + " --spp 1 -D res=16 --no-progress").code, 0);
+  ASSERT_EQ(runCli("render " + scene + " -o " + d.file("c.pfm") + " --spp 1 -D res=8 --no-progress").code, 0);
+  CliResult r = runCli("compare " + d.file("a.pfm") + " " + d.file("a.pfm") + " " + d.file("b.pfm"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::istringstream lines(r.output);
+  std::string line, name;
+  std::vector<double> rmse;
+  while (std::getline(lines, line)) {
+    std::istringstream ls(line);
+    double mean, e;
+    if (ls >> name >> mean >> e && name.find(".pfm") != std::string::npos) rmse.push_back(e);
+  }
+  ASSERT_EQ(rmse.size(), 2u) << r.output;
+  EXPECT_EQ(rmse[0], 0.0);
+  EXPECT_GT(rmse[1], 0.0);
+  CliResult bad = runCli("compare " + d.file("a.pfm") + " " + d.file("c.pfm"));
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.output.find("reference is 16x16, the image 8x8"), std::string::npos) << bad.output;
+  EXPECT_EQ(bad.output.find("RMSE"), std::string::npos) << "no half table: " << bad.output;
+}
