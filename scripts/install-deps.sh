@@ -9,6 +9,9 @@ PKGS=(
   libtinyobjloader-dev libpugixml-dev libcli11-dev nlohmann-json3-dev
   libfmt-dev libspdlog-dev libnanoflann-dev
   libgtest-dev libbenchmark-dev
+  libboost-dev
+  # The viewer's browser test drives a real headless Chromium.
+  chromium
 )
 
 missing=()

@@ -196,11 +196,22 @@ float toneMapChannel(float v, const SaveOptions& opts) {
   return v <= 0.0031308f ? 12.92f * v : 1.055f * std::pow(v, 1.f / 2.4f) - 0.055f;
 }
 
+// stb_image_write's output callback, into a std::string.
+static void appendTo(void* ctx, void* data, int size) {
+  static_cast<std::string*>(ctx)->append(static_cast<char*>(data), size_t(size));
+}
+
 std::string encodePng(int width, int height, const std::vector<unsigned char>& rgb) {
   std::string out;
-  auto append = [](void* ctx, void* data, int size) { static_cast<std::string*>(ctx)->append(static_cast<char*>(data), size_t(size)); };
-  if (!stbi_write_png_to_func(append, &out, width, height, 3, rgb.data(), width * 3))
+  if (!stbi_write_png_to_func(appendTo, &out, width, height, 3, rgb.data(), width * 3))
     throw std::runtime_error("cannot encode a PNG");
+  return out;
+}
+
+std::string encodeJpeg(int width, int height, const std::vector<unsigned char>& rgb, int quality) {
+  std::string out;
+  if (!stbi_write_jpg_to_func(appendTo, &out, width, height, 3, rgb.data(), quality))
+    throw std::runtime_error("cannot encode a JPEG");
   return out;
 }
 

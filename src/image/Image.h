@@ -46,6 +46,8 @@ void saveImage(const Image& img, const std::string& path, const SaveOptions& opt
 float toneMapChannel(float v, const SaveOptions& opts);
 // An 8-bit RGB buffer (3 bytes a pixel) encoded as PNG, in memory.
 std::string encodePng(int width, int height, const std::vector<unsigned char>& rgb);
+// 8-bit RGB as a baseline JPEG (quality 1-100), for streaming frames.
+std::string encodeJpeg(int width, int height, const std::vector<unsigned char>& rgb, int quality);
 
 // The whole image as 8-bit sRGB, 3 bytes a pixel.
 std::vector<unsigned char> toneMapImage(const Image& img, const SaveOptions& opts);

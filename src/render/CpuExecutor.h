@@ -53,6 +53,13 @@ class CpuExecutor final : public PassExecutor {
 
   void readFilm(FilmSums* out) override { *out = film_; }
 
+  bool restart(const Camera& cam) override {
+    cam_ = cam;
+    film_.sum.assign(size_t(cam.width) * cam.height, Color(0.f));
+    if (!film_.sumSqLum.empty()) film_.sumSqLum.assign(film_.sum.size(), 0.0);
+    return true;
+  }
+
  private:
   Camera cam_;
   SampleSequence seq_;

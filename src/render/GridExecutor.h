@@ -44,6 +44,7 @@ class GridExecutor final : public PassExecutor {
     camera_->runPass(s0, s1, progress, counters);
   }
   void readFilm(FilmSums* out) override { camera_->readFilm(out); }
+  bool restart(const Camera& cam) override { return camera_->restart(cam); }
   const PhotonShootStats& photonStats() const { return photonStats_; }
   const GridBuildStats& gridStats() const { return gridStats_; }
   const IlluminationGrid& grid() const { return grid_; }

@@ -8,6 +8,7 @@
 
 #include "core/Vec.h"
 #include "render/Progress.h"
+#include "scene/Camera.h"
 
 namespace envgi {
 
@@ -31,6 +32,9 @@ class PassExecutor {
   virtual void readFilm(FilmSums* out) = 0;
   // The most samples one pass may take: passes are where checkpoints and Ctrl-C happen.
   virtual int maxPassSize() const { return 64; }
+  // Starts over with a new camera and an empty film, keeping what does not depend on the
+  // camera (photon maps, a grid). False: this executor cannot, make a new one.
+  virtual bool restart(const Camera&) { return false; }
 };
 
 }  // namespace envgi

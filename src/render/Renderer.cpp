@@ -55,17 +55,28 @@ ChainParams chainParams(const Scene& scene, int maxDepth, int rrDepth, bool hide
   return c;
 }
 
-// Camera passes on the CPU for an integrator that has done its own preparation.
-template <class Integrator>
-Image renderCameraPasses(const Scene& scene, const Integrator& integ, int spp, const RenderOptions& opts,
-                         RenderStats* stats) {
-  const Camera& cam = scene.view().camera;
-  SampleSequence seq{scene.sampler.type, uint32_t(spp), scene.sampler.seed};
-  CpuExecutor<Integrator> ex(cam, seq, integ, opts.threads, opts.varianceOut != nullptr, "cpu", opts.tileSize);
-  return renderPasses(ex, cam.width, cam.height, spp, opts, stats);
+// The photon integrator's second pass: camera samples that read the maps built beforehand.
+struct PhotonSample {
+  const SceneView* scene;
+  EmbreeTracer tracer;
+  std::shared_ptr<const PhotonMap> global, caustic;
+  PhotonRenderParams params;
+  Color operator()(const Ray& ray, Sampler& smp, uint64_t* rays) const {
+    return photonTrace(*scene, tracer, ray, smp, *global, *caustic, params, rays);
+  }
+};
+
+int samplesOf(const Scene& scene, const RenderOptions& opts) {
+  int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
+  if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
+  return spp;
 }
 
-Image renderSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
+SampleSequence sequenceOf(const Scene& scene, int spp) {
+  return SampleSequence{scene.sampler.type, uint32_t(spp), scene.sampler.seed};
+}
+
+PreparedRender prepareSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
   const SppmSettings& ss = scene.integrator.sppm;
   SppmParams sp;
   sp.photonsPerPass = ss.photonCount;
@@ -76,20 +87,12 @@ Image renderSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptio
   sp.strategy = findStrategy(scene.integrator.env.strategy).env;
   int passes = opts.spp > 0 ? opts.spp : ss.passes;
   if (passes <= 0) throw std::runtime_error("sppm: passes must be positive");
-  SppmExecutor ex(scene, accel, sp, opts.threads);
-  Image img = renderPasses(ex, scene.view().camera.width, scene.view().camera.height, passes, opts, stats);
-  SppmStats st = ex.stats();
-  spdlog::info("sppm: {} passes, {} photons ({} photon-visible-point hits), camera passes {:.2f} s, photon passes "
-               "{:.2f} s, mean final radius {:.4g}, {:.1f} MB",
-               st.passesDone, st.photonsShot, st.photonHits, st.cameraSeconds, st.photonSeconds, st.meanRadius,
-               st.bytes / 1e6);
-  return img;
+  return {std::make_unique<SppmExecutor>(scene, accel, sp, opts.threads), passes};
 }
 
-Image renderGrid(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
+PreparedRender prepareGrid(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
   const GridSettings& gs = scene.integrator.grid;
-  int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
-  if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
+  int spp = samplesOf(scene, opts);
   PhotonSettings maps;  // the photon integrator's lookup radii, the grid's photon counts
   maps.globalPhotons = gs.globalPhotons;
   maps.causticPhotons = gs.causticPhotons;
@@ -100,26 +103,24 @@ Image renderGrid(const Scene& scene, const EmbreeAccel& accel, const RenderOptio
   ge.resolution = gs.resolution;
   ge.gatherRays = gs.gatherRays;
   ge.seed = scene.sampler.seed;
-  SampleSequence seq{scene.sampler.type, uint32_t(spp), scene.sampler.seed};
-  GridExecutor ex(scene, accel, ge, seq, opts.threads, opts.varianceOut != nullptr, opts.tileSize);
-  logPhotonStats(ex.photonStats());
-  const GridBuildStats& gst = ex.gridStats();
-  const IlluminationGridView& gv = ex.grid().view();
+  auto ex = std::make_unique<GridExecutor>(scene, accel, ge, sequenceOf(scene, spp), opts.threads,
+                                           opts.varianceOut != nullptr, opts.tileSize);
+  logPhotonStats(ex->photonStats());
+  const GridBuildStats& gst = ex->gridStats();
+  const IlluminationGridView& gv = ex->grid().view();
   spdlog::info("grid: {}x{}x{} points ({} inside geometry), {} gather rays each, {:.2f} M rays in {:.2f} s, {:.1f} MB",
                gv.nx, gv.ny, gv.nz, gst.insidePoints, gs.gatherRays, gst.rays / 1e6, gst.seconds,
-               ex.grid().bytes() / 1e6);
-  const Camera& cam = scene.view().camera;
-  return renderPasses(ex, cam.width, cam.height, spp, opts, stats);
+               ex->grid().bytes() / 1e6);
+  return {std::move(ex), spp};
 }
 
-Image renderPhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
+PreparedRender preparePhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
   const PhotonSettings& ps = scene.integrator.photon;
-  const SceneView& sc = scene.view();
-  int spp = opts.spp > 0 ? opts.spp : scene.sampler.sampleCount;
-  if (spp <= 0) throw std::runtime_error("samples per pixel must be positive");
-  PhotonMap globalMap, causticMap;
+  int spp = samplesOf(scene, opts);
+  auto globalMap = std::make_shared<PhotonMap>(), causticMap = std::make_shared<PhotonMap>();
   PhotonShootStats pst;
-  shootPhotons(scene, accel, photonShootSettings(scene, opts, ps, ps.gatherSamples > 0), &globalMap, &causticMap, &pst);
+  shootPhotons(scene, accel, photonShootSettings(scene, opts, ps, ps.gatherSamples > 0), globalMap.get(),
+               causticMap.get(), &pst);
   logPhotonStats(pst);
   float sceneRadius = makePhotonEmitter(scene).radius;
   PhotonRenderParams php;
@@ -129,11 +130,11 @@ Image renderPhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOpt
   php.global.coneFilter = php.caustic.coneFilter = ps.coneFilter;
   php.gatherSamples = ps.gatherSamples;
   php.chain = chainParams(scene, ps.maxDepth, ps.rrDepth, ps.hideEmitters);
-  EmbreeTracer embree{&accel};
-  auto photon = [&](const Ray& ray, Sampler& smp, uint64_t* rays) {
-    return photonTrace(sc, embree, ray, smp, globalMap, causticMap, php, rays);
-  };
-  return renderCameraPasses(scene, photon, spp, opts, stats);
+  PhotonSample sample{&scene.view(), EmbreeTracer{&accel}, globalMap, causticMap, php};
+  return {std::make_unique<CpuExecutor<PhotonSample>>(scene.view().camera, sequenceOf(scene, spp), sample,
+                                                       opts.threads, opts.varianceOut != nullptr, "cpu",
+                                                       opts.tileSize),
+          spp};
 }
 
 }  // namespace
@@ -235,27 +236,42 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   return img;
 }
 
-Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
-  const SceneView& sc = scene.view();
-  const Camera& cam = sc.camera;
+PreparedRender prepareRender(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
   switch (scene.integrator.type) {
-    case IntegratorType::Sppm: return renderSppm(scene, accel, opts, stats);
-    case IntegratorType::Photon: return renderPhoton(scene, accel, opts, stats);
-    case IntegratorType::Grid: return renderGrid(scene, accel, opts, stats);
+    case IntegratorType::Sppm: return prepareSppm(scene, accel, opts);
+    case IntegratorType::Photon: return preparePhoton(scene, accel, opts);
+    case IntegratorType::Grid: return prepareGrid(scene, accel, opts);
     case IntegratorType::Path:
     case IntegratorType::Direct: break;
   }
-  bool keepVar = opts.varianceOut != nullptr;
   KernelSettings k = kernelSettings(scene, opts);
-  if (opts.cpuTracer == CpuTracer::Bvh) {
+  const SceneView& sc = scene.view();
+  SampleIntegrator<EmbreeTracer> integ{k.type, k.path, k.direct, &sc, EmbreeTracer{&accel}};
+  return {std::make_unique<CpuExecutor<decltype(integ)>>(sc.camera, k.sequence, integ, opts.threads,
+                                                         opts.varianceOut != nullptr, "cpu", opts.tileSize),
+          k.spp};
+}
+
+Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
+  const Camera& cam = scene.view().camera;
+  if (opts.cpuTracer == CpuTracer::Bvh && hasSampleKernel(scene.integrator.type)) {
+    KernelSettings k = kernelSettings(scene, opts);
     Bvh bvh(scene);
-    SampleIntegrator<BvhTracer> integ{k.type, k.path, k.direct, &sc, BvhTracer{bvh.view()}};
-    CpuExecutor<decltype(integ)> ex(cam, k.sequence, integ, opts.threads, keepVar, "cpu (envgi BVH)", opts.tileSize);
+    SampleIntegrator<BvhTracer> integ{k.type, k.path, k.direct, &scene.view(), BvhTracer{bvh.view()}};
+    CpuExecutor<decltype(integ)> ex(cam, k.sequence, integ, opts.threads, opts.varianceOut != nullptr,
+                                    "cpu (envgi BVH)", opts.tileSize);
     return renderPasses(ex, cam.width, cam.height, k.spp, opts, stats);
   }
-  SampleIntegrator<EmbreeTracer> integ{k.type, k.path, k.direct, &sc, EmbreeTracer{&accel}};
-  CpuExecutor<decltype(integ)> ex(cam, k.sequence, integ, opts.threads, keepVar, "cpu", opts.tileSize);
-  return renderPasses(ex, cam.width, cam.height, k.spp, opts, stats);
+  PreparedRender pr = prepareRender(scene, accel, opts);
+  Image img = renderPasses(*pr.executor, cam.width, cam.height, pr.spp, opts, stats);
+  if (auto* sppm = dynamic_cast<SppmExecutor*>(pr.executor.get())) {
+    SppmStats st = sppm->stats();
+    spdlog::info("sppm: {} passes, {} photons ({} photon-visible-point hits), camera passes {:.2f} s, photon passes "
+                 "{:.2f} s, mean final radius {:.4g}, {:.1f} MB",
+                 st.passesDone, st.photonsShot, st.photonHits, st.cameraSeconds, st.photonSeconds, st.meanRadius,
+                 st.bytes / 1e6);
+  }
+  return img;
 }
 
 }  // namespace envgi

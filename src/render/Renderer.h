@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <functional>
+#include <memory>
 #include <string>
 
 #include "accel/EmbreeAccel.h"
@@ -46,6 +47,14 @@ struct RenderStats {
 // The path/direct settings the kernels run with, from the scene's integrator settings;
 // throws for integrators that have no per-sample kernel (photon, sppm).
 KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts);
+
+// An executor for the scene's integrator on the CPU (Embree), with what comes before the
+// camera passes done (photon maps, a grid), and the passes it wants (spp, or sppm's passes).
+struct PreparedRender {
+  std::unique_ptr<PassExecutor> executor;
+  int spp = 0;
+};
+PreparedRender prepareRender(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts);
 
 // Renders on the CPU (Embree, or the GPU's BVH by opts.cpuTracer), any integrator.
 Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats);
