@@ -15,6 +15,7 @@ void addRenderCommand(CLI::App& app);
 void addPhotonsCommand(CLI::App& app);
 void addStudyCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
+void addViewCommand(CLI::App& app);
 
 // -D name=value pairs into a map; throws on a pair without '='.
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds);

@@ -120,6 +120,12 @@ void EnvironmentMap::setPoints(std::vector<DirectionalLight> points) {
   points_ = std::move(points);
 }
 
+void EnvironmentMap::setPlacement(float scale, const Transform& toWorld) {
+  if (!(scale >= 0.f) || !std::isfinite(scale)) throw std::runtime_error("environment scale must be a non-negative number");
+  opts_.scale = scale;
+  opts_.toWorld = toWorld;
+}
+
 EnvironmentMapView EnvironmentMap::view() const {
   EnvironmentMapView v;
   v.rgb = image_.rgb.data();

@@ -41,6 +41,9 @@ class EnvironmentMap {
   EnvironmentMap& operator=(EnvironmentMap&&) = default;
 
   EnvironmentMapView view() const;
+  // Moves and rescales the map (the viewer's controls); the sampling tables, in the map's own
+  // frame, stay valid. Throws for a negative scale.
+  void setPlacement(float scale, const Transform& toWorld);
   const Image& image() const { return image_; }
   const EnvironmentMapOptions& options() const { return opts_; }
   size_t invalidPixels() const { return invalid_; }

@@ -1,0 +1,67 @@
+// `envgi view SCENE.xml`: the scene in a browser, rendered progressively and steered from the
+// page; local (127.0.0.1) by default, or on a headless server behind an SSH tunnel.
+#include <spdlog/spdlog.h>
+
+#include <random>
+
+#include "cli/Commands.h"
+#include "scene/NameTables.h"
+#include "scene/SceneLoader.h"
+#include "view/ViewServer.h"
+
+namespace envgi::cli {
+
+namespace {
+struct ViewArgs {
+  std::string scene, host = "127.0.0.1", integrator, strategy;
+  int port = 8000, threads = 0, maxSpp = 4096;
+  std::vector<std::string> defines;
+};
+
+std::string makeToken() {
+  std::random_device rd;
+  const char* hex = "0123456789abcdef";
+  std::string t;
+  for (int i = 0; i < 32; ++i) t += hex[rd() % 16];
+  return t;
+}
+
+void runView(const ViewArgs& a) {
+  auto scene = std::make_unique<Scene>();
+  loadScene(a.scene, parseDefines(a.defines), *scene);
+  if (!a.integrator.empty()) scene->integrator.type = findIntegrator(a.integrator);
+  if (!a.strategy.empty()) scene->integrator.setStrategy(a.strategy);
+  ViewOptions vo;
+  vo.threads = a.threads;
+  vo.maxSpp = a.maxSpp;
+  ViewSession session(std::move(scene), a.scene, vo);
+  ViewServerOptions so;
+  so.host = a.host;
+  so.port = a.port;
+  if (a.host != "127.0.0.1" && a.host != "::1" && a.host != "localhost") so.token = makeToken();
+  if (so.host == "localhost") so.host = "127.0.0.1";
+  ViewServer server(session, so);
+  std::string url = fmt::format("http://{}:{}/", so.host == "0.0.0.0" ? "HOST" : so.host, server.port());
+  if (!so.token.empty()) url += "?token=" + so.token;
+  spdlog::info("view: open {}  (Ctrl-C stops)", url);
+  std::fflush(stdout);
+  server.run();
+  spdlog::info("view: stopped after {} frames", session.framesSent());
+}
+}  // namespace
+
+void addViewCommand(CLI::App& app) {
+  auto a = std::make_shared<ViewArgs>();
+  CLI::App* c = app.add_subcommand("view", "Render a scene progressively in the browser, steered from the page");
+  c->add_option("scene", a->scene, "Scene file (.xml)")->required()->check(CLI::ExistingFile);
+  c->add_option("--port", a->port, "Port to listen on (0: any free one)")->check(CLI::Range(0, 65535));
+  c->add_option("--host", a->host, "Address to bind (default 127.0.0.1; anything wider requires the printed token)");
+  c->add_option("--integrator", a->integrator, "Integrator: " + nameList(kIntegratorNames));
+  c->add_option("--strategy", a->strategy, "Environment strategy: " + strategyNameList());
+  c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
+  c->add_option("--max-spp", a->maxSpp, "Stop refining at this many samples per pixel")->check(CLI::PositiveNumber);
+  c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
+  c->callback([a] { runView(*a); });
+}
+
+}  // namespace envgi::cli

@@ -1,0 +1,301 @@
+#include "view/ViewSession.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "scene/NameTables.h"
+
+namespace envgi {
+
+using json = nlohmann::json;
+using Clock = std::chrono::steady_clock;
+
+struct ViewSession::State {
+  Vec3f origin, target, up;
+  int cameraVersion = 0;
+  float exposure = 0.f;
+  ToneMap tone = ToneMap::Clamp;
+  float envRotation = 0.f, envScale = 1.f;  // degrees about +Y on top of the file's placement
+  std::string strategy, integrator;
+  float resolutionScale = 1.f;
+  bool restart = true;   // the camera or resolution changed: an empty film
+  bool rebuild = true;   // the integrator, strategy or environment changed: a new executor
+  bool toneChanged = false;
+  bool frameRequested = true;
+};
+
+namespace {
+Vec3f vec3(const json& j, const char* key) {
+  const json& v = j.at(key);
+  if (!v.is_array() || v.size() != 3) throw std::runtime_error(std::string("'") + key + "' must be 3 numbers");
+  Vec3f r(v[0].get<float>(), v[1].get<float>(), v[2].get<float>());
+  if (!isFiniteVec(r)) throw std::runtime_error(std::string("'") + key + "' must be finite");
+  return r;
+}
+json arr(Vec3f v) { return json::array({v.x, v.y, v.z}); }
+float number(const json& j, const char* key, float lo, float hi) {
+  float v = j.at(key).get<float>();
+  if (!(v >= lo && v <= hi)) throw std::runtime_error(fmt::format("'{}' must be in [{}, {}]", key, lo, hi));
+  return v;
+}
+}  // namespace
+
+ViewSession::ViewSession(std::unique_ptr<Scene> scene, std::string scenePath, ViewOptions opts)
+    : scene_(std::move(scene)), scenePath_(std::move(scenePath)), opts_(opts), state_(std::make_unique<State>()) {
+  scene_->finalize();
+  accel_ = std::make_unique<EmbreeAccel>(*scene_);
+  const Transform& t = scene_->camera.toWorld;
+  State& s = *state_;
+  s.origin = t.point(Vec3f(0.f));
+  Vec3f fwd = normalize(t.vector(Vec3f(0.f, 0.f, 1.f)));
+  const SceneView& sc = scene_->view();
+  Vec3f centre = (sc.boundsMin + sc.boundsMax) * 0.5f;
+  float dist = std::max(dot(centre - s.origin, fwd), 1e-2f * length(sc.boundsMax - sc.boundsMin) + 1e-3f);
+  s.target = s.origin + fwd * dist;
+  s.up = normalize(t.vector(Vec3f(0.f, 1.f, 0.f)));
+  s.strategy = scene_->integrator.env.strategy;
+  s.integrator = integratorName(scene_->integrator.type);
+}
+
+ViewSession::~ViewSession() { stop(); }
+
+void ViewSession::start(std::function<void(ViewFrame)> sink) {
+  sink_ = std::move(sink);
+  worker_ = std::thread([this] { run(); });
+}
+
+void ViewSession::stop() {
+  stop_ = true;
+  wake_.notify_all();
+  if (worker_.joinable()) worker_.join();
+}
+
+std::string ViewSession::hello() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  const State& s = *state_;
+  const SceneView& sc = scene_->view();
+  json integrators = json::array(), strategies = json::array();
+  for (const auto& n : kIntegratorNames)
+    if (!n.alias) integrators.push_back(n.name);
+  for (const auto& n : kStrategyNames) strategies.push_back(n.name);
+  json j = {{"type", "hello"},
+            {"scene", std::filesystem::path(scenePath_).filename().string()},
+            {"width", scene_->camera.width},
+            {"height", scene_->camera.height},
+            {"tanHalfY", scene_->camera.tanHalfY},
+            {"camera", {{"origin", arr(s.origin)}, {"target", arr(s.target)}, {"up", arr(s.up)}}},
+            {"bounds", {{"min", arr(sc.boundsMin)}, {"max", arr(sc.boundsMax)}}},
+            {"integrators", integrators},
+            {"strategies", strategies},
+            {"integrator", s.integrator},
+            {"strategy", s.strategy},
+            {"hasEnvironment", scene_->env != nullptr}};
+  return j.dump();
+}
+
+std::string ViewSession::handle(const std::string& message) {
+  json j = json::parse(message, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || !j.contains("type") || !j["type"].is_string())
+    throw std::runtime_error("malformed message (not a JSON object with a 'type')");
+  std::string type = j["type"];
+  try {
+    if (type == "next") {
+      requestFrame();
+      return "";
+    }
+    if (type == "save") return json{{"type", "saved"}, {"path", saveExr()}}.dump();
+    std::lock_guard<std::mutex> lock(mutex_);
+    State next = *state_;
+    if (type == "camera") {
+      next.origin = vec3(j, "origin");
+      next.target = vec3(j, "target");
+      next.up = vec3(j, "up");
+      if (length(next.target - next.origin) < 1e-6f || length(cross(next.target - next.origin, next.up)) < 1e-6f)
+        throw std::runtime_error("camera: origin, target and up must span a frame");
+      next.cameraVersion = j.value("version", next.cameraVersion + 1);
+      next.restart = true;
+    } else if (type == "exposure") {
+      next.exposure = number(j, "value", -20.f, 20.f);
+      next.toneChanged = true;
+    } else if (type == "tonemap") {
+      std::string v = j.at("value");
+      if (v != "clamp" && v != "aces") throw std::runtime_error("tonemap must be clamp or aces");
+      next.tone = v == "aces" ? ToneMap::Aces : ToneMap::Clamp;
+      next.toneChanged = true;
+    } else if (type == "environment") {
+      if (!scene_->env) throw std::runtime_error("the scene has no environment map");
+      next.envRotation = number(j, "rotation", -360.f, 360.f);
+      next.envScale = number(j, "scale", 0.f, 1e4f);
+      next.rebuild = true;
+    } else if (type == "strategy") {
+      next.strategy = findStrategy(j.at("value").get<std::string>()).name;
+      next.rebuild = true;
+    } else if (type == "integrator") {
+      next.integrator = integratorName(findIntegrator(j.at("value").get<std::string>()));
+      next.rebuild = true;
+    } else if (type == "resolution") {
+      next.resolutionScale = number(j, "scale", 0.1f, 2.f);
+      next.restart = true;
+    } else {
+      throw std::runtime_error("unknown message type '" + type + "'");
+    }
+    *state_ = next;
+  } catch (const json::exception& e) {
+    throw std::runtime_error(type + ": " + e.what());
+  } catch (const std::runtime_error& e) {
+    std::string what = e.what();
+    throw std::runtime_error(what.rfind(type, 0) == 0 ? what : type + ": " + what);
+  }
+  wake_.notify_all();
+  return "";
+}
+
+void ViewSession::requestFrame() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    state_->frameRequested = true;
+  }
+  wake_.notify_all();
+}
+
+std::string ViewSession::saveExr() {
+  Image img;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    img = lastImage_;
+  }
+  if (img.width == 0) throw std::runtime_error("nothing rendered yet");
+  namespace fs = std::filesystem;
+  fs::path scene(scenePath_);
+  fs::path dir = scene.has_parent_path() ? scene.parent_path() : fs::path(".");
+  for (int n = 1; n < 100000; ++n) {
+    fs::path p = dir / fmt::format("{}-view-{}.exr", scene.stem().string(), n);
+    if (fs::exists(p)) continue;
+    saveImage(img, p.string(), SaveOptions{});
+    spdlog::info("view: saved {}", p.string());
+    return p.string();
+  }
+  throw std::runtime_error("no free file name beside the scene");
+}
+
+ViewFrame ViewSession::makeFrame(const Image& hdr, const State& s) {
+  SaveOptions so;
+  so.exposure = s.exposure;
+  so.toneMap = s.tone;
+  ViewFrame f;
+  f.jpeg = encodeJpeg(hdr.width, hdr.height, toneMapImage(hdr, so), opts_.jpegQuality);
+  return f;
+}
+
+void ViewSession::run() {
+  PreparedRender pr;
+  int spp = 0, sentSpp = -1, frame = 0;
+  const int baseW = scene_->camera.width, baseH = scene_->camera.height;
+  const Transform envBase = scene_->env ? scene_->env->options().toWorld : Transform{};
+  const float envBaseScale = scene_->env ? scene_->env->options().scale : 1.f;
+  auto t0 = Clock::now(), lastFrame = Clock::now();
+  PassCounters counters;
+  Progress quiet(1, false);
+  State s;
+  auto limit = [&] { return pr.executor ? std::min(opts_.maxSpp, pr.spp) : 0; };
+  while (!stop_) {
+    bool restart = false, rebuild = false, send = false;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      wake_.wait(lock, [&] {
+        const State& st = *state_;
+        return stop_ || st.restart || st.rebuild || (st.frameRequested && (st.toneChanged || spp != sentSpp)) ||
+               spp < limit();
+      });
+      if (stop_) break;
+      restart = state_->restart;
+      rebuild = state_->rebuild;
+      state_->restart = state_->rebuild = false;
+      s = *state_;
+    }
+    if (restart || rebuild) {
+      Camera& cam = scene_->camera;
+      cam.toWorld = lookAt(s.origin, s.target, s.up);
+      cam.width = std::max(8, int(std::lround(baseW * s.resolutionScale)));
+      cam.height = std::max(8, int(std::lround(baseH * s.resolutionScale)));
+      try {
+        if (rebuild) {
+          if (scene_->env) scene_->env->setPlacement(envBaseScale * s.envScale, rotate(Vec3f(0, 1, 0), s.envRotation) * envBase);
+          scene_->integrator.type = findIntegrator(s.integrator);
+          scene_->integrator.setStrategy(s.strategy);
+        }
+        scene_->finalize();
+        if (rebuild || !pr.executor || !pr.executor->restart(scene_->view().camera)) {
+          RenderOptions ro;
+          ro.progress = false;
+          ro.threads = opts_.threads;
+          ro.spp = opts_.maxSpp;
+          pr = prepareRender(*scene_, *accel_, ro);
+        }
+      } catch (const std::runtime_error& e) {
+        spdlog::warn("view: {}", e.what());
+        pr = PreparedRender{};
+        if (sink_) sink_(ViewFrame{json{{"type", "error"}, {"message", e.what()}}.dump(), ""});
+      }
+      spp = 0;
+      sentSpp = -1;
+      t0 = Clock::now();
+    }
+    if (spp < limit()) {
+      pr.executor->runPass(spp, spp + 1, quiet, &counters);
+      ++spp;
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      send = pr.executor && state_->frameRequested && (state_->toneChanged || spp != sentSpp);
+      if (send) {
+        state_->frameRequested = false;
+        state_->toneChanged = false;
+        s = *state_;
+      }
+    }
+    if (!send) continue;
+    FilmSums film;
+    pr.executor->readFilm(&film);
+    const Camera& cam = scene_->view().camera;
+    Image img(cam.width, cam.height);
+    for (size_t i = 0; i < film.sum.size() && i < size_t(cam.width) * cam.height; ++i) {
+      Color c = film.sum[i] / float(std::max(spp, 1));
+      img.rgb[3 * i] = c.x;
+      img.rgb[3 * i + 1] = c.y;
+      img.rgb[3 * i + 2] = c.z;
+    }
+    ViewFrame f = makeFrame(img, s);
+    auto now = Clock::now();
+    double seconds = std::chrono::duration<double>(now - t0).count();
+    double sinceLast = std::chrono::duration<double>(now - lastFrame).count();
+    lastFrame = now;
+    f.meta = json{{"type", "frame"},
+                  {"frame", ++frame},
+                  {"spp", spp},
+                  {"seconds", seconds},
+                  {"fps", sinceLast > 0 ? 1.0 / sinceLast : 0.0},
+                  {"width", cam.width},
+                  {"height", cam.height},
+                  {"exposure", s.exposure},
+                  {"tonemap", s.tone == ToneMap::Aces ? "aces" : "clamp"},
+                  {"cameraVersion", s.cameraVersion},
+                  {"integrator", s.integrator},
+                  {"strategy", s.strategy},
+                  {"bytes", f.jpeg.size()}}
+                 .dump();
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      lastImage_ = std::move(img);
+    }
+    sentSpp = spp;
+    ++framesSent_;
+    if (sink_) sink_(std::move(f));
+  }
+}
+
+}  // namespace envgi

@@ -1,0 +1,195 @@
+// The viewer's one page (HTML, CSS and JavaScript), compiled into the binary so that nothing
+// is fetched at view time. It draws the frames the server streams, sends the camera as the
+// mouse orbits (drag), pans (right or shift drag) and dollies (wheel), and the controls' values;
+// it asks for the next frame only when it has drawn the last. window.envgiTest exposes its
+// state to the browser test.
+#pragma once
+
+namespace envgi {
+
+inline constexpr const char* kViewerPage = R"envgipage(<!doctype html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<title>envgi view</title>
+<style>
+  body { margin: 0; background: #1e1e1e; color: #ddd; font: 13px system-ui, sans-serif; display: flex; }
+  #view { flex: 1; display: flex; align-items: center; justify-content: center; height: 100vh; }
+  #frame { image-rendering: auto; max-width: 100%; max-height: 100vh; cursor: grab; background: #000; }
+  #panel { width: 250px; padding: 10px; background: #2a2a2a; height: 100vh; box-sizing: border-box; overflow-y: auto; }
+  #panel label { display: block; margin-top: 10px; }
+  #panel input[type=range], #panel select { width: 100%; }
+  #stats { font-family: monospace; white-space: pre; margin-top: 12px; color: #9c9; }
+  #message { margin-top: 10px; color: #fc6; word-break: break-all; }
+  button { margin-top: 12px; width: 100%; }
+</style>
+</head>
+<body>
+<div id="view"><img id="frame" alt="rendering" draggable="false"></div>
+<div id="panel">
+  <b id="title">envgi</b>
+  <label>Exposure <span id="exposureValue">0</span>
+    <input id="exposure" type="range" min="-8" max="8" step="0.1" value="0"></label>
+  <label>Tone curve <select id="tonemap"><option value="clamp">clamp</option><option value="aces">ACES</option></select></label>
+  <label>Integrator <select id="integrator"></select></label>
+  <label>Strategy <select id="strategy"></select></label>
+  <label>Environment rotation <span id="rotationValue">0</span>&deg;
+    <input id="rotation" type="range" min="-180" max="180" step="1" value="0"></label>
+  <label>Environment scale <input id="envScale" type="number" min="0" step="0.1" value="1"></label>
+  <label>Resolution <select id="resolution">
+    <option value="0.25">25%</option><option value="0.5">50%</option><option value="1" selected>100%</option><option value="2">200%</option></select></label>
+  <button id="save">Save EXR</button>
+  <div id="stats">connecting...</div>
+  <div id="message"></div>
+</div>
+<script>
+"use strict";
+const T = window.envgiTest = { frames: 0, lastMeta: null, lastHash: 0, errors: [], saved: null, cameraSent: 0, latencyMs: null };
+window.addEventListener("error", e => T.errors.push(String(e.message)));
+const $ = id => document.getElementById(id);
+const img = $("frame");
+let ws, hello, cam, version = 0, pendingMeta = null, sendTimes = {}, lastUrl = null, cameraQueued = false;
+
+const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+const mul = (a, s) => [a[0] * s, a[1] * s, a[2] * s];
+const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const norm = a => mul(a, 1 / Math.hypot(a[0], a[1], a[2]));
+// Rodrigues: v rotated by angle about unit axis k.
+const rot = (v, k, a) => add(add(mul(v, Math.cos(a)), mul(cross(k, v), Math.sin(a))), mul(k, dot(k, v) * (1 - Math.cos(a))));
+
+function send(obj) { if (ws && ws.readyState === 1) ws.send(JSON.stringify(obj)); }
+function showMessage(text) { $("message").textContent = text; }
+
+function sendCamera() {
+  if (cameraQueued) return;
+  cameraQueued = true;
+  requestAnimationFrame(() => {
+    cameraQueued = false;
+    version += 1;
+    sendTimes[version] = performance.now();
+    T.cameraSent = version;
+    send({ type: "camera", origin: cam.origin, target: cam.target, up: cam.up, version: version });
+  });
+}
+
+function orbit(dx, dy) {
+  const up = norm(cam.up);
+  let off = sub(cam.origin, cam.target);
+  off = rot(off, up, -dx * 0.008);
+  const right = norm(cross(off, up));
+  const tilted = rot(off, right, dy * 0.008);
+  if (Math.abs(dot(norm(tilted), up)) < 0.98) off = tilted;
+  cam.origin = add(cam.target, off);
+  sendCamera();
+}
+function pan(dx, dy) {
+  const off = sub(cam.origin, cam.target), dist = Math.hypot(off[0], off[1], off[2]);
+  const fwd = norm(mul(off, -1)), right = norm(cross(fwd, cam.up)), up = cross(right, fwd);
+  const s = dist * 2 * hello.tanHalfY / img.clientHeight;
+  const d = add(mul(right, -dx * s), mul(up, dy * s));
+  cam.origin = add(cam.origin, d);
+  cam.target = add(cam.target, d);
+  sendCamera();
+}
+function dolly(f) {
+  cam.origin = add(cam.target, mul(sub(cam.origin, cam.target), f));
+  sendCamera();
+}
+
+let drag = null;
+img.addEventListener("mousedown", e => { drag = { x: e.clientX, y: e.clientY, pan: e.button === 2 || e.shiftKey }; e.preventDefault(); });
+window.addEventListener("mouseup", () => { drag = null; });
+window.addEventListener("mousemove", e => {
+  if (!drag || !cam) return;
+  const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
+  drag.x = e.clientX; drag.y = e.clientY;
+  if (drag.pan) pan(dx, dy); else orbit(dx, dy);
+});
+img.addEventListener("contextmenu", e => e.preventDefault());
+img.addEventListener("wheel", e => { if (cam) { dolly(e.deltaY > 0 ? 1.1 : 1 / 1.1); e.preventDefault(); } }, { passive: false });
+window.addEventListener("keydown", e => {
+  if (!cam || e.target.tagName === "INPUT") return;
+  const k = { ArrowLeft: [-20, 0], ArrowRight: [20, 0], ArrowUp: [0, -20], ArrowDown: [0, 20] }[e.key];
+  if (k) orbit(k[0], k[1]);
+  if (e.key === "+" || e.key === "=") dolly(1 / 1.1);
+  if (e.key === "-") dolly(1.1);
+});
+
+$("exposure").addEventListener("input", e => { $("exposureValue").textContent = e.target.value; send({ type: "exposure", value: parseFloat(e.target.value) }); });
+$("tonemap").addEventListener("change", e => send({ type: "tonemap", value: e.target.value }));
+$("integrator").addEventListener("change", e => send({ type: "integrator", value: e.target.value }));
+$("strategy").addEventListener("change", e => send({ type: "strategy", value: e.target.value }));
+const sendEnv = () => send({ type: "environment", rotation: parseFloat($("rotation").value), scale: parseFloat($("envScale").value) || 0 });
+$("rotation").addEventListener("input", e => { $("rotationValue").textContent = e.target.value; sendEnv(); });
+$("envScale").addEventListener("change", sendEnv);
+$("resolution").addEventListener("change", e => send({ type: "resolution", scale: parseFloat(e.target.value) }));
+$("save").addEventListener("click", () => send({ type: "save" }));
+
+function fill(select, names, current) {
+  select.innerHTML = "";
+  for (const n of names) { const o = document.createElement("option"); o.value = o.textContent = n; select.appendChild(o); }
+  select.value = current;
+}
+
+function onText(m) {
+  if (m.type === "hello") {
+    hello = m;
+    cam = { origin: m.camera.origin, target: m.camera.target, up: m.camera.up };
+    $("title").textContent = "envgi: " + m.scene;
+    fill($("integrator"), m.integrators, m.integrator);
+    fill($("strategy"), m.strategies, m.strategy);
+    for (const id of ["rotation", "envScale"]) $(id).disabled = !m.hasEnvironment;
+  } else if (m.type === "frame") {
+    pendingMeta = m;
+  } else if (m.type === "saved") {
+    T.saved = m.path;
+    showMessage("saved " + m.path);
+  } else if (m.type === "error") {
+    showMessage("error: " + m.message);
+  }
+}
+
+function onFrame(buffer) {
+  const m = pendingMeta;
+  pendingMeta = null;
+  const bytes = new Uint8Array(buffer);
+  let h = 0;
+  for (let i = 0; i < bytes.length; i += 7) h = (h * 31 + bytes[i]) >>> 0;
+  const url = URL.createObjectURL(new Blob([buffer], { type: "image/jpeg" }));
+  img.onload = () => {
+    if (lastUrl) URL.revokeObjectURL(lastUrl);
+    lastUrl = url;
+    T.frames += 1;
+    T.lastMeta = m;
+    T.lastHash = h;
+    if (m && sendTimes[m.cameraVersion] !== undefined) {
+      T.latencyMs = performance.now() - sendTimes[m.cameraVersion];
+      for (const v in sendTimes) if (+v <= m.cameraVersion) delete sendTimes[v];
+    }
+    if (m) {
+      $("stats").textContent =
+        `frame   ${m.frame}\nspp     ${m.spp}\ntime    ${m.seconds.toFixed(2)} s\nfps     ${m.fps.toFixed(1)}\n` +
+        `size    ${m.width}x${m.height}\n${m.integrator} / ${m.strategy}\n` +
+        `move->frame ${T.latencyMs === null ? "-" : T.latencyMs.toFixed(0) + " ms"}`;
+    }
+    send({ type: "next" });
+  };
+  img.onerror = () => { T.errors.push("a frame did not decode"); send({ type: "next" }); };
+  img.src = url;
+}
+
+function connect() {
+  ws = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws" + location.search);
+  ws.binaryType = "arraybuffer";
+  ws.onmessage = e => { if (typeof e.data === "string") onText(JSON.parse(e.data)); else onFrame(e.data); };
+  ws.onclose = () => { $("stats").textContent = "disconnected"; };
+}
+connect();
+</script>
+</body>
+</html>
+)envgipage";
+
+}  // namespace envgi
