@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -102,6 +103,10 @@ std::string ViewSession::handle(const std::string& message) {
   if (j.is_discarded() || !j.is_object() || !j.contains("type") || !j["type"].is_string())
     throw std::runtime_error("malformed message (not a JSON object with a 'type')");
   std::string type = j["type"];
+  static const char* known[] = {"next", "save", "camera", "exposure", "tonemap", "environment", "strategy",
+                                "integrator", "resolution"};
+  if (std::find(std::begin(known), std::end(known), type) == std::end(known))
+    throw std::runtime_error("unknown message type '" + type + "'");
   try {
     if (type == "next") {
       requestFrame();
@@ -140,8 +145,6 @@ std::string ViewSession::handle(const std::string& message) {
     } else if (type == "resolution") {
       next.resolutionScale = number(j, "scale", 0.1f, 2.f);
       next.restart = true;
-    } else {
-      throw std::runtime_error("unknown message type '" + type + "'");
     }
     *state_ = next;
   } catch (const json::exception& e) {

@@ -1,0 +1,164 @@
+// The viewer's session without a browser: frames come one per request, the page's messages
+// change what is rendered, and bad messages are errors that change nothing.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <filesystem>
+#include <mutex>
+#include <nlohmann/json.hpp>
+
+#include "cli/CliRunner.h"
+#include "scene/SceneLoader.h"
+#include "view/ViewSession.h"
+
+using namespace envgi;
+using json = nlohmann::json;
+
+namespace {
+
+// Collects what the session hands out, and waits for it.
+struct Sink {
+  std::mutex m;
+  std::condition_variable cv;
+  std::vector<ViewFrame> frames;
+  void operator()(ViewFrame f) {
+    std::lock_guard<std::mutex> l(m);
+    frames.push_back(std::move(f));
+    cv.notify_all();
+  }
+  // The next frame after `count` (a JSON meta), or fails the test after 30 s.
+  json waitFor(size_t count, std::string* jpeg = nullptr) {
+    std::unique_lock<std::mutex> l(m);
+    bool ok = cv.wait_for(l, std::chrono::seconds(30), [&] { return frames.size() > count; });
+    if (!ok) {
+      ADD_FAILURE() << "no frame within 30 s";
+      return json{};
+    }
+    if (jpeg) *jpeg = frames[count].jpeg;
+    return json::parse(frames[count].meta);
+  }
+};
+
+std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& sink) {
+  std::string xml = dir + "/ball.xml";
+  std::ofstream(xml) << R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="3"/></integrator>
+  <sensor type="perspective"><float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="16"/></film>
+  </sensor>
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <shape type="sphere"><float name="radius" value="1"/></shape>
+</scene>)";
+  auto scene = std::make_unique<Scene>();
+  loadScene(xml, {}, *scene);
+  ViewOptions vo;
+  vo.threads = 1;
+  vo.maxSpp = 16;
+  auto s = std::make_unique<ViewSession>(std::move(scene), xml, vo);
+  s->start([&sink](ViewFrame f) { sink(std::move(f)); });
+  return s;
+}
+
+}  // namespace
+
+TEST(ViewSession, FramesComeOnRequestAndFollowTheControls) {
+  test::TempDir d;
+  Sink sink;
+  auto session = makeSession(d.path.string(), sink);
+  json hello = json::parse(session->hello());
+  EXPECT_EQ(hello["type"], "hello");
+  EXPECT_EQ(hello["width"], 24);
+  EXPECT_EQ(hello["integrator"], "path");
+
+  std::string jpeg;
+  json f1 = sink.waitFor(0, &jpeg);
+  EXPECT_EQ(f1["type"], "frame");
+  EXPECT_EQ(f1["width"], 24);
+  EXPECT_GE(f1["spp"].get<int>(), 1);
+  ASSERT_GE(jpeg.size(), 4u);
+  EXPECT_EQ((unsigned char)jpeg[0], 0xFF) << "a JPEG starts with FF D8";
+  EXPECT_EQ((unsigned char)jpeg[1], 0xD8);
+  // One frame in flight: nothing more arrives until the page asks.
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  {
+    std::lock_guard<std::mutex> l(sink.m);
+    EXPECT_EQ(sink.frames.size(), 1u);
+  }
+  // Exposure re-encodes without re-rendering: the next frame says so.
+  EXPECT_EQ(session->handle(R"({"type":"exposure","value":2})"), "");
+  session->requestFrame();
+  json f2 = sink.waitFor(1);
+  EXPECT_EQ(f2["exposure"], 2.0);
+  // Frames until one satisfies pred (the renderer may still send frames of the old state).
+  auto until = [&](auto pred) {
+    json f;
+    for (int i = 0; i < 50; ++i) {
+      size_t n;
+      {
+        std::lock_guard<std::mutex> l(sink.m);
+        n = sink.frames.size();
+      }
+      session->requestFrame();
+      f = sink.waitFor(n);
+      if (f.is_null() || pred(f)) break;
+    }
+    return f;
+  };
+  // A camera move restarts accumulation and carries its version.
+  session->handle(R"({"type":"camera","origin":[0,1,4],"target":[0,0,0],"up":[0,1,0],"version":7})");
+  json f3 = until([](const json& f) { return f["cameraVersion"] == 7; });
+  EXPECT_EQ(f3["cameraVersion"], 7);
+  EXPECT_LE(f3["spp"].get<int>(), 16);
+  // Resolution and integrator changes.
+  session->handle(R"({"type":"resolution","scale":0.5})");
+  session->handle(R"({"type":"integrator","value":"direct"})");
+  session->handle(R"({"type":"strategy","value":"uniform"})");
+  json f4 = until([](const json& f) { return f["width"] == 12 && f["integrator"] == "direct"; });
+  EXPECT_EQ(f4["width"], 12);
+  EXPECT_EQ(f4["height"], 8);
+  EXPECT_EQ(f4["integrator"], "direct");
+  EXPECT_EQ(f4["strategy"], "uniform");
+  // Save writes an EXR beside the scene, and the reply names it.
+  json saved = json::parse(session->handle(R"({"type":"save"})"));
+  EXPECT_EQ(saved["type"], "saved");
+  std::string path = saved["path"];
+  EXPECT_EQ(std::filesystem::path(path).parent_path(), d.path);
+  Image img = loadImage(path);
+  EXPECT_EQ(img.width, 12);
+  session->stop();
+}
+
+TEST(ViewSession, BadMessagesAreErrorsAndChangeNothing) {
+  test::TempDir d;
+  Sink sink;
+  auto session = makeSession(d.path.string(), sink);
+  auto errorOf = [&](const std::string& m) -> std::string {
+    try {
+      session->handle(m);
+    } catch (const std::runtime_error& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(errorOf("not json"), "malformed message (not a JSON object with a 'type')");
+  EXPECT_EQ(errorOf("[1,2]"), "malformed message (not a JSON object with a 'type')");
+  EXPECT_EQ(errorOf(R"({"type":"teleport"})"), "unknown message type 'teleport'");
+  EXPECT_EQ(errorOf(R"({"type":"exposure","value":99})"), "exposure: 'value' must be in [-20, 20]");
+  EXPECT_NE(errorOf(R"({"type":"exposure","value":"bright"})").find("exposure: "), std::string::npos);
+  EXPECT_EQ(errorOf(R"({"type":"camera","origin":[0,0,1],"target":[0,0,1],"up":[0,1,0]})"),
+            "camera: origin, target and up must span a frame");
+  EXPECT_EQ(errorOf(R"({"type":"camera","origin":[0,0],"target":[0,0,1],"up":[0,1,0]})"),
+            "camera: 'origin' must be 3 numbers");
+  EXPECT_NE(errorOf(R"({"type":"strategy","value":"nope"})").find("unknown strategy 'nope'"), std::string::npos);
+  EXPECT_NE(errorOf(R"({"type":"integrator","value":"bdpt"})").find("unknown integrator 'bdpt'"), std::string::npos);
+  EXPECT_EQ(errorOf(R"({"type":"environment","rotation":10,"scale":-1})"),
+            "environment: 'scale' must be in [0, 10000]");
+  EXPECT_EQ(errorOf(R"({"type":"resolution","scale":9})"), "resolution: 'scale' must be in [0.1, 2]");
+  // The session still renders what it rendered before.
+  json f = sink.waitFor(0);
+  EXPECT_EQ(f["exposure"], 0.0);
+  EXPECT_EQ(f["integrator"], "path");
+  EXPECT_EQ(f["width"], 24);
+}
