@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/CliRunner.h"
+#include "view/BrowserDriver.h"
 #include "scene/SceneLoader.h"
 #include "view/ViewSession.h"
 
@@ -42,15 +43,7 @@ struct Sink {
 
 std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& sink) {
   std::string xml = dir + "/ball.xml";
-  std::ofstream(xml) << R"(<scene version="3.0.0">
-  <integrator type="path"><integer name="max_depth" value="3"/></integrator>
-  <sensor type="perspective"><float name="fov" value="40"/>
-    <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
-    <film type="hdrfilm"><integer name="width" value="24"/><integer name="height" value="16"/></film>
-  </sensor>
-  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
-  <shape type="sphere"><float name="radius" value="1"/></shape>
-</scene>)";
+  test::writeBallScene(xml, 24, 16, "");
   auto scene = std::make_unique<Scene>();
   loadScene(xml, {}, *scene);
   ViewOptions vo;

@@ -1,0 +1,177 @@
+// `envgi view` in a real browser: headless Chromium (Debian's `chromium`, installed by
+// scripts/install-deps.sh) opens the page over the DevTools protocol; the first frame comes,
+// a mouse drag orbits (a new frame, from the new camera), the exposure slider re-tones, "Save
+// EXR" writes a readable file beside the scene, a second page is refused, bad messages get
+// error replies, and Ctrl-C stops the server cleanly. No display, no network.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <regex>
+
+#include "cli/CliRunner.h"
+#include "image/Image.h"
+#include "view/BrowserDriver.h"
+
+using namespace envgi;
+using namespace envgi::test;
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string findChromium() {
+  for (const char* name : {"chromium", "chromium-browser", "google-chrome"}) {
+    std::string cmd = std::string("command -v ") + name + " >/dev/null 2>&1";
+    if (std::system(cmd.c_str()) == 0) return name;
+  }
+  return "";
+}
+
+// The port a child printed in "http://HOST:PORT/".
+int portFrom(const std::string& log) {
+  std::smatch m;
+  if (std::regex_search(log, m, std::regex(R"(http://[^:/]+:([0-9]+)/)"))) return std::stoi(m[1]);
+  return -1;
+}
+
+std::string writeScene(const TempDir& d) {
+  std::string xml = d.file("ball.xml");
+  writeBallScene(xml, 96, 64, std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/studio.hdr");
+  return xml;
+}
+
+}  // namespace
+
+TEST(ViewBrowser, OrbitExposureSaveInHeadlessChromium) {
+  std::string chromium = findChromium();
+  ASSERT_FALSE(chromium.empty()) << "the browser test needs Debian's chromium (scripts/install-deps.sh installs it)";
+  TempDir d;
+  std::string scene = writeScene(d);
+  Child view({ENVGI_CLI_PATH, "view", scene, "--port", "0", "--threads", "2", "--max-spp", "256"}, d.file("view.log"));
+  ASSERT_TRUE(view.waitForLog("view: open http://", 30)) << view.log();
+  int port = portFrom(view.log());
+  ASSERT_GT(port, 0) << view.log();
+
+  Child browser({chromium, "--headless=new", "--no-sandbox", "--disable-gpu", "--no-first-run",
+                 "--remote-debugging-port=0", "--user-data-dir=" + d.file("profile"), "--window-size=900,600",
+                 "about:blank"},
+                d.file("chromium.log"));
+  ASSERT_TRUE(browser.waitForLog("DevTools listening on ws://", 60)) << browser.log();
+  int devPort = portFrom(std::regex_replace(browser.log(), std::regex("ws://"), "http://"));
+  ASSERT_GT(devPort, 0) << browser.log();
+  std::string list;
+  ASSERT_EQ(httpGet(devPort, "/json/list", &list), 200);
+  std::string pageWs;
+  for (const json& t : json::parse(list))
+    if (t.value("type", "") == "page") pageWs = t.value("webSocketDebuggerUrl", "");
+  ASSERT_FALSE(pageWs.empty()) << list;
+  DevTools page(devPort, pageWs.substr(pageWs.find('/', 5)));
+  page.call("Runtime.enable");
+  page.call("Log.enable");
+  page.call("Page.enable");
+  page.call("Page.navigate", {{"url", "http://127.0.0.1:" + std::to_string(port) + "/"}});
+
+  // The first frame, then a drag across the image: a frame from camera version >= 1 that differs.
+  ASSERT_TRUE(page.waitFor("window.envgiTest !== undefined && envgiTest.frames >= 1", 30)) << view.log();
+  json first = page.eval("envgiTest.lastMeta");
+  EXPECT_EQ(first["width"], 96);
+  EXPECT_EQ(first["cameraVersion"], 0);
+  double hash0 = page.eval("envgiTest.lastHash").get<double>();
+  json rect = page.eval("(() => { const r = document.getElementById('frame').getBoundingClientRect();"
+                        " return [r.left + r.width / 2, r.top + r.height / 2]; })()");
+  double x = rect[0], y = rect[1];
+  page.mouse("mousePressed", x, y);
+  for (int i = 1; i <= 10; ++i) page.mouse("mouseMoved", x + 8 * i, y);
+  page.mouse("mouseReleased", x + 80, y);
+  ASSERT_TRUE(page.waitFor("envgiTest.cameraSent >= 1 && envgiTest.lastMeta.cameraVersion >= 1", 30))
+      << page.eval("JSON.stringify(envgiTest)").dump() << view.log();
+  EXPECT_NE(page.eval("envgiTest.lastHash").get<double>(), hash0) << "the orbit changed the picture";
+  EXPECT_TRUE(page.eval("envgiTest.latencyMs !== null && envgiTest.latencyMs > 0") == true)
+      << "the page reports the time from a move to its frame";
+
+  // Exposure: the slider's value comes back on the next frame.
+  page.eval("(() => { const e = document.getElementById('exposure'); e.value = '2';"
+            " e.dispatchEvent(new Event('input')); })()");
+  EXPECT_TRUE(page.waitFor("envgiTest.lastMeta.exposure === 2", 30));
+
+  // Save: a readable EXR beside the scene, named in the page.
+  page.eval("document.getElementById('save').click()");
+  ASSERT_TRUE(page.waitFor("envgiTest.saved !== null", 30)) << view.log();
+  std::string saved = page.eval("envgiTest.saved");
+  EXPECT_EQ(fs::path(saved).parent_path(), d.path);
+  Image img = loadImage(saved);
+  EXPECT_EQ(img.width, 96);
+  EXPECT_EQ(img.height, 64);
+
+  // A second page is refused; the first keeps its frames.
+  {
+    WsConnection second(port, "/ws");
+    json m = json::parse(second.read(10));
+    EXPECT_EQ(m["type"], "error");
+    EXPECT_EQ(m["message"], "another page is already connected");
+  }
+  EXPECT_TRUE(view.waitForLog("a second client was refused", 10));
+  int frames = page.eval("envgiTest.frames");
+  page.eval("(() => { const e = document.getElementById('exposure'); e.value = '1';"
+            " e.dispatchEvent(new Event('input')); })()");
+  EXPECT_TRUE(page.waitFor("envgiTest.frames > " + std::to_string(frames), 30));
+
+  EXPECT_EQ(page.eval("envgiTest.errors.length"), 0) << page.eval("JSON.stringify(envgiTest.errors)").dump();
+  page.call("Runtime.evaluate", {{"expression", "1"}});  // drain pending events
+  EXPECT_TRUE(page.pageErrors().empty()) << page.pageErrors().front();
+
+  // Closing the browser drops the socket; the server says so and goes on.
+  browser.signal(SIGKILL);
+  EXPECT_TRUE(view.waitForLog("the page disconnected", 10)) << view.log();
+  {
+    // Bad messages from a new client: error replies, the server keeps serving.
+    WsConnection ws(port, "/ws");
+    json hello = json::parse(ws.read(10));
+    EXPECT_EQ(hello["type"], "hello");
+    ws.send("{{{ not json");
+    ws.send(R"({"type":"exposure","value":"bright"})");
+    int errors = 0;
+    bool gotFrame = false;
+    for (int i = 0; i < 20 && (errors < 2 || !gotFrame); ++i) {
+      bool binary = false;
+      std::string m = ws.read(10, &binary);
+      if (binary) {
+        gotFrame = true;
+        ws.send(R"({"type":"next"})");
+        continue;
+      }
+      json j = json::parse(m);
+      if (j["type"] == "error") ++errors;
+    }
+    EXPECT_EQ(errors, 2);
+    EXPECT_TRUE(gotFrame);
+  }
+  // The page is served only at / ; nothing else of the disk.
+  EXPECT_EQ(httpGet(port, "/../../etc/passwd", nullptr), 404);
+  EXPECT_EQ(httpGet(port, "/ball.xml", nullptr), 404);
+
+  // Ctrl-C: one line, exit 0.
+  view.signal(SIGINT);
+  EXPECT_EQ(view.wait(20), 0) << view.log();
+  EXPECT_NE(view.log().find("SIGINT received, stopping"), std::string::npos) << view.log();
+}
+
+// Bound wider than loopback, every request needs the token printed at start.
+TEST(ViewBrowser, WiderBindingRequiresTheToken) {
+  TempDir d;
+  std::string scene = writeScene(d);
+  Child view({ENVGI_CLI_PATH, "view", scene, "--host", "0.0.0.0", "--port", "0", "--threads", "1"}, d.file("v.log"));
+  ASSERT_TRUE(view.waitForLog("view: open http://", 30)) << view.log();
+  std::smatch m;
+  std::string log = view.log();
+  ASSERT_TRUE(std::regex_search(log, m, std::regex(R"(:([0-9]+)/\?token=([0-9a-f]{32}))"))) << log;
+  int port = std::stoi(m[1]);
+  std::string token = m[2];
+  EXPECT_EQ(httpGet(port, "/", nullptr), 403);
+  EXPECT_EQ(httpGet(port, "/?token=wrong", nullptr), 403);
+  std::string body;
+  EXPECT_EQ(httpGet(port, "/?token=" + token, &body), 200);
+  EXPECT_NE(body.find("envgi view"), std::string::npos);
+  view.signal(SIGTERM);
+  EXPECT_EQ(view.wait(20), 0) << view.log();
+}
