@@ -237,7 +237,11 @@ void ViewSession::run() {
           ro.progress = false;
           ro.threads = opts_.threads;
           ro.spp = opts_.maxSpp;
+          auto tp = Clock::now();
+          pr = PreparedRender{};  // free the old executor's maps first
           pr = prepareRender(*scene_, *accel_, ro);
+          spdlog::info("view: {} ready in {:.2f} s (rebuild {}, restart {})", s.integrator,
+                       std::chrono::duration<double>(Clock::now() - tp).count(), rebuild, restart);
         }
       } catch (const std::runtime_error& e) {
         spdlog::warn("view: {}", e.what());
@@ -258,7 +262,10 @@ void ViewSession::run() {
       if (send) {
         state_->frameRequested = false;
         state_->toneChanged = false;
-        s = *state_;
+        // Only the tone settings: a camera or integrator that arrived since is not what this
+        // film holds, and the frame must not claim it.
+        s.exposure = state_->exposure;
+        s.tone = state_->tone;
       }
     }
     if (!send) continue;
