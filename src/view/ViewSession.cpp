@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "scene/NameTables.h"
@@ -23,6 +24,7 @@ struct ViewSession::State {
   float envRotation = 0.f, envScale = 1.f;  // degrees about +Y on top of the file's placement
   std::string strategy, integrator;
   float resolutionScale = 1.f;
+  int sceneVersion = 0;  // bumped by what every executor depends on (environment, strategy)
   bool restart = true;   // the camera or resolution changed: an empty film
   bool rebuild = true;   // the integrator, strategy or environment changed: a new executor
   bool toneChanged = false;
@@ -136,9 +138,11 @@ std::string ViewSession::handle(const std::string& message) {
       next.envRotation = number(j, "rotation", -360.f, 360.f);
       next.envScale = number(j, "scale", 0.f, 1e4f);
       next.rebuild = true;
+      ++next.sceneVersion;
     } else if (type == "strategy") {
       next.strategy = findStrategy(j.at("value").get<std::string>()).name;
       next.rebuild = true;
+      ++next.sceneVersion;
     } else if (type == "integrator") {
       next.integrator = integratorName(findIntegrator(j.at("value").get<std::string>()));
       next.rebuild = true;
@@ -196,6 +200,11 @@ ViewFrame ViewSession::makeFrame(const Image& hdr, const State& s) {
 
 void ViewSession::run() {
   PreparedRender pr;
+  std::string prIntegrator;
+  // Executors of other integrators, kept while the scene stays the same, so that switching
+  // back (grid while the camera moves, path when it stops) costs no new photon maps.
+  std::map<std::string, PreparedRender> parked;
+  int parkedVersion = 0;
   int spp = 0, sentSpp = -1, frame = 0;
   const int baseW = scene_->camera.width, baseH = scene_->camera.height;
   const Transform envBase = scene_->env ? scene_->env->options().toWorld : Transform{};
@@ -232,7 +241,19 @@ void ViewSession::run() {
           scene_->integrator.setStrategy(s.strategy);
         }
         scene_->finalize();
-        if (rebuild || !pr.executor || !pr.executor->restart(scene_->view().camera)) {
+        if (s.sceneVersion != parkedVersion) {
+          parked.clear();
+          parkedVersion = s.sceneVersion;
+          if (pr.executor) pr = PreparedRender{};
+        }
+        if (rebuild && prIntegrator != s.integrator) {
+          if (pr.executor) parked[prIntegrator] = std::move(pr);
+          auto it = parked.find(s.integrator);
+          pr = it != parked.end() ? std::move(it->second) : PreparedRender{};
+          if (it != parked.end()) parked.erase(it);
+          prIntegrator = s.integrator;
+        }
+        if (!pr.executor || !pr.executor->restart(scene_->view().camera)) {
           RenderOptions ro;
           ro.progress = false;
           ro.threads = opts_.threads;
@@ -240,12 +261,14 @@ void ViewSession::run() {
           auto tp = Clock::now();
           pr = PreparedRender{};  // free the old executor's maps first
           pr = prepareRender(*scene_, *accel_, ro);
-          spdlog::info("view: {} ready in {:.2f} s (rebuild {}, restart {})", s.integrator,
-                       std::chrono::duration<double>(Clock::now() - tp).count(), rebuild, restart);
+          ++preparations_;
+          spdlog::info("view: {} ready in {:.2f} s", s.integrator,
+                       std::chrono::duration<double>(Clock::now() - tp).count());
         }
       } catch (const std::runtime_error& e) {
         spdlog::warn("view: {}", e.what());
         pr = PreparedRender{};
+        prIntegrator.clear();
         if (sink_) sink_(ViewFrame{json{{"type", "error"}, {"message", e.what()}}.dump(), ""});
       }
       spp = 0;

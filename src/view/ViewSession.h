@@ -51,6 +51,9 @@ class ViewSession {
   void requestFrame();
 
   int framesSent() const { return framesSent_.load(); }
+  // How many executors were made (photon maps, grids...): switching back to an integrator
+  // used before, with the same environment and strategy, makes none.
+  int preparations() const { return preparations_.load(); }
   // Writes the current image beside the scene (atomically); returns its path.
   std::string saveExr();
 
@@ -70,6 +73,7 @@ class ViewSession {
   std::thread worker_;
   std::atomic<bool> stop_{false};
   std::atomic<int> framesSent_{0};
+  std::atomic<int> preparations_{0};
   Image lastImage_;  // the mean so far, for save (guarded by mutex_)
 };
 

@@ -32,6 +32,7 @@ inline constexpr const char* kViewerPage = R"envgipage(<!doctype html>
     <input id="exposure" type="range" min="-8" max="8" step="0.1" value="0"></label>
   <label>Tone curve <select id="tonemap"><option value="clamp">clamp</option><option value="aces">ACES</option></select></label>
   <label>Integrator <select id="integrator"></select></label>
+  <label><input id="gridWhileMoving" type="checkbox"> grid while the camera moves</label>
   <label>Strategy <select id="strategy"></select></label>
   <label>Environment rotation <span id="rotationValue">0</span>&deg;
     <input id="rotation" type="range" min="-180" max="180" step="1" value="0"></label>
@@ -62,7 +63,18 @@ const rot = (v, k, a) => add(add(mul(v, Math.cos(a)), mul(cross(k, v), Math.sin(
 function send(obj) { if (ws && ws.readyState === 1) ws.send(JSON.stringify(obj)); }
 function showMessage(text) { $("message").textContent = text; }
 
+// With "grid while the camera moves": the fast grid method during a move, the chosen
+// integrator again 300 ms after the last one (the server keeps both prepared).
+let moving = false, stopTimer = null;
+function noteMove() {
+  if (!$("gridWhileMoving").checked || $("integrator").value === "grid") return;
+  if (!moving) { moving = true; send({ type: "integrator", value: "grid" }); }
+  clearTimeout(stopTimer);
+  stopTimer = setTimeout(() => { moving = false; send({ type: "integrator", value: $("integrator").value }); }, 300);
+}
+
 function sendCamera() {
+  noteMove();
   if (cameraQueued) return;
   cameraQueued = true;
   requestAnimationFrame(() => {

@@ -46,6 +46,11 @@ std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& sink) {
   test::writeBallScene(xml, 24, 16, "");
   auto scene = std::make_unique<Scene>();
   loadScene(xml, {}, *scene);
+  GridSettings& grid = scene->integrator.grid;  // small, so that the grid is quick to make
+  grid.globalPhotons = 5000;
+  grid.causticPhotons = 0;
+  grid.resolution = 8;
+  grid.gatherRays = 16;
   ViewOptions vo;
   vo.threads = 1;
   vo.maxSpp = 16;
@@ -154,4 +159,41 @@ TEST(ViewSession, BadMessagesAreErrorsAndChangeNothing) {
   EXPECT_EQ(f["exposure"], 0.0);
   EXPECT_EQ(f["integrator"], "path");
   EXPECT_EQ(f["width"], 24);
+}
+
+// Switching back to an integrator used before keeps its preparation (the grid's photon maps):
+// what "grid while the camera moves" relies on. A strategy change drops them all.
+TEST(ViewSession, SwitchingBackReusesThePreparedIntegrator) {
+  test::TempDir d;
+  Sink sink;
+  auto session = makeSession(d.path.string(), sink);
+  auto showing = [&](const std::string& integrator, const std::string& strategy) {
+    for (int i = 0; i < 200; ++i) {
+      size_t n;
+      {
+        std::lock_guard<std::mutex> l(sink.m);
+        n = sink.frames.size();
+      }
+      session->requestFrame();
+      json f = sink.waitFor(n);
+      if (f.is_null() || (f["integrator"] == integrator && f["strategy"] == strategy)) return;
+    }
+    ADD_FAILURE() << "no frame from " << integrator;
+  };
+  showing("path", "mis");
+  int base = session->preparations();
+  session->handle(R"({"type":"integrator","value":"grid"})");
+  showing("grid", "mis");
+  EXPECT_EQ(session->preparations(), base + 1);
+  for (int i = 0; i < 2; ++i) {
+    session->handle(R"({"type":"integrator","value":"path"})");
+    session->handle(R"({"type":"camera","origin":[0,1.5,4],"target":[0,0,0],"up":[0,1,0]})");
+    showing("path", "mis");
+    session->handle(R"({"type":"integrator","value":"grid"})");
+    showing("grid", "mis");
+  }
+  EXPECT_EQ(session->preparations(), base + 1) << "path and grid were both kept";
+  session->handle(R"({"type":"strategy","value":"importance"})");
+  showing("grid", "importance");
+  EXPECT_EQ(session->preparations(), base + 2) << "a new strategy makes the grid anew";
 }
