@@ -1,0 +1,90 @@
+#!/usr/bin/env python3
+"""envgi's `path` against Mitsuba 3's on envgi's own example scenes (the same XML): RMSE at
+equal samples and at equal time, each renderer against its own high-sample reference (so a
+systematic difference between the two, docs/validation.md, does not count as noise).
+
+Times are render times only: envgi's "done in" (passes, after loading and Embree), Mitsuba's
+mi.render after a warm-up render (its kernels compiled). Run through scripts/perf-mitsuba.sh;
+prints the Markdown table that docs/performance.md holds.
+"""
+import argparse
+import os
+import re
+import subprocess
+import tempfile
+import time
+
+import mitsuba as mi
+import numpy as np
+
+from crosscheck_mitsuba import ENVGI_ONLY
+
+
+def envgi_render(envgi, xml, out, spp, seed, res, threads):
+    cmd = [envgi, 'render', xml, '-o', out, '--spp', str(spp), '--seed', str(seed), '--no-progress',
+           '--device', 'cpu', '--integrator', 'path', '--strategy', 'mis', '-D', f'res={res}', '--threads', str(threads)]
+    log = subprocess.run(cmd, check=True, capture_output=True, text=True)
+    m = re.search(r'done in ([0-9.]+) s', log.stdout + log.stderr)
+    return np.array(mi.Bitmap(out))[..., :3].astype(np.float64), float(m.group(1))
+
+
+def mitsuba_scene(xml, res):
+    text = ENVGI_ONLY.sub('', open(xml).read())
+    # envgi's scenes may name direct; the comparison is of path tracers.
+    text = re.sub(r'<integrator type="[a-z]+">', '<integrator type="path">', text)
+    text = re.sub(r'<integer name="(emitter_samples|bsdf_samples|shading_samples)"[^>]*/>', '', text)
+    resolver = mi.Thread.thread().file_resolver()
+    resolver.prepend(os.path.dirname(os.path.abspath(xml)))
+    return mi.load_string(text, res=str(res))
+
+
+def mitsuba_render(scene, spp, seed):
+    t = time.perf_counter()
+    img = np.array(mi.render(scene, spp=spp, seed=seed))[..., :3].astype(np.float64)
+    return img, time.perf_counter() - t
+
+
+def rmse(a, b):
+    return float(np.sqrt(np.mean((a - b) ** 2)))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument('--envgi', required=True)
+    ap.add_argument('--scenes', required=True)
+    ap.add_argument('--variant', default='llvm_ad_rgb')
+    ap.add_argument('--res', type=int, default=256)
+    ap.add_argument('--ref-spp', type=int, default=2048)
+    ap.add_argument('--spp', default='16,64')
+    ap.add_argument('--threads', type=int, default=os.cpu_count())
+    args = ap.parse_args()
+    mi.set_variant(args.variant)
+    tmp = tempfile.mkdtemp(prefix='envgi_perf_')
+    out = os.path.join(tmp, 'e.exr')
+    rows = []
+    for name in ('buddha', 'cornell-box', 'teapot-glass'):
+        xml = os.path.join(args.scenes, name + '.xml')
+        eref, _ = envgi_render(args.envgi, xml, out, args.ref_spp, 1, args.res, args.threads)
+        scene = mitsuba_scene(xml, args.res)
+        mitsuba_render(scene, 4, 0)  # compiles its kernels
+        mref, _ = mitsuba_render(scene, args.ref_spp, 1)
+        for spp in (int(s) for s in args.spp.split(',')):
+            mimg, mt = mitsuba_render(scene, spp, 7)
+            eimg, et = envgi_render(args.envgi, xml, out, spp, 7, args.res, args.threads)
+            espp = max(1, int(round(spp * mt / et)))
+            eimg2, et2 = envgi_render(args.envgi, xml, out, espp, 7, args.res, args.threads)
+            rm, re_, re2 = rmse(mimg, mref), rmse(eimg, eref), rmse(eimg2, eref)
+            rows.append((name, spp, mt, rm, et, re_, espp, et2, re2, (re2 * re2 * et2) / (rm * rm * mt)))
+            print(rows[-1], flush=True)
+    print(f'\nMitsuba {mi.__version__} {args.variant} vs envgi path (strategy mis), {args.res}^2, '
+          f'{args.threads} threads; RMSE against each renderer\'s own {args.ref_spp}-spp reference\n')
+    print('| scene | spp | Mitsuba s | Mitsuba RMSE | envgi s | envgi RMSE | envgi spp, same time | s | RMSE | '
+          'envgi RMSE² t / Mitsuba\'s |')
+    print('|---|---|---|---|---|---|---|---|---|---|')
+    for r in rows:
+        print(f'| {r[0]} | {r[1]} | {r[2]:.2f} | {r[3]:.4f} | {r[4]:.2f} | {r[5]:.4f} | {r[6]} | {r[7]:.2f} | {r[8]:.4f} '
+              f'| {r[9]:.2f} |')
+
+
+if __name__ == '__main__':
+    main()
