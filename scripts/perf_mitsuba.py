@@ -3,7 +3,7 @@
 equal samples and at equal time, each renderer against its own high-sample reference (so a
 systematic difference between the two, docs/validation.md, does not count as noise).
 
-Times are render times only: envgi's "done in" (passes, after loading and Embree), Mitsuba's
+Both use a box pixel filter (see mitsuba_scene). Times are render times only: envgi's "done in" (passes, after loading and Embree), Mitsuba's
 mi.render after a warm-up render (its kernels compiled). Run through scripts/perf-mitsuba.sh;
 prints the Markdown table that docs/performance.md holds.
 """
@@ -22,7 +22,8 @@ from crosscheck_mitsuba import ENVGI_ONLY
 
 def envgi_render(envgi, xml, out, spp, seed, res, threads):
     cmd = [envgi, 'render', xml, '-o', out, '--spp', str(spp), '--seed', str(seed), '--no-progress',
-           '--device', 'cpu', '--integrator', 'path', '--strategy', 'mis', '-D', f'res={res}', '--threads', str(threads)]
+           '--device', 'cpu', '--integrator', 'path', '--strategy', 'mis', '-D', f'res={res}', '--threads', str(threads),
+           '--filter', 'box']
     log = subprocess.run(cmd, check=True, capture_output=True, text=True)
     m = re.search(r'done in ([0-9.]+) s', log.stdout + log.stderr)
     return np.array(mi.Bitmap(out))[..., :3].astype(np.float64), float(m.group(1))
@@ -33,7 +34,11 @@ def mitsuba_scene(xml, res):
     # envgi's scenes may name direct; the comparison is of path tracers.
     text = re.sub(r'<integrator type="[a-z]+">', '<integrator type="path">', text)
     text = re.sub(r'<integer name="(emitter_samples|bsdf_samples|shading_samples)"[^>]*/>', '', text)
-    resolver = mi.Thread.thread().file_resolver()
+    # A box filter in both: Mitsuba splats a tent or Gaussian sample over several pixels, envgi
+    # importance-samples the filter (one pixel a sample), so with those the per-pixel noise
+    # would differ by design, not by the estimators.
+    text = re.sub(r'<rfilter type="[a-z]+"\s*/>', '<rfilter type="box"/>', text)
+    resolver = mi.file_resolver()
     resolver.prepend(os.path.dirname(os.path.abspath(xml)))
     return mi.load_string(text, res=str(res))
 
@@ -52,7 +57,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('--envgi', required=True)
     ap.add_argument('--scenes', required=True)
-    ap.add_argument('--variant', default='llvm_ad_rgb')
+    ap.add_argument('--variant', default='scalar_rgb')  # llvm_ad_rgb aborts in LLVM here (Debian's libLLVM)
     ap.add_argument('--res', type=int, default=256)
     ap.add_argument('--ref-spp', type=int, default=2048)
     ap.add_argument('--spp', default='16,64')

@@ -34,7 +34,7 @@ struct RenderArgs {
   float exposure = 0.f;
   bool aces = false;
   double checkpoint = 60.0;
-  std::string device = "auto", sampler, pointMethod;
+  std::string device = "auto", sampler, pointMethod, filter;
   int points = 0;
   int gpu = 0;
 };
@@ -87,6 +87,7 @@ void runRender(const RenderArgs& a) {
   if (!a.pointMethod.empty()) scene.integrator.env.pointMethod = a.pointMethod;  // Scene::finalize checks it
   if (a.seed >= 0) scene.sampler.seed = uint32_t(a.seed);
   if (!a.sampler.empty()) scene.sampler.type = findSampler(a.sampler);
+  if (!a.filter.empty()) scene.camera.filter = findName(kFilterNames, a.filter, "filter");
   scene.finalize();
   bool cuda = chooseCuda(a, scene.integrator.type);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -181,6 +182,7 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("--checkpoint", a->checkpoint, "Seconds between writes of the image so far (0: never)");
   c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
   c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(CLI::NonNegativeNumber);
+  c->add_option("--filter", a->filter, "Pixel filter: " + nameList(kFilterNames) + " (overrides the scene)");
   c->add_option("--sampler", a->sampler, "Sample sequence: " + nameList(kSamplerNames) + " (overrides the scene)");
   c->callback([a] { runRender(*a); });
 }

@@ -22,6 +22,7 @@ template <class Tracer>
 ENVGI_HD Color pathTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& smp, const PathParams& pp,
                          uint64_t* rayCount) {
   Color L(0.f), beta(1.f);
+  float etaScale = 1.f;  // product of eta^2 over refractions, for Russian roulette
   float prevPdf = 0.f;
   bool prevDelta = true;
   Vec3f prevP = ray.o, prevAxis(0.f, 0.f, 1.f);
@@ -59,6 +60,7 @@ ENVGI_HD Color pathTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sam
     if (!bsdfSample(bsdf, woLocal, uc, ub, &bs)) break;
     Vec3f wi = si.shading.toWorld(bs.wi);
     beta *= bs.weight;
+    etaScale *= bsdfEtaSquared(bsdf, woLocal, bs.wi);
     if (isBlack(beta)) break;
     prevPdf = bs.pdf;
     prevDelta = bs.delta;
@@ -68,7 +70,7 @@ ENVGI_HD Color pathTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sam
     ray.d = wi;
     ray.tMax = INFINITY;
 
-    if (depth >= pp.rrDepth && !russianRoulette(&beta, smp.get1D(), kRouletteMaxSurvival)) break;
+    if (depth >= pp.rrDepth && !russianRoulette(&beta, smp.get1D(), kRouletteMaxSurvival, etaScale)) break;
   }
   return L;
 }

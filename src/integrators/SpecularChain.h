@@ -64,6 +64,7 @@ template <class Tracer, class Estimate>
 ENVGI_HD Color traceSpecularChain(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& smp,
                                   const ChainParams& cp, const Estimate& estimate, uint64_t* rays) {
   Color L(0.f), beta(1.f);
+  float etaScale = 1.f;  // product of eta^2 over refractions, for Russian roulette
   bool countEmission = !cp.hideEmitters;  // camera rays and specular bounces see emitters
   for (int depth = 0; depth < cp.maxDepth; ++depth) {
     Hit h;
@@ -96,10 +97,11 @@ ENVGI_HD Color traceSpecularChain(const SceneView& sc, const Tracer& tracer, Ray
     if (pDelta > 0.f && pDelta < 1.f && !bs.delta) break;
     beta *= bs.weight;
     if (isBlack(beta)) break;
+    etaScale *= bsdfEtaSquared(bsdf, si.shading.toLocal(wo), bs.wi);
     countEmission = bs.delta;  // after a glossy bounce, directLighting counted the emitters
     Vec3f wi = si.shading.toWorld(bs.wi);
     ray = Ray{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};
-    if (depth + 1 >= cp.rrDepth && !russianRoulette(&beta, smp.get1D(), kRouletteMaxSurvival)) break;
+    if (depth + 1 >= cp.rrDepth && !russianRoulette(&beta, smp.get1D(), kRouletteMaxSurvival, etaScale)) break;
   }
   return L;
 }

@@ -43,6 +43,16 @@ struct BsdfSample {
   bool delta = false;
 };
 
+// The squared relative index of refraction a path crossed going from wo to wi through a
+// dielectric (1 for reflection and for thin sheets): the 1/eta^2 by which radiance was
+// compressed, which Russian roulette should not count as lost throughput (pbrt-v4's etaScale,
+// Mitsuba 3's eta^2 in its roulette).
+ENVGI_INLINE float bsdfEtaSquared(const Bsdf& b, Vec3f wo, Vec3f wi) {
+  if ((b.type != BsdfType::Dielectric && b.type != BsdfType::RoughDielectric) || wo.z * wi.z >= 0.f) return 1.f;
+  float etap = wo.z > 0.f ? b.ior : 1.f / b.ior;
+  return etap * etap;
+}
+
 // True when every lobe is a delta: next-event estimation is pointless there.
 ENVGI_INLINE bool bsdfIsDelta(const Bsdf& b) {
   return b.type == BsdfType::Conductor || b.type == BsdfType::Dielectric || b.type == BsdfType::ThinDielectric;
