@@ -179,6 +179,10 @@ TEST(RenderCli, SamplerVersionAndParseErrors) {
   EXPECT_EQ(s.code, 0) << s.output;
   EXPECT_NE(s.output.find("stratified sampler"), std::string::npos) << s.output;
   EXPECT_EQ(runCli("render " + scene + " -o " + d.file("t.exr") + " --sampler halton").code, 1);
+  EXPECT_EQ(runCli("render " + scene + " -o " + d.file("f.exr") + " --filter tent --no-progress").code, 0);
+  CliResult f = runCli("render " + scene + " -o " + d.file("g.exr") + " --filter lanczos");
+  EXPECT_NE(f.output.find("unknown filter 'lanczos' (box, tent, gaussian)"), std::string::npos) << f.output;
+  EXPECT_FALSE(fs::exists(d.file("g.exr")));
   // The collapsed map's options and the device index: bad values are one error line, no file.
   for (std::string bad : {"--strategy points --point-method bogus", "--strategy magic", "--points 0", "--gpu -1"}) {
     CliResult b = runCli("render " + scene + " -o " + d.file("bad.exr") + " --no-progress " + bad);
