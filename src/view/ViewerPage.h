@@ -15,7 +15,8 @@ inline constexpr const char* kViewerPage = R"envgipage(<!doctype html>
 <style>
   body { margin: 0; background: #1e1e1e; color: #ddd; font: 13px system-ui, sans-serif; display: flex; }
   #view { flex: 1; display: flex; align-items: center; justify-content: center; height: 100vh; }
-  #frame { image-rendering: auto; max-width: 100%; max-height: 100vh; cursor: grab; background: #000; }
+  /* Scaled to fit the window whatever the render's size (the resolution control). */
+  #frame { width: 100%; height: 100vh; object-fit: contain; cursor: grab; }
   #panel { width: 250px; padding: 10px; background: #2a2a2a; height: 100vh; box-sizing: border-box; overflow-y: auto; }
   #panel label { display: block; margin-top: 10px; }
   #panel input[type=range], #panel select { width: 100%; }
