@@ -178,6 +178,18 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
   return k;
 }
 
+Image filmMean(const FilmSums& film, int width, int height, int samples) {
+  Image img(width, height);
+  size_t n = std::min(film.sum.size(), size_t(width) * size_t(height));
+  for (size_t i = 0; i < n; ++i) {
+    Color c = film.sum[i] / float(std::max(samples, 1));
+    img.rgb[3 * i] = c.x;
+    img.rgb[3 * i + 1] = c.y;
+    img.rgb[3 * i + 2] = c.z;
+  }
+  return img;
+}
+
 Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts, RenderStats* stats) {
   // Passes double in size (1, 1, 2, 4, ...) up to the executor's limit (64 samples on the CPU),
   // so a checkpoint comes early.
@@ -193,14 +205,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   bool cancelled = false;
   auto meanImage = [&](int n) {
     ex.readFilm(&film);
-    Image img(W, H);
-    for (size_t i = 0; i < film.sum.size(); ++i) {
-      Color c = film.sum[i] / float(n);
-      img.rgb[3 * i] = c.x;
-      img.rgb[3 * i + 1] = c.y;
-      img.rgb[3 * i + 2] = c.z;
-    }
-    return img;
+    return filmMean(film, W, H, n);
   };
   for (auto [s0, s1] : passes) {
     if (opts.cancel && opts.cancel->load()) {

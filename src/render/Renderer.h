@@ -59,6 +59,9 @@ PreparedRender prepareRender(const Scene& scene, const EmbreeAccel& accel, const
 // Renders on the CPU (Embree, or the GPU's BVH by opts.cpuTracer), any integrator.
 Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats);
 
+// The film's per-pixel means after `samples` samples a pixel.
+Image filmMean(const FilmSums& film, int width, int height, int samples);
+
 // The loop itself, over an executor that already holds the scene (e.g. a GPU's).
 Image renderPasses(PassExecutor& executor, int width, int height, int spp, const RenderOptions& opts,
                    RenderStats* stats);

@@ -238,7 +238,9 @@ void ViewSession::run() {
         if (rebuild) {
           if (scene_->env) scene_->env->setPlacement(envBaseScale * s.envScale, rotate(Vec3f(0, 1, 0), s.envRotation) * envBase);
           scene_->integrator.type = findIntegrator(s.integrator);
-          scene_->integrator.setStrategy(s.strategy);
+          // Only a new strategy resets direct's sample counts to the strategy's own; an
+          // integrator or environment change keeps what the scene file set.
+          if (s.strategy != scene_->integrator.env.strategy) scene_->integrator.setStrategy(s.strategy);
         }
         scene_->finalize();
         if (s.sceneVersion != parkedVersion) {
@@ -295,13 +297,7 @@ void ViewSession::run() {
     FilmSums film;
     pr.executor->readFilm(&film);
     const Camera& cam = scene_->view().camera;
-    Image img(cam.width, cam.height);
-    for (size_t i = 0; i < film.sum.size() && i < size_t(cam.width) * cam.height; ++i) {
-      Color c = film.sum[i] / float(std::max(spp, 1));
-      img.rgb[3 * i] = c.x;
-      img.rgb[3 * i + 1] = c.y;
-      img.rgb[3 * i + 2] = c.z;
-    }
+    Image img = filmMean(film, cam.width, cam.height, spp);
     ViewFrame f = makeFrame(img, s);
     auto now = Clock::now();
     double seconds = std::chrono::duration<double>(now - t0).count();

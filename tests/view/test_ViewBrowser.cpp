@@ -175,3 +175,17 @@ TEST(ViewBrowser, WiderBindingRequiresTheToken) {
   view.signal(SIGTERM);
   EXPECT_EQ(view.wait(20), 0) << view.log();
 }
+
+// Bad start-up arguments are one error line and a non-zero exit, before anything listens.
+TEST(ViewBrowser, BadArgumentsAreOneErrorLine) {
+  TempDir d;
+  std::string scene = writeScene(d);
+  for (std::string bad : {"--host not-an-address", "--integrator bdpt", "--strategy magic", "--port 70000"}) {
+    CliResult r = runCli("view " + scene + " " + bad);
+    EXPECT_NE(r.code, 0) << bad;
+    EXPECT_NE(r.output.find("error"), std::string::npos) << bad << ": " << r.output;
+    EXPECT_EQ(r.output.find("view: open"), std::string::npos) << bad << ": " << r.output;
+  }
+  CliResult missing = runCli("view " + d.file("absent.xml"));
+  EXPECT_NE(missing.code, 0);
+}
