@@ -88,7 +88,7 @@ static void BM_SppmPass(benchmark::State& state) {
   SppmStats st;
   Progress quiet(1, false);
   for (auto _ : state) {
-    SppmExecutor ex(f.scene, *f.accel, s, 0);
+    SppmExecutor<EmbreeTracer> ex(f.scene, EmbreeTracer{f.accel.get()}, s, 0);
     PassCounters c;
     ex.runPass(0, 1, quiet, &c);
     st = ex.stats();

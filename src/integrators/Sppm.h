@@ -1,10 +1,12 @@
 // Stochastic progressive photon mapping (Hachisuka and Jensen 2009). Each pass traces one
 // camera path per pixel to its first non-specular surface (a visible point, with direct light
 // by MIS there), shoots photons, and gathers them at visible points through a hashed grid;
-// per-pixel radii shrink with alpha. This is the per-path, host/device part; the driver that
-// runs its passes is render/SppmExecutor.
+// per-pixel radii shrink with alpha. This is the host/device part: one function per step of an
+// iteration and per element (pixel or photon), which the CPU driver (render/SppmExecutor, oneTBB)
+// and the CUDA one (gpu/CudaSppm.cu) both run.
 #pragma once
 
+#include "core/Atomic.h"
 #include "integrators/DirectIntegrator.h"
 #include "photon/HashGrid.h"
 #include "photon/PhotonTracing.h"
@@ -83,5 +85,97 @@ struct SppmParams {
   uint32_t seed = 0;
   EnvStrategy strategy = EnvStrategy::Alias;
 };
+
+// The radius every pixel starts with: the scene's, or 1% of its bounding-sphere radius.
+ENVGI_INLINE float sppmInitialRadius(const SppmParams& s, const PhotonEmitter& e) {
+  return s.initialRadius > 0.f ? s.initialRadius : 0.01f * e.radius;
+}
+
+// Per-pixel SPPM state as flat arrays (host or device memory): the visible point, the photon
+// statistics of Hachisuka and Jensen (R^2, N, tau, and this pass's M and Phi) and the sum of
+// direct light over passes.
+struct SppmPixels {
+  VisiblePoint* vp = nullptr;
+  Vec3f* vpPos = nullptr;
+  char* vpValid = nullptr;
+  float* r2 = nullptr;
+  float* n = nullptr;
+  float* phi = nullptr;  // 3 a pixel, summed by atomics during the photon pass
+  uint32_t* m = nullptr;
+  Color* tau = nullptr;
+  Color* ld = nullptr;
+};
+
+// Camera step for pixel i of pass `pass`: its visible point and direct light. Returns rays.
+template <class Tracer>
+ENVGI_HD uint64_t sppmCameraStep(const SceneView& sc, const Tracer& tracer, const SppmParams& s, SppmPixels px, int i,
+                                 int pass) {
+  const Camera& cam = sc.camera;
+  Sampler smp;
+  smp.type = SamplerType::Independent;
+  smp.seed = s.seed;
+  smp.start(uint64_t(i), uint32_t(pass));
+  Vec2f off = sampleFilter(cam.filter, smp.get2D());
+  Ray ray = cam.generateRay(float(i % cam.width) + 0.5f + off.x, float(i / cam.width) + 0.5f + off.y);
+  Color L(0.f);
+  uint64_t rays = 0;
+  VisiblePoint vp = sppmCameraPath(sc, tracer, ray, smp, s.maxDepth, s.strategy, &L, &rays);
+  if (isFiniteVec(L)) px.ld[i] += L;
+  px.vp[i] = vp;
+  px.vpPos[i] = vp.p;
+  px.vpValid[i] = vp.valid && isFiniteVec(vp.beta) && !isBlack(vp.beta);
+  return rays;
+}
+
+// Photon j of pass `pass`: traced from the lights, splatted into every visible point within
+// its radius (atomics: photons from many threads meet at one pixel). Returns the splats made.
+template <class Tracer>
+ENVGI_HD uint32_t sppmPhotonStep(const SceneView& sc, const Tracer& tracer, const PhotonEmitter& emitter,
+                                 const SppmParams& s, SppmPixels px, const HashGridView& grid, uint64_t j, int pass) {
+  Sampler smp;
+  smp.type = SamplerType::Independent;
+  smp.seed = s.seed ^ kSppmPhotonStream;
+  smp.start(uint64_t(pass) * s.photonsPerPass + j, 1);
+  Ray ray;
+  Color power;
+  if (!emitter.emit(sc, smp, &ray, &power)) return 0;
+  uint32_t hits = 0;
+  tracePhoton(sc, tracer, ray, power, smp, s.maxDepth, [&](const SurfaceInteraction& si, Vec3f wi, Color pw, bool, int) {
+    grid.forNeighbours(si.p, [&](int idx) {
+      const VisiblePoint& vp = px.vp[idx];
+      if (lengthSq(vp.p - si.p) > px.r2[idx]) return;
+      Color c = sppmContribution(sc, vp, wi, pw);
+      if (!isFiniteVec(c)) return;
+      atomicAddRelaxed(&px.phi[3 * idx], c.x);
+      atomicAddRelaxed(&px.phi[3 * idx + 1], c.y);
+      atomicAddRelaxed(&px.phi[3 * idx + 2], c.z);
+      atomicAddRelaxed(&px.m[idx], 1u);
+      ++hits;
+    });
+  });
+  return hits;
+}
+
+// Progressive radius reduction at pixel i after a photon pass: N' = N + alpha M,
+// R'^2 = R^2 N' / (N + M), tau' = (tau + Phi) R'^2 / R^2; then this pass's M and Phi are cleared.
+ENVGI_INLINE void sppmUpdateStep(const SppmParams& s, SppmPixels px, int i) {
+  uint32_t mi = px.m[i];
+  if (mi > 0) {
+    Color ph(px.phi[3 * i], px.phi[3 * i + 1], px.phi[3 * i + 2]);
+    float nNew = px.n[i] + s.alpha * float(mi);
+    float r2New = px.r2[i] * nNew / (px.n[i] + float(mi));
+    px.tau[i] = (px.tau[i] + ph) * (r2New / px.r2[i]);
+    px.n[i] = nNew;
+    px.r2[i] = r2New;
+  }
+  px.phi[3 * i] = px.phi[3 * i + 1] = px.phi[3 * i + 2] = 0.f;
+  px.m[i] = 0;
+}
+
+// Pixel i's estimate after `passes` iterations and `photons` photons: the mean direct light
+// plus tau / (photons pi R^2).
+ENVGI_INLINE Color sppmRadiance(const Color& ldSum, const Color& tau, float r2, int passes, double photons) {
+  return ldSum / float(passes) + tau / float(photons * kPi * r2);
+}
 
 }  // namespace envgi

@@ -1,5 +1,7 @@
-// A hashed uniform grid over points (SPPM's visible points): counting-sorted into flat
-// arrays, so the photon pass can query it on the CPU or in a CUDA kernel. No kd-tree.
+// A hashed uniform grid over points (SPPM's visible points): points sorted by bucket into flat
+// arrays, so the photon pass can query it on the CPU or in a CUDA kernel. No kd-tree. The CPU
+// sorts by counting; a GPU sorts the same keys with CUB's (stable) radix sort and finds the
+// bucket starts with hashGridBucketStarts, which gives the same arrays.
 #pragma once
 
 #include <vector>
@@ -7,6 +9,9 @@
 #include "core/Vec.h"
 
 namespace envgi {
+
+// Buckets for n points: twice as many, so few cells share one.
+ENVGI_INLINE int hashGridTableSize(size_t n) { return int(n > 0 ? 2 * n : 1); }
 
 struct HashGridView {
   const int* bucketStart = nullptr;  // tableSize + 1 offsets into items
@@ -22,6 +27,14 @@ struct HashGridView {
   ENVGI_HD int bucket(int x, int y, int z) const {
     uint32_t h = (uint32_t(x) * 73856093u) ^ (uint32_t(y) * 19349663u) ^ (uint32_t(z) * 83492791u);
     return int(h % uint32_t(tableSize));
+  }
+
+  // The bucket a point goes into; tableSize (past every bucket) for a point left out.
+  ENVGI_HD int key(Vec3f p, bool valid) const {
+    if (!valid) return tableSize;
+    int x, y, z;
+    cellOf(p, &x, &y, &z);
+    return bucket(x, y, z);
   }
 
   // Calls visit(index) once for every point stored in the 27 cells around p; callers check
@@ -46,28 +59,34 @@ struct HashGridView {
   }
 };
 
+// One thread's share of finding bucket starts from keys sorted ascending (n of them, keys in
+// [0, tableSize]): thread i, for i in [0, n], writes start[b] = i for every bucket b whose
+// points begin at sorted position i, so start[tableSize] is the number of points kept.
+ENVGI_INLINE void hashGridBucketStarts(const int* sortedKeys, int n, int tableSize, int i, int* start) {
+  int prev = i > 0 ? sortedKeys[i - 1] : -1;
+  int cur = i < n ? sortedKeys[i] : tableSize;
+  for (int b = prev + 1; b <= cur && b <= tableSize; ++b) start[b] = i;
+}
+
 class HashGrid {
  public:
   // Points with valid[i] == false are left out. cellSize must be at least the search radius.
   void build(const std::vector<Vec3f>& points, const std::vector<char>& valid, float cellSize) {
     size_t n = 0;
     for (char v : valid) n += v ? 1 : 0;
-    view_.tableSize = int(std::max<size_t>(1, 2 * n));
+    view_.tableSize = hashGridTableSize(n);
     view_.cellSize = cellSize;
     start_.assign(size_t(view_.tableSize) + 1, 0);
     items_.assign(n, 0);
-    std::vector<int> bucketOf(points.size(), -1);
+    std::vector<int> keyOf(points.size());
     for (size_t i = 0; i < points.size(); ++i) {
-      if (!valid[i]) continue;
-      int x, y, z;
-      view_.cellOf(points[i], &x, &y, &z);
-      bucketOf[i] = view_.bucket(x, y, z);
-      ++start_[size_t(bucketOf[i]) + 1];
+      keyOf[i] = view_.key(points[i], valid[i] != 0);
+      if (keyOf[i] < view_.tableSize) ++start_[size_t(keyOf[i]) + 1];
     }
     for (size_t b = 0; b < size_t(view_.tableSize); ++b) start_[b + 1] += start_[b];
     std::vector<int> fill(start_.begin(), start_.end() - 1);
     for (size_t i = 0; i < points.size(); ++i)
-      if (bucketOf[i] >= 0) items_[size_t(fill[size_t(bucketOf[i])]++)] = int(i);
+      if (keyOf[i] < view_.tableSize) items_[size_t(fill[size_t(keyOf[i])]++)] = int(i);
     view_.bucketStart = start_.data();
     view_.items = items_.data();
   }

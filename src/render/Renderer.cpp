@@ -76,7 +76,9 @@ SampleSequence sequenceOf(const Scene& scene, int spp) {
   return SampleSequence{scene.sampler.type, uint32_t(spp), scene.sampler.seed};
 }
 
-PreparedRender prepareSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
+}  // namespace
+
+SppmParams sppmParams(const Scene& scene) {
   const SppmSettings& ss = scene.integrator.sppm;
   SppmParams sp;
   sp.photonsPerPass = ss.photonCount;
@@ -85,9 +87,31 @@ PreparedRender prepareSppm(const Scene& scene, const EmbreeAccel& accel, const R
   sp.maxDepth = ss.maxDepth;
   sp.seed = scene.sampler.seed;
   sp.strategy = findStrategy(scene.integrator.env.strategy).env;
-  int passes = opts.spp > 0 ? opts.spp : ss.passes;
+  checkSppmParams(sp);
+  return sp;
+}
+
+int sppmPasses(const Scene& scene, const RenderOptions& opts) {
+  int passes = opts.spp > 0 ? opts.spp : scene.integrator.sppm.passes;
   if (passes <= 0) throw std::runtime_error("sppm: passes must be positive");
-  return {std::make_unique<SppmExecutor>(scene, accel, sp, opts.threads), passes};
+  return passes;
+}
+
+void logExecutorStats(const PassExecutor& ex) {
+  if (auto* sppm = dynamic_cast<const SppmPassExecutor*>(&ex)) {
+    SppmStats st = sppm->stats();
+    spdlog::info("sppm: {} passes, {} photons ({} photon-visible-point hits), camera passes {:.2f} s, photon passes "
+                 "{:.2f} s, mean final radius {:.4g}, {:.1f} MB",
+                 st.passesDone, st.photonsShot, st.photonHits, st.cameraSeconds, st.photonSeconds, st.meanRadius,
+                 st.bytes / 1e6);
+  }
+}
+
+namespace {
+
+PreparedRender prepareSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
+  return {std::make_unique<SppmExecutor<EmbreeTracer>>(scene, EmbreeTracer{&accel}, sppmParams(scene), opts.threads),
+          sppmPasses(scene, opts)};
 }
 
 PreparedRender prepareGrid(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
@@ -259,6 +283,13 @@ PreparedRender prepareRender(const Scene& scene, const EmbreeAccel& accel, const
 
 Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
   const Camera& cam = scene.view().camera;
+  if (opts.cpuTracer == CpuTracer::Bvh && scene.integrator.type == IntegratorType::Sppm) {
+    Bvh bvh(scene);
+    SppmExecutor<BvhTracer> ex(scene, BvhTracer{bvh.view()}, sppmParams(scene), opts.threads);
+    Image img = renderPasses(ex, cam.width, cam.height, sppmPasses(scene, opts), opts, stats);
+    logExecutorStats(ex);
+    return img;
+  }
   if (opts.cpuTracer == CpuTracer::Bvh && hasSampleKernel(scene.integrator.type)) {
     KernelSettings k = kernelSettings(scene, opts);
     Bvh bvh(scene);
@@ -269,13 +300,7 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
   }
   PreparedRender pr = prepareRender(scene, accel, opts);
   Image img = renderPasses(*pr.executor, cam.width, cam.height, pr.spp, opts, stats);
-  if (auto* sppm = dynamic_cast<SppmExecutor*>(pr.executor.get())) {
-    SppmStats st = sppm->stats();
-    spdlog::info("sppm: {} passes, {} photons ({} photon-visible-point hits), camera passes {:.2f} s, photon passes "
-                 "{:.2f} s, mean final radius {:.4g}, {:.1f} MB",
-                 st.passesDone, st.photonsShot, st.photonHits, st.cameraSeconds, st.photonSeconds, st.meanRadius,
-                 st.bytes / 1e6);
-  }
+  logExecutorStats(*pr.executor);
   return img;
 }
 

@@ -10,6 +10,7 @@
 
 #include "accel/EmbreeAccel.h"
 #include "image/Image.h"
+#include "integrators/Sppm.h"
 #include "render/PassExecutor.h"
 #include "render/PixelKernel.h"
 #include "scene/Scene.h"
@@ -47,6 +48,13 @@ struct RenderStats {
 // The path/direct settings the kernels run with, from the scene's integrator settings;
 // throws for integrators that have no per-sample kernel (photon, sppm).
 KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts);
+
+// SPPM's options from the scene, checked, and the passes to run (opts.spp overrides).
+SppmParams sppmParams(const Scene& scene);
+int sppmPasses(const Scene& scene, const RenderOptions& opts);
+
+// Logs what an executor counted beyond rays (SPPM's passes, photons and radius).
+void logExecutorStats(const PassExecutor& ex);
 
 // An executor for the scene's integrator on the CPU (Embree), with what comes before the
 // camera passes done (photon maps, a grid), and the passes it wants (spp, or sppm's passes).

@@ -6,6 +6,8 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "accel/BvhView.h"
+
 namespace envgi {
 
 namespace {
@@ -13,14 +15,19 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 }  // namespace
 
-SppmExecutor::SppmExecutor(const Scene& scene, const EmbreeAccel& accel, const SppmParams& params, int threads)
-    : scene_(scene), tracer_{&accel}, p_(params),
+void checkSppmParams(const SppmParams& p) {
+  if (p.photonsPerPass == 0) throw std::runtime_error("sppm: photon_count must be positive");
+  if (!(p.alpha > 0.f && p.alpha < 1.f)) throw std::runtime_error("sppm: alpha must be in (0, 1)");
+}
+
+template <class Tracer>
+SppmExecutor<Tracer>::SppmExecutor(const Scene& scene, Tracer tracer, const SppmParams& params, int threads)
+    : scene_(scene), tracer_(tracer), p_(params),
       arena_(threads > 0 ? threads : tbb::this_task_arena::max_concurrency()), emitter_(makePhotonEmitter(scene)),
       anyLight_(emitter_.emitsLight(scene.view())), W_(scene.view().camera.width), H_(scene.view().camera.height) {
-  if (p_.photonsPerPass == 0) throw std::runtime_error("sppm: photon_count must be positive");
-  if (!(p_.alpha > 0.f && p_.alpha < 1.f)) throw std::runtime_error("sppm: alpha must be in (0, 1)");
+  checkSppmParams(p_);
   size_t np = size_t(W_) * H_;
-  float r0 = p_.initialRadius > 0.f ? p_.initialRadius : 0.01f * emitter_.radius;
+  float r0 = sppmInitialRadius(p_, emitter_);
   r2_.assign(np, r0 * r0);
   n_.assign(np, 0.f);
   phi_.assign(np * 3, 0.f);
@@ -32,102 +39,51 @@ SppmExecutor::SppmExecutor(const Scene& scene, const EmbreeAccel& accel, const S
   vpValid_.assign(np, 0);
 }
 
-void SppmExecutor::runPass(int s0, int s1, Progress& progress, PassCounters* counters) {
+template <class Tracer>
+void SppmExecutor<Tracer>::runPass(int s0, int s1, Progress& progress, PassCounters* counters) {
   for (int pass = s0; pass < s1; ++pass) {
     iteration(pass, counters);
     progress.add(size_t(W_) * H_);
   }
 }
 
-void SppmExecutor::iteration(int pass, PassCounters* counters) {
+template <class Tracer>
+void SppmExecutor<Tracer>::iteration(int pass, PassCounters* counters) {
   const SceneView& sc = scene_.view();
-  const Camera& cam = sc.camera;
-  const int W = W_, N = W_ * H_;
+  const int N = W_ * H_;
+  SppmPixels px{vps_.data(), vpPos_.data(), vpValid_.data(), r2_.data(), n_.data(),
+                phi_.data(),  m_.data(),     tau_.data(),     ld_.data()};
   std::atomic<uint64_t> rays{0}, hits{0};
   auto tc = Clock::now();
-  std::vector<Color>& ld = ld_;
-  std::vector<VisiblePoint>& vps = vps_;
-  std::vector<float>& r2 = r2_;
-  std::vector<float>& phi = phi_;
-  std::vector<uint32_t>& m = m_;
-  const SppmParams& s = p_;
-  const EmbreeTracer& tracer = tracer_;
   arena_.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, N, 256), [&](const tbb::blocked_range<int>& r) {
-      Sampler smp;
-      smp.type = SamplerType::Independent;
-      smp.seed = s.seed;
-      uint64_t localRays = 0;
-      for (int i = r.begin(); i < r.end(); ++i) {
-        smp.start(uint64_t(i), uint32_t(pass));
-        Vec2f off = sampleFilter(cam.filter, smp.get2D());
-        Ray ray = cam.generateRay(float(i % W) + 0.5f + off.x, float(i / W) + 0.5f + off.y);
-        Color L(0.f);
-        vps[size_t(i)] = sppmCameraPath(sc, tracer, ray, smp, s.maxDepth, s.strategy, &L, &localRays);
-        if (isFiniteVec(L)) ld[size_t(i)] += L;
-        vpPos_[size_t(i)] = vps[size_t(i)].p;
-        vpValid_[size_t(i)] = vps[size_t(i)].valid && isFiniteVec(vps[size_t(i)].beta) && !isBlack(vps[size_t(i)].beta);
-      }
-      rays += localRays;
+      uint64_t local = 0;
+      for (int i = r.begin(); i < r.end(); ++i) local += sppmCameraStep(sc, tracer_, p_, px, i, pass);
+      rays += local;
     });
   });
   float maxR2 = 0.f;
   for (int i = 0; i < N; ++i)
-    if (vpValid_[size_t(i)]) maxR2 = std::max(maxR2, r2[size_t(i)]);
+    if (vpValid_[size_t(i)]) maxR2 = std::max(maxR2, r2_[size_t(i)]);
   grid_.build(vpPos_, vpValid_, std::sqrt(std::max(maxR2, 1e-12f)));
   auto tp = Clock::now();
   st_.cameraSeconds += std::chrono::duration<double>(tp - tc).count();
 
   if (anyLight_) {
-    HashGridView gv = grid_.view();
+    const HashGridView& gv = grid_.view();
     const size_t chunk = 1024;
-    size_t chunks = (s.photonsPerPass + chunk - 1) / chunk;
-    const PhotonEmitter& emitter = emitter_;
+    size_t chunks = (p_.photonsPerPass + chunk - 1) / chunk;
     arena_.execute([&] {
       tbb::parallel_for(size_t(0), chunks, [&](size_t ci) {
-        Sampler smp;
-        smp.type = SamplerType::Independent;
-        smp.seed = s.seed ^ kSppmPhotonStream;
-        uint64_t localHits = 0;
-        for (size_t j = ci * chunk; j < std::min(s.photonsPerPass, (ci + 1) * chunk); ++j) {
-          smp.start(uint64_t(pass) * s.photonsPerPass + j, 1);
-          Ray ray;
-          Color power;
-          if (!emitter.emit(sc, smp, &ray, &power)) continue;
-          tracePhoton(sc, tracer, ray, power, smp, s.maxDepth,
-                      [&](const SurfaceInteraction& si, Vec3f wi, Color pw, bool, int) {
-                        gv.forNeighbours(si.p, [&](int idx) {
-                          const VisiblePoint& vp = vps[size_t(idx)];
-                          if (lengthSq(vp.p - si.p) > r2[size_t(idx)]) return;
-                          Color c = sppmContribution(sc, vp, wi, pw);
-                          if (!isFiniteVec(c)) return;
-                          std::atomic_ref<float>(phi[size_t(idx) * 3]).fetch_add(c.x, std::memory_order_relaxed);
-                          std::atomic_ref<float>(phi[size_t(idx) * 3 + 1]).fetch_add(c.y, std::memory_order_relaxed);
-                          std::atomic_ref<float>(phi[size_t(idx) * 3 + 2]).fetch_add(c.z, std::memory_order_relaxed);
-                          std::atomic_ref<uint32_t>(m[size_t(idx)]).fetch_add(1u, std::memory_order_relaxed);
-                          ++localHits;
-                        });
-                      });
-        }
-        hits += localHits;
+        uint64_t local = 0;
+        for (size_t j = ci * chunk; j < std::min(p_.photonsPerPass, (ci + 1) * chunk); ++j)
+          local += sppmPhotonStep(sc, tracer_, emitter_, p_, px, gv, j, pass);
+        hits += local;
       });
     });
   }
-  st_.photonsShot += s.photonsPerPass;
-  // Progressive radius reduction: N' = N + alpha M, R'^2 = R^2 N'/(N + M).
-  for (int i = 0; i < N; ++i) {
-    uint32_t mi = m[size_t(i)];
-    Color ph(phi[size_t(i) * 3], phi[size_t(i) * 3 + 1], phi[size_t(i) * 3 + 2]);
-    if (mi > 0) {
-      float nNew = n_[size_t(i)] + s.alpha * float(mi);
-      float r2New = r2[size_t(i)] * nNew / (n_[size_t(i)] + float(mi));
-      tau_[size_t(i)] = (tau_[size_t(i)] + ph) * (r2New / r2[size_t(i)]);
-      n_[size_t(i)] = nNew;
-      r2[size_t(i)] = r2New;
-    }
-    phi[size_t(i) * 3] = phi[size_t(i) * 3 + 1] = phi[size_t(i) * 3 + 2] = 0.f;
-    m[size_t(i)] = 0;
-  }
+  st_.photonsShot += p_.photonsPerPass;
+  for (int i = 0; i < N; ++i) sppmUpdateStep(p_, px, i);
   st_.photonSeconds += since(tp);
   st_.passesDone = pass + 1;
   st_.photonHits += hits.load();
@@ -135,19 +91,18 @@ void SppmExecutor::iteration(int pass, PassCounters* counters) {
   counters->rays += rays.load();
 }
 
-void SppmExecutor::readFilm(FilmSums* out) {
+template <class Tracer>
+void SppmExecutor<Tracer>::readFilm(FilmSums* out) {
   size_t np = size_t(W_) * H_;
   int passes = std::max(st_.passesDone, 1);
   double photons = double(std::max<uint64_t>(st_.photonsShot, 1));
   out->sum.resize(np);
   out->sumSqLum.clear();
-  for (size_t i = 0; i < np; ++i) {
-    Color c = ld_[i] / float(passes) + tau_[i] / float(photons * kPi * r2_[i]);
-    out->sum[i] = c * float(passes);
-  }
+  for (size_t i = 0; i < np; ++i) out->sum[i] = sppmRadiance(ld_[i], tau_[i], r2_[i], passes, photons) * float(passes);
 }
 
-SppmStats SppmExecutor::stats() const {
+template <class Tracer>
+SppmStats SppmExecutor<Tracer>::stats() const {
   SppmStats s = st_;
   size_t np = size_t(W_) * H_;
   s.bytes = grid_.bytes() + vps_.size() * sizeof(VisiblePoint) + np * (sizeof(float) * 5 + 2 * sizeof(Color) + 4);
@@ -156,5 +111,8 @@ SppmStats SppmExecutor::stats() const {
   s.meanRadius = float(rs / double(np));
   return s;
 }
+
+template class SppmExecutor<EmbreeTracer>;
+template class SppmExecutor<BvhTracer>;
 
 }  // namespace envgi

@@ -1,43 +1,36 @@
-// SPPM's driver (Hachisuka and Jensen 2009): each pass of the render loop is one SPPM
-// iteration, camera pass (visible points) then photon pass (hashed grid, atomics) and the
-// progressive radius update, run with oneTBB over the per-path code of integrators/Sppm.h.
+// SPPM's CPU driver (Hachisuka and Jensen 2009): each pass of the render loop is one SPPM
+// iteration, camera step (visible points), hashed grid, photon step (atomics) and the
+// progressive radius update, run with oneTBB over the per-element steps of integrators/Sppm.h.
+// The tracer is Embree, or the BVH the GPU traverses (to check the GPU's bodies on the CPU).
 #pragma once
 
 #include <vector>
 
+#include <tbb/task_arena.h>
+
 #include "accel/EmbreeAccel.h"
 #include "integrators/Sppm.h"
 #include "render/PhotonShooter.h"
-#include "render/PassExecutor.h"
-
-#include <tbb/task_arena.h>
+#include "render/SppmPassExecutor.h"
+#include "scene/Scene.h"
 
 namespace envgi {
 
-struct SppmStats {
-  int passesDone = 0;
-  uint64_t photonsShot = 0, photonHits = 0, rays = 0;
-  double cameraSeconds = 0.0, photonSeconds = 0.0;
-  size_t bytes = 0;
-  float meanRadius = 0.f;
-};
-
-class SppmExecutor final : public PassExecutor {
+template <class Tracer>
+class SppmExecutor final : public SppmPassExecutor {
  public:
-  SppmExecutor(const Scene& scene, const EmbreeAccel& accel, const SppmParams& params, int threads);
+  SppmExecutor(const Scene& scene, Tracer tracer, const SppmParams& params, int threads);
   std::string deviceName() const override { return "cpu"; }
-  // One SPPM iteration a pass, so checkpoints and Ctrl-C come between iterations.
-  int maxPassSize() const override { return 1; }
   void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override;
   // The estimate so far times the iterations done, so the loop's mean is the estimate.
   void readFilm(FilmSums* out) override;
-  SppmStats stats() const;
+  SppmStats stats() const override;
 
  private:
   void iteration(int pass, PassCounters* counters);
 
   const Scene& scene_;
-  EmbreeTracer tracer_;
+  Tracer tracer_;
   SppmParams p_;
   tbb::task_arena arena_;
   PhotonEmitter emitter_;
@@ -52,5 +45,8 @@ class SppmExecutor final : public PassExecutor {
   HashGrid grid_;
   SppmStats st_;
 };
+
+// Checks the options every SPPM driver shares; throws with the option's name.
+void checkSppmParams(const SppmParams& p);
 
 }  // namespace envgi

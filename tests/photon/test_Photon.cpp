@@ -141,6 +141,29 @@ TEST(HashGrid, FindsEveryPointWithinTheCellSize) {
   }
 }
 
+// The GPU builds the grid by radix-sorting (key, index) pairs and finding the bucket starts per
+// sorted position; the same steps here, with a stable sort, give the CPU's counting sort.
+TEST(HashGrid, SortedKeysGiveTheCountingSortsArrays) {
+  Pcg32 rng(9);
+  std::vector<Vec3f> pts(3000);
+  std::vector<char> valid(pts.size(), 1);
+  for (Vec3f& p : pts) p = Vec3f(rng.nextFloat() * 3, rng.nextFloat() * 3, rng.nextFloat() * 3);
+  for (size_t i = 0; i < pts.size(); i += 7) valid[i] = 0;
+  HashGrid g;
+  g.build(pts, valid, 0.2f);
+  const HashGridView& v = g.view();
+  std::vector<std::pair<int, int>> pairs;
+  for (size_t i = 0; i < pts.size(); ++i) pairs.push_back({v.key(pts[i], valid[i] != 0), int(i)});
+  std::stable_sort(pairs.begin(), pairs.end(), [](auto& a, auto& b) { return a.first < b.first; });
+  std::vector<int> keys, start(size_t(v.tableSize) + 1, -1);
+  for (auto& pr : pairs) keys.push_back(pr.first);
+  int n = int(keys.size());
+  for (int i = 0; i <= n; ++i) hashGridBucketStarts(keys.data(), n, v.tableSize, i, start.data());
+  for (int b = 0; b <= v.tableSize; ++b) ASSERT_EQ(start[size_t(b)], v.bucketStart[b]) << "bucket " << b;
+  ASSERT_EQ(start.back(), int(pts.size() - (pts.size() + 6) / 7));
+  for (int i = 0; i < start.back(); ++i) ASSERT_EQ(pairs[size_t(i)].second, v.items[i]);
+}
+
 // An all-black map is a light of zero power: no photons, a black image, no NaN.
 TEST(PhotonIntegrators, BlackMapShootsNothingAndRendersBlack) {
   Bsdf b;

@@ -1,0 +1,33 @@
+// Relaxed atomic adds that compile for both host and device: SPPM's photon splats add into
+// per-pixel sums from many threads, on the CPU (oneTBB) and in CUDA kernels alike.
+#pragma once
+
+#include <cstdint>
+
+#include "core/Common.h"
+
+namespace envgi {
+
+ENVGI_INLINE void atomicAddRelaxed(float* p, float v) {
+#if defined(__CUDA_ARCH__)
+  atomicAdd(p, v);
+#else
+  // GCC/Clang's generic builtins work on float in C++17 too (nvcc's host pass), unlike
+  // std::atomic_ref.
+  float expected, desired;
+  __atomic_load(p, &expected, __ATOMIC_RELAXED);
+  desired = expected + v;
+  while (!__atomic_compare_exchange(p, &expected, &desired, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
+    desired = expected + v;
+#endif
+}
+
+ENVGI_INLINE void atomicAddRelaxed(uint32_t* p, uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  atomicAdd(reinterpret_cast<unsigned int*>(p), v);
+#else
+  __atomic_fetch_add(p, v, __ATOMIC_RELAXED);
+#endif
+}
+
+}  // namespace envgi
