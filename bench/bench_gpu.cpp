@@ -3,6 +3,8 @@
 // `path` with max_depth 8, a GGX conductor (alpha 0.15) in the Grace map, as the Mitsuba 3
 // figure quoted in the GPU issue. Per device: milliseconds per 1-spp frame (median of
 // --frames), M samples/s and M rays/s over a --spp run (default 64; the CPU runs --cpu-spp).
+// Then SPPM on the bundled buddha scene at the same resolution: milliseconds a pass (median)
+// and photons traced and splatted a second, with --sppm-photons a pass.
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -16,7 +18,9 @@
 #include "gpu/CudaExecutor.h"
 #include "gpu/GpuSceneFiles.h"
 #include "render/CpuExecutor.h"
+#include "render/PhotonShooter.h"
 #include "render/Renderer.h"
+#include "render/SppmExecutor.h"
 #include "scene/SceneLoader.h"
 #include "support/FrameMesh.h"
 
@@ -60,11 +64,36 @@ Row measure(PassExecutor& ex, const std::string& scene, int W, int H, int frames
   return r;
 }
 
+struct SppmRow {
+  std::string device;
+  double passMs = 0, photonsPerSec = 0;
+  int passes = 0;
+};
+
+SppmRow measureSppm(PassExecutor& ex, int passes) {
+  SppmRow r;
+  r.device = ex.deviceName();
+  Progress quiet(1, false);
+  PassCounters c;
+  std::vector<double> t;
+  for (int i = 0; i < passes; ++i) {
+    auto t0 = std::chrono::steady_clock::now();
+    ex.runPass(i, i + 1, quiet, &c);
+    t.push_back(seconds(t0));
+  }
+  SppmStats st = dynamic_cast<SppmPassExecutor&>(ex).stats();
+  std::sort(t.begin(), t.end());
+  r.passMs = 1e3 * t[t.size() / 2];
+  r.passes = passes;
+  r.photonsPerSec = st.photonSeconds > 0 ? double(st.photonsShot) / st.photonSeconds : 0.0;
+  return r;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   std::string dragon;
-  int res = 512, frames = 9, spp = 64, cpuSpp = 4;
+  int res = 512, frames = 9, spp = 64, cpuSpp = 4, sppmPhotons = 1000000;
   bool cpu = true;
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
@@ -75,13 +104,14 @@ int main(int argc, char** argv) {
     else if (a == "--spp") spp = std::atoi(next().c_str());
     else if (a == "--cpu-spp") cpuSpp = std::atoi(next().c_str());
     else if (a == "--no-cpu") cpu = false;
+    else if (a == "--sppm-photons") sppmPhotons = std::atoi(next().c_str());
     else {
-      std::fprintf(stderr, "usage: envgi_bench_gpu [--dragon PLY] [--res N] [--frames N] [--spp N] [--cpu-spp N] [--no-cpu]\n");
+      std::fprintf(stderr, "usage: envgi_bench_gpu [--dragon PLY] [--res N] [--frames N] [--spp N] [--cpu-spp N] [--no-cpu] [--sppm-photons N]\n");
       return 2;
     }
   }
-  if (res <= 0 || frames <= 0 || spp <= 0 || cpuSpp <= 0) {
-    std::fprintf(stderr, "envgi_bench_gpu: --res, --frames, --spp and --cpu-spp must be positive\n");
+  if (res <= 0 || frames <= 0 || spp <= 0 || cpuSpp <= 0 || sppmPhotons <= 0) {
+    std::fprintf(stderr, "envgi_bench_gpu: --res, --frames, --spp, --cpu-spp and --sppm-photons must be positive\n");
     return 2;
   }
 #ifdef ENVGI_ASSETS_DIR
@@ -94,6 +124,7 @@ int main(int argc, char** argv) {
   int gpus = gpu::deviceCount(&why);
   if (gpus == 0) std::printf("no CUDA device (%s): CPU figures only\n", why.c_str());
   std::vector<Row> rows;
+  std::vector<SppmRow> sppmRows;
   try {
     for (auto& [name, mesh] : scenes) {
       Scene s;
@@ -136,6 +167,22 @@ int main(int argc, char** argv) {
         rows.push_back(measure(exB, name, res, res, std::min(frames, 3), cpuSpp));
       }
     }
+    Scene s;
+    loadScene(test::bundledScenesDir() + "/buddha.xml", {}, s);
+    s.camera.width = s.camera.height = res;
+    s.integrator.type = IntegratorType::Sppm;
+    s.integrator.sppm.photonCount = size_t(sppmPhotons);
+    s.finalize();
+    Bvh bvh(s);
+    if (gpus > 0) {
+      auto ex = gpu::makeCudaSppmExecutor(s, bvh, sppmParams(s), makePhotonEmitter(s), 0);
+      sppmRows.push_back(measureSppm(*ex, frames));
+    }
+    if (cpu) {
+      EmbreeAccel accel(s);
+      SppmExecutor<EmbreeTracer> ex(s, EmbreeTracer{&accel}, sppmParams(s), 0);
+      sppmRows.push_back(measureSppm(ex, 3));
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "envgi_bench_gpu: error: %s\n", e.what());
     return 1;
@@ -145,5 +192,9 @@ int main(int argc, char** argv) {
   for (const Row& r : rows)
     std::printf("| %s | %s | %.2f | %d | %.2f | %.1f |\n", r.scene.c_str(), r.device.c_str(), r.frameMs, r.spp,
                 r.msamples, r.mrays);
+  std::printf("\n%dx%d, sppm on buddha, %d photons a pass\n", res, res, sppmPhotons);
+  std::printf("| device | ms / pass (median) | passes | M photons/s |\n|---|---|---|---|\n");
+  for (const SppmRow& r : sppmRows)
+    std::printf("| %s | %.1f | %d | %.2f |\n", r.device.c_str(), r.passMs, r.passes, r.photonsPerSec / 1e6);
   return 0;
 }

@@ -13,6 +13,7 @@
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
 #include "gpu/CudaExecutor.h"
+#include "render/PhotonShooter.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
 #include "scene/NameTables.h"
@@ -48,14 +49,14 @@ bool chooseCuda(const RenderArgs& a, IntegratorType type) {
   if (a.device != "cpu" && a.device != "cuda" && a.device != "auto")
     throw std::runtime_error("unknown device '" + a.device + "' (cpu, cuda, auto)");
   if (a.device == "cpu") return false;
-  bool kernels = hasSampleKernel(type);
+  bool kernels = hasSampleKernel(type) || type == IntegratorType::Sppm;
   std::string integrator = integratorName(type);
   std::string why;
   int n = gpu::deviceCount(&why);
   if (a.device == "cuda") {
     if (n == 0) throw std::runtime_error("--device cuda: no CUDA device (" + why + ")");
     if (!kernels)
-      throw std::runtime_error("--device cuda: the '" + integrator + "' integrator runs on the CPU only (path and direct run on the GPU)");
+      throw std::runtime_error("--device cuda: the '" + integrator + "' integrator runs on the CPU only (path, direct and sppm run on the GPU)");
     return true;
   }
   if (n == 0) {
@@ -127,13 +128,22 @@ void runRender(const RenderArgs& a) {
     const BvhBuildStats& bs = bvh.stats();
     spdlog::info("BVH: {} triangles, {} nodes, depth {}, {:.1f} bytes a triangle, built in {:.2f} s", bs.triangles,
                  bs.nodes, bs.maxDepth, bs.triangles ? double(bs.bytes()) / double(bs.triangles) : 0.0, bs.seconds);
-    KernelSettings k = kernelSettings(scene, ro);
     auto t2 = std::chrono::steady_clock::now();
     size_t bytes = 0;
-    auto ex = gpu::makeCudaExecutor(scene, bvh, k, a.gpu, false, &bytes);
+    std::unique_ptr<PassExecutor> ex;
+    int passes = 0;
+    if (scene.integrator.type == IntegratorType::Sppm) {
+      ex = gpu::makeCudaSppmExecutor(scene, bvh, sppmParams(scene), makePhotonEmitter(scene), a.gpu, &bytes);
+      passes = sppmPasses(scene, ro);
+    } else {
+      KernelSettings k = kernelSettings(scene, ro);
+      ex = gpu::makeCudaExecutor(scene, bvh, k, a.gpu, false, &bytes);
+      passes = k.spp;
+    }
     spdlog::info("device: {}: scene uploaded in {:.2f} s, {:.1f} MB of device memory", ex->deviceName(),
                  secondsSince(t2), bytes / 1e6);
-    img = renderPasses(*ex, scene.camera.width, scene.camera.height, k.spp, ro, &st);
+    img = renderPasses(*ex, scene.camera.width, scene.camera.height, passes, ro, &st);
+    logExecutorStats(*ex);
   } else {
     auto t1 = std::chrono::steady_clock::now();
     EmbreeAccel accel(scene);

@@ -103,8 +103,7 @@ std::string deviceName(int gpu) {
   return p.name;
 }
 
-std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene& scene, const Bvh& bvh, const KernelSettings& k, int gpu,
-                                               bool keepVariance, size_t* deviceBytes) {
+void selectDevice(int gpu) {
   std::string why;
   int n = deviceCount(&why);
   if (n == 0) throw std::runtime_error("no CUDA device: " + why);
@@ -112,6 +111,11 @@ std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene& scene, const Bvh& bv
     throw std::runtime_error("--gpu " + std::to_string(gpu) + ": this machine has " + std::to_string(n) +
                              " CUDA device(s), numbered from 0");
   check(cudaSetDevice(gpu), "selecting the device");
+}
+
+std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene& scene, const Bvh& bvh, const KernelSettings& k, int gpu,
+                                               bool keepVariance, size_t* deviceBytes) {
+  selectDevice(gpu);
   auto ex = std::make_unique<CudaExecutor>(scene, bvh, k, gpu, keepVariance);
   if (deviceBytes) *deviceBytes = ex->deviceBytes();
   return ex;

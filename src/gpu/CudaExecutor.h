@@ -6,6 +6,7 @@
 #include <string>
 
 #include "accel/Bvh.h"
+#include "integrators/Sppm.h"
 #include "render/PassExecutor.h"
 #include "render/PixelKernel.h"
 
@@ -16,9 +17,17 @@ namespace envgi::gpu {
 int deviceCount(std::string* why);
 std::string deviceName(int gpu);
 
+// Makes CUDA device `gpu` current; throws when it does not exist.
+void selectDevice(int gpu);
+
 // Uploads the scene and its BVH to GPU `gpu` and runs path/direct passes there; *deviceBytes
 // receives the device memory it holds.
 std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene& scene, const Bvh& bvh, const KernelSettings& k, int gpu,
                                                bool keepVariance, size_t* deviceBytes = nullptr);
+
+// Uploads the scene and its BVH and runs SPPM there, one iteration a pass (integrators/Sppm.h's
+// steps as kernels); the emitter is the CPU's (render/PhotonShooter).
+std::unique_ptr<PassExecutor> makeCudaSppmExecutor(const Scene& scene, const Bvh& bvh, const SppmParams& params,
+                                                   const PhotonEmitter& emitter, int gpu, size_t* deviceBytes = nullptr);
 
 }  // namespace envgi::gpu

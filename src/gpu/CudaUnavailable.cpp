@@ -12,6 +12,13 @@ int deviceCount(std::string* why) {
 
 std::string deviceName(int) { return "none"; }
 
+void selectDevice(int) { throw std::runtime_error("no CUDA device: this envgi was built without CUDA"); }
+
+std::unique_ptr<PassExecutor> makeCudaSppmExecutor(const Scene&, const Bvh&, const SppmParams&, const PhotonEmitter&, int,
+                                                   size_t*) {
+  throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
+}
+
 std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene&, const Bvh&, const KernelSettings&, int, bool, size_t*) {
   throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
 }

@@ -167,8 +167,10 @@ TEST(RenderCli, DeviceChoice) {
   EXPECT_EQ(bad.code, 1);
   EXPECT_NE(bad.output.find("unknown device 'tpu'"), std::string::npos) << bad.output;
   // The CPU-only integrators refuse --device cuda whatever the machine.
-  CliResult sppm = runCli("render " + scene + " -o " + d.file("s.exr") + " --device cuda --integrator sppm");
-  EXPECT_EQ(sppm.code, 1);
+  CliResult photon = runCli("render " + scene + " -o " + d.file("s.exr") + " --device cuda --integrator photon");
+  EXPECT_EQ(photon.code, 1);
+  EXPECT_NE(photon.output.find("envgi: error: --device cuda"), std::string::npos) << photon.output;
+  EXPECT_FALSE(fs::exists(d.file("s.exr")));
 }
 
 // --sampler on render, --version, and parse errors as one `envgi: error:` line.

@@ -9,7 +9,9 @@
 #include "accel/EmbreeAccel.h"
 #include "gpu/CudaExecutor.h"
 #include "gpu/GpuSceneFiles.h"
+#include "render/PhotonShooter.h"
 #include "render/Renderer.h"
+#include "render/SppmPassExecutor.h"
 #include "scene/NameTables.h"
 #include "scene/SceneLoader.h"
 #include "support/RegionZTest.h"
@@ -84,6 +86,51 @@ TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
   }
 }
 
+// SPPM's kernels against the CPU driver with the same seed: the same visible points and photon
+// paths, up to traversal rounding, FMA contraction and the order of the atomics' float sums;
+// so the image means and the 8x8-region means agree closely.
+TEST(GpuRender, SppmMatchesTheCpuDriver) {
+  for (std::string name : {"cornell-box", "teapot-glass", "buddha"}) {
+    Scene s;
+    loadScene(test::bundledScenesDir() + "/" + name + ".xml", {}, s);
+    s.camera.width = s.camera.height = kRes;
+    s.integrator.type = IntegratorType::Sppm;
+    s.integrator.sppm.photonCount = 200000;
+    s.finalize();
+    RenderOptions o;
+    o.progress = false;
+    o.spp = 16;
+    RenderStats cs, gs;
+    EmbreeAccel accel(s);
+    Image cpu = render(s, accel, o, &cs);
+    Bvh bvh(s);
+    auto ex = gpu::makeCudaSppmExecutor(s, bvh, sppmParams(s), makePhotonEmitter(s), 0);
+    Image gpuImg = renderPasses(*ex, kRes, kRes, 16, o, &gs);
+    EXPECT_EQ(gs.sppDone, 16);
+    double mc = 0, mg = 0, worst = 0;
+    for (size_t i = 0; i < cpu.rgb.size(); ++i) {
+      mc += cpu.rgb[i];
+      mg += gpuImg.rgb[i];
+    }
+    for (int ry = 0; ry < kRes; ry += 8)
+      for (int rx = 0; rx < kRes; rx += 8) {
+        double a = 0, b = 0;
+        for (int y = ry; y < ry + 8; ++y)
+          for (int x = rx; x < rx + 8; ++x) {
+            a += luminance(cpu.at(x, y));
+            b += luminance(gpuImg.at(x, y));
+          }
+        worst = std::max(worst, std::fabs(b - a) / (a + 0.64));
+      }
+    SppmStats st = dynamic_cast<SppmPassExecutor&>(*ex).stats();
+    std::printf("%-12s sppm: image mean GPU/CPU %.4f, worst region %.3f, GPU %.1f ms a pass (%.2f s photons), "
+                "CPU %.1f ms a pass\n",
+                name.c_str(), mg / mc, worst, 1e3 * gs.seconds / 16, st.photonSeconds, 1e3 * cs.seconds / 16);
+    EXPECT_NEAR(mg / mc, 1.0, 0.01) << name;
+    EXPECT_LT(worst, 0.05) << name;
+  }
+}
+
 TEST(GpuRender, BadDeviceIndexIsAnError) {
   Scene s;
   loadScene(test::bundledScenesDir() + "/cornell-box.xml", {}, s);
@@ -91,6 +138,7 @@ TEST(GpuRender, BadDeviceIndexIsAnError) {
   Bvh bvh(s);
   RenderOptions o;
   EXPECT_THROW(gpu::makeCudaExecutor(s, bvh, kernelSettings(s, o), 1000, false), std::runtime_error);
+  EXPECT_THROW(gpu::makeCudaSppmExecutor(s, bvh, sppmParams(s), makePhotonEmitter(s), 1000), std::runtime_error);
 }
 
 int main(int argc, char** argv) {
