@@ -4,7 +4,8 @@
 // figure quoted in the GPU issue. Per device: milliseconds per 1-spp frame (median of
 // --frames), M samples/s and M rays/s over a --spp run (default 64; the CPU runs --cpu-spp).
 // Then SPPM on the bundled buddha scene at the same resolution: milliseconds a pass (median)
-// and photons traced and splatted a second, with --sppm-photons a pass.
+// and photons traced and splatted a second, with --sppm-photons a pass. And the photon-map pass
+// (1M global photons stored, no caustic map): photons emitted a second, tracing only.
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -125,6 +126,7 @@ int main(int argc, char** argv) {
   if (gpus == 0) std::printf("no CUDA device (%s): CPU figures only\n", why.c_str());
   std::vector<Row> rows;
   std::vector<SppmRow> sppmRows;
+  std::vector<std::pair<std::string, double>> mapRows;  // device, M photons emitted a second
   try {
     for (auto& [name, mesh] : scenes) {
       Scene s;
@@ -183,6 +185,19 @@ int main(int argc, char** argv) {
       SppmExecutor<EmbreeTracer> ex(s, EmbreeTracer{&accel}, sppmParams(s), 0);
       sppmRows.push_back(measureSppm(ex, 3));
     }
+    EmbreeAccel accel(s);
+    PhotonShootSettings ps;
+    ps.globalPhotons = 1000000;
+    ps.causticPhotons = 0;
+    ps.progress = false;
+    for (int dev = gpus > 0 ? 0 : 1; dev < (cpu ? 2 : 1); ++dev) {
+      if (dev == 0) ps.tracer = gpu::makeCudaPhotonTracer(s, bvh, 0, ps.maxDepth);
+      else ps.tracer = makeCpuPhotonTracer(s, accel);
+      PhotonMap g, c;
+      PhotonShootStats st;
+      shootPhotons(s, accel, ps, &g, &c, &st);
+      mapRows.push_back({st.device, double(st.emittedGlobal) / st.traceSeconds / 1e6});
+    }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "envgi_bench_gpu: error: %s\n", e.what());
     return 1;
@@ -196,5 +211,7 @@ int main(int argc, char** argv) {
   std::printf("| device | ms / pass (median) | passes | M photons/s |\n|---|---|---|---|\n");
   for (const SppmRow& r : sppmRows)
     std::printf("| %s | %.1f | %d | %.2f |\n", r.device.c_str(), r.passMs, r.passes, r.photonsPerSec / 1e6);
+  std::printf("\nphoton-map pass on buddha, 1M global photons stored\n| device | M photons emitted/s |\n|---|---|\n");
+  for (auto& [dev, rate] : mapRows) std::printf("| %s | %.2f |\n", dev.c_str(), rate);
   return 0;
 }

@@ -44,30 +44,17 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// cpu, cuda or auto (CUDA when a device is present and the integrator has GPU kernels).
-bool chooseCuda(const RenderArgs& a, IntegratorType type) {
+// cpu, cuda or auto (CUDA when a device is present). path, direct and sppm run wholly on the
+// GPU; photon and grid trace their photon maps there and the rest on the CPU.
+bool chooseCuda(const RenderArgs& a) {
   if (a.device != "cpu" && a.device != "cuda" && a.device != "auto")
     throw std::runtime_error("unknown device '" + a.device + "' (cpu, cuda, auto)");
   if (a.device == "cpu") return false;
-  bool kernels = hasSampleKernel(type) || type == IntegratorType::Sppm;
-  std::string integrator = integratorName(type);
   std::string why;
   int n = gpu::deviceCount(&why);
-  if (a.device == "cuda") {
-    if (n == 0) throw std::runtime_error("--device cuda: no CUDA device (" + why + ")");
-    if (!kernels)
-      throw std::runtime_error("--device cuda: the '" + integrator + "' integrator runs on the CPU only (path, direct and sppm run on the GPU)");
-    return true;
-  }
-  if (n == 0) {
-    spdlog::info("device: CPU ({})", why);
-    return false;
-  }
-  if (!kernels) {
-    spdlog::info("device: CPU (the '{}' integrator has no GPU kernels yet)", integrator);
-    return false;
-  }
-  return true;
+  if (a.device == "cuda" && n == 0) throw std::runtime_error("--device cuda: no CUDA device (" + why + ")");
+  if (n == 0) spdlog::info("device: CPU ({})", why);
+  return n > 0;
 }
 
 void runRender(const RenderArgs& a) {
@@ -90,7 +77,7 @@ void runRender(const RenderArgs& a) {
   if (!a.sampler.empty()) scene.sampler.type = findSampler(a.sampler);
   if (!a.filter.empty()) scene.camera.filter = findName(kFilterNames, a.filter, "filter");
   scene.finalize();
-  bool cuda = chooseCuda(a, scene.integrator.type);
+  bool cuda = chooseCuda(a);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   spdlog::info("scene {}: {} triangles, {} spheres, {} area-light primitives{}, {:.1f} MB of geometry, loaded in {:.2f} s",
                a.scene, scene.triangleCount(), scene.spheres.size(), scene.lightCount(),
@@ -123,7 +110,15 @@ void runRender(const RenderArgs& a) {
                integratorName(is.type), is.env.strategy, a.spp > 0 ? a.spp : scene.sampler.sampleCount,
                samplerName(scene.sampler.type));
   Image img;
-  if (cuda) {
+  IntegratorType type = scene.integrator.type;
+  bool photonsOnly = type == IntegratorType::Photon || type == IntegratorType::Grid;
+  if (cuda && photonsOnly) {
+    Bvh bvh(scene);
+    int depth = type == IntegratorType::Photon ? scene.integrator.photon.maxDepth : scene.integrator.grid.maxDepth;
+    ro.photonTracer = gpu::makeCudaPhotonTracer(scene, bvh, a.gpu, depth);
+    spdlog::info("device: photon maps on {}, the rest on the CPU", ro.photonTracer->deviceName());
+  }
+  if (cuda && !photonsOnly) {
     Bvh bvh(scene);
     const BvhBuildStats& bs = bvh.stats();
     spdlog::info("BVH: {} triangles, {} nodes, depth {}, {:.1f} bytes a triangle, built in {:.2f} s", bs.triangles,

@@ -8,6 +8,7 @@
 #include "accel/Bvh.h"
 #include "integrators/Sppm.h"
 #include "render/PassExecutor.h"
+#include "render/PhotonShooter.h"
 #include "render/PixelKernel.h"
 
 namespace envgi::gpu {
@@ -29,5 +30,9 @@ std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene& scene, const Bvh& bv
 // steps as kernels); the emitter is the CPU's (render/PhotonShooter).
 std::unique_ptr<PassExecutor> makeCudaSppmExecutor(const Scene& scene, const Bvh& bvh, const SppmParams& params,
                                                    const PhotonEmitter& emitter, int gpu, size_t* deviceBytes = nullptr);
+
+// Traces photon-map passes on GPU `gpu` (photons of paths up to maxDepth bounces); the maps
+// are then built on the host as the CPU's.
+std::shared_ptr<PhotonBatchTracer> makeCudaPhotonTracer(const Scene& scene, const Bvh& bvh, int gpu, int maxDepth);
 
 }  // namespace envgi::gpu

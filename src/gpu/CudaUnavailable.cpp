@@ -19,6 +19,10 @@ std::unique_ptr<PassExecutor> makeCudaSppmExecutor(const Scene&, const Bvh&, con
   throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
 }
 
+std::shared_ptr<PhotonBatchTracer> makeCudaPhotonTracer(const Scene&, const Bvh&, int, int) {
+  throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
+}
+
 std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene&, const Bvh&, const KernelSettings&, int, bool, size_t*) {
   throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
 }

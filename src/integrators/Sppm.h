@@ -132,15 +132,9 @@ ENVGI_HD uint64_t sppmCameraStep(const SceneView& sc, const Tracer& tracer, cons
 template <class Tracer>
 ENVGI_HD uint32_t sppmPhotonStep(const SceneView& sc, const Tracer& tracer, const PhotonEmitter& emitter,
                                  const SppmParams& s, SppmPixels px, const HashGridView& grid, uint64_t j, int pass) {
-  Sampler smp;
-  smp.type = SamplerType::Independent;
-  smp.seed = s.seed ^ kSppmPhotonStream;
-  smp.start(uint64_t(pass) * s.photonsPerPass + j, 1);
-  Ray ray;
-  Color power;
-  if (!emitter.emit(sc, smp, &ray, &power)) return 0;
   uint32_t hits = 0;
-  tracePhoton(sc, tracer, ray, power, smp, s.maxDepth, [&](const SurfaceInteraction& si, Vec3f wi, Color pw, bool, int) {
+  uint64_t index = uint64_t(pass) * s.photonsPerPass + j;
+  auto splat = [&](const SurfaceInteraction& si, Vec3f wi, Color pw, bool, int) {
     grid.forNeighbours(si.p, [&](int idx) {
       const VisiblePoint& vp = px.vp[idx];
       if (lengthSq(vp.p - si.p) > px.r2[idx]) return;
@@ -152,7 +146,8 @@ ENVGI_HD uint32_t sppmPhotonStep(const SceneView& sc, const Tracer& tracer, cons
       atomicAddRelaxed(&px.m[idx], 1u);
       ++hits;
     });
-  });
+  };
+  shootPhoton(sc, tracer, emitter, s.seed ^ kSppmPhotonStream, index, 1, s.maxDepth, splat);
   return hits;
 }
 

@@ -101,4 +101,25 @@ ENVGI_HD int tracePhoton(const SceneView& sc, const Tracer& tracer, Ray ray, Col
   return stored;
 }
 
+// One photon from the lights: its own random stream (streamSeed, index, sampleIndex), emitted
+// and traced; store as tracePhoton's. The photon-map pass and SPPM's photon step, on either
+// device, start every photon here.
+template <class Tracer, class Store>
+ENVGI_HD void shootPhoton(const SceneView& sc, const Tracer& tracer, const PhotonEmitter& emitter, uint32_t streamSeed,
+                          uint64_t index, uint32_t sampleIndex, int maxDepth, Store&& store) {
+  Sampler smp;
+  smp.type = SamplerType::Independent;
+  smp.seed = streamSeed;
+  smp.start(index, sampleIndex);
+  Ray ray;
+  Color power;
+  if (!emitter.emit(sc, smp, &ray, &power)) return;
+  tracePhoton(sc, tracer, ray, power, smp, maxDepth, store);
+}
+
+// The photon a map stores at a hit: where, from where, the normal facing it, and its power.
+ENVGI_INLINE Photon makePhoton(const SurfaceInteraction& si, Vec3f wi, Color power) {
+  return Photon{si.p, wi, faceForward(si.ng, wi), power};
+}
+
 }  // namespace envgi

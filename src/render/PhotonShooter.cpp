@@ -19,62 +19,96 @@ PhotonEmitter makePhotonEmitter(const Scene& scene) {
   return e;
 }
 
+namespace {
+
+template <class Tracer>
+class CpuPhotonTracer final : public PhotonBatchTracer {
+ public:
+  CpuPhotonTracer(const Scene& scene, Tracer tracer, std::string name)
+      : scene_(scene), tracer_(tracer), emitter_(makePhotonEmitter(scene)), name_(std::move(name)) {}
+  std::string deviceName() const override { return name_; }
+  void trace(const PhotonTraceRequest& r, std::vector<PhotonBatch>* out) override {
+    const int chunk = 1024, chunks = kPhotonSubBatch / chunk;
+    std::vector<PhotonBatch> local(static_cast<size_t>(chunks));
+    const SceneView& sc = scene_.view();
+    tbb::parallel_for(0, chunks, [&](int ci) {
+      PhotonBatch& b = local[size_t(ci)];
+      for (int j = 0; j < chunk; ++j)
+        shootPhoton(sc, tracer_, emitter_, r.seed ^ kPhotonMapStream, r.first + uint64_t(ci) * chunk + j, 0,
+                    r.maxDepth, [&](const SurfaceInteraction& si, Vec3f wi, Color pw, bool isCaustic, int) {
+                      if (isCaustic ? r.caustic : r.global)
+                        (isCaustic ? b.caustic : b.global).push_back(makePhoton(si, wi, pw));
+                    });
+    });
+    // Chunks are appended in order, so the maps do not depend on the thread count.
+    PhotonBatch all;
+    for (PhotonBatch& b : local) {
+      all.global.insert(all.global.end(), b.global.begin(), b.global.end());
+      all.caustic.insert(all.caustic.end(), b.caustic.begin(), b.caustic.end());
+    }
+    out->assign(1, std::move(all));
+  }
+
+ private:
+  const Scene& scene_;
+  Tracer tracer_;
+  PhotonEmitter emitter_;
+  std::string name_;
+};
+
+}  // namespace
+
+std::unique_ptr<PhotonBatchTracer> makeCpuPhotonTracer(const Scene& scene, const EmbreeAccel& accel) {
+  return std::make_unique<CpuPhotonTracer<EmbreeTracer>>(scene, EmbreeTracer{&accel}, "cpu");
+}
+
+std::unique_ptr<PhotonBatchTracer> makeCpuPhotonTracer(const Scene& scene, const BvhView& bvh) {
+  return std::make_unique<CpuPhotonTracer<BvhTracer>>(scene, BvhTracer{bvh}, "cpu (envgi BVH)");
+}
+
 void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShootSettings& s, PhotonMap* global,
                   PhotonMap* caustic, PhotonShootStats* stats) {
   using Clock = std::chrono::steady_clock;
   auto t0 = Clock::now();
   const SceneView& sc = scene.view();
-  PhotonEmitter emitter = makePhotonEmitter(scene);
-  bool anyLight = emitter.emitsLight(sc);
+  std::shared_ptr<PhotonBatchTracer> tracer = s.tracer;
+  if (!tracer) tracer = makeCpuPhotonTracer(scene, accel);
+  bool anyLight = makePhotonEmitter(scene).emitsLight(sc);
   std::vector<Photon> g, c;
   bool gDone = s.globalPhotons == 0, cDone = s.causticPhotons == 0;
   uint64_t emitted = 0, gEmitted = 0, cEmitted = 0;
   // A scene without caustic paths never fills its caustic map: stop after a generous bound.
   const uint64_t cap = 64 * std::max(s.globalPhotons, s.causticPhotons) + 100000;
-  const int batch = 1 << 15, chunk = 1024;
-  EmbreeTracer tracer{&accel};
   double lastLog = 0.0;
   if (!anyLight) {
     spdlog::warn("the scene emits no light: no photons shot");
     gDone = cDone = true;
   }
+  std::vector<PhotonBatch> batches;
   while (!(gDone && cDone) && emitted < cap) {
-    int chunks = batch / chunk;
-    std::vector<std::vector<Photon>> gLocal(static_cast<size_t>(chunks)), cLocal(static_cast<size_t>(chunks));
-    tbb::parallel_for(0, chunks, [&](int ci) {
-      Sampler smp;
-      smp.type = SamplerType::Independent;
-      smp.seed = s.seed ^ kPhotonMapStream;
-      for (int j = 0; j < chunk; ++j) {
-        uint64_t id = emitted + uint64_t(ci) * chunk + j;
-        smp.start(id, 0);
-        Ray ray;
-        Color power;
-        if (!emitter.emit(sc, smp, &ray, &power)) continue;
-        tracePhoton(sc, tracer, ray, power, smp, s.maxDepth,
-                    [&](const SurfaceInteraction& si, Vec3f wi, Color pw, bool isCaustic, int) {
-                      if (isCaustic) {
-                        if (!cDone) cLocal[size_t(ci)].push_back({si.p, wi, faceForward(si.ng, wi), pw});
-                      } else if (!gDone) {
-                        gLocal[size_t(ci)].push_back({si.p, wi, faceForward(si.ng, wi), pw});
-                      }
-                    });
+    PhotonTraceRequest req;
+    req.first = emitted;
+    req.seed = s.seed;
+    req.maxDepth = s.maxDepth;
+    req.global = !gDone;
+    req.caustic = !cDone;
+    tracer->trace(req, &batches);
+    // Sub-batches are taken in order and the maps checked after each, whatever the device
+    // traced at once: the same seed fills the same maps.
+    for (PhotonBatch& b : batches) {
+      if ((gDone && cDone) || emitted >= cap) break;
+      if (!gDone) g.insert(g.end(), b.global.begin(), b.global.end());
+      if (!cDone) c.insert(c.end(), b.caustic.begin(), b.caustic.end());
+      emitted += uint64_t(kPhotonSubBatch);
+      if (!gDone) gEmitted = emitted;
+      if (!cDone) cEmitted = emitted;
+      gDone = gDone || g.size() >= s.globalPhotons;
+      cDone = cDone || c.size() >= s.causticPhotons;
+      // No specular surface in reach of the lights: do not spin on an empty caustic map.
+      if (!cDone && c.empty() && emitted >= (uint64_t(1) << 20)) {
+        spdlog::info("no caustic paths after {} photons: the caustic map stays empty", emitted);
+        cDone = true;
       }
-    });
-    emitted += uint64_t(batch);
-    // Chunks are appended in order, so the maps do not depend on the thread count.
-    for (int ci = 0; ci < chunks; ++ci) {
-      g.insert(g.end(), gLocal[size_t(ci)].begin(), gLocal[size_t(ci)].end());
-      c.insert(c.end(), cLocal[size_t(ci)].begin(), cLocal[size_t(ci)].end());
-    }
-    if (!gDone) gEmitted = emitted;
-    if (!cDone) cEmitted = emitted;
-    gDone = gDone || g.size() >= s.globalPhotons;
-    cDone = cDone || c.size() >= s.causticPhotons;
-    // No specular surface in reach of the lights: do not spin on an empty caustic map.
-    if (!cDone && c.empty() && emitted >= (uint64_t(1) << 20)) {
-      spdlog::info("no caustic paths after {} photons: the caustic map stays empty", emitted);
-      cDone = true;
     }
     double t = std::chrono::duration<double>(Clock::now() - t0).count();
     if (s.progress && t - lastLog >= 2.0) {
@@ -91,6 +125,7 @@ void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShoo
     stats->emittedCaustic = cEmitted;
     stats->storedGlobal = g.size();
     stats->storedCaustic = c.size();
+    stats->device = tracer->deviceName();
   }
   global->build(std::move(g));
   caustic->build(std::move(c));

@@ -1,13 +1,50 @@
-// The photon map's first pass on the CPU (Embree, oneTBB): shoots photons in deterministic
-// batches until the global and caustic maps hold the requested counts, then builds both
-// kd-trees.
+// The photon map's first pass: shoots photons in deterministic sub-batches until the global and
+// caustic maps hold the requested counts, then builds both kd-trees. The photons are traced on
+// the CPU (oneTBB, Embree or the GPU's BVH) or by a GPU (gpu/CudaPhotons.cu); either way the
+// same seed stores the same photons in the same order.
 #pragma once
 
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "accel/BvhView.h"
 #include "accel/EmbreeAccel.h"
 #include "photon/PhotonMap.h"
 #include "scene/Scene.h"
 
 namespace envgi {
+
+// Photons are shot, and the maps' counts checked, in sub-batches of this many.
+constexpr int kPhotonSubBatch = 1 << 15;
+
+// What one sub-batch of photons stored, in photon order (and, for one photon, bounce order).
+struct PhotonBatch {
+  std::vector<Photon> global, caustic;
+};
+
+struct PhotonTraceRequest {
+  uint64_t first = 0;
+  uint32_t seed = 0;
+  int maxDepth = kSpecularChainDepth;
+  bool global = true, caustic = true;  // which maps still want photons
+};
+
+// Traces sub-batches of a photon-map pass on some device.
+class PhotonBatchTracer {
+ public:
+  virtual ~PhotonBatchTracer() = default;
+  virtual std::string deviceName() const = 0;
+  // How many sub-batches one trace() call does (a GPU wants many photons in flight).
+  virtual int subBatchesPerCall() const { return 1; }
+  // Photons [r.first, r.first + subBatchesPerCall() * kPhotonSubBatch), emitted from the stream
+  // r.seed ^ kPhotonMapStream: out receives one PhotonBatch a sub-batch.
+  virtual void trace(const PhotonTraceRequest& r, std::vector<PhotonBatch>* out) = 0;
+};
+
+// The CPU's: oneTBB over chunks of a sub-batch, with Embree or the GPU's BVH as tracer.
+std::unique_ptr<PhotonBatchTracer> makeCpuPhotonTracer(const Scene& scene, const EmbreeAccel& accel);
+std::unique_ptr<PhotonBatchTracer> makeCpuPhotonTracer(const Scene& scene, const BvhView& bvh);
 
 struct PhotonShootSettings {
   size_t globalPhotons = 250000;   // stored photons wanted in the global map (0: none)
@@ -21,6 +58,8 @@ struct PhotonShootSettings {
   int irradianceLookup = 64;
   float irradianceRadius = 0.1f;
   float causticIrradianceRadius = 0.025f;
+  // Where photons are traced; null: the CPU with Embree.
+  std::shared_ptr<PhotonBatchTracer> tracer;
 };
 
 struct PhotonShootStats {
@@ -28,6 +67,7 @@ struct PhotonShootStats {
   size_t storedGlobal = 0, storedCaustic = 0;
   double traceSeconds = 0.0, buildSeconds = 0.0;
   size_t bytes = 0;
+  std::string device;  // where the photons were traced
 };
 
 // The emitter for a scene: bounding sphere, and the environment's share of the emitted power.

@@ -22,9 +22,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 void logPhotonStats(const PhotonShootStats& st) {
-  spdlog::info("photon pass: {} global photons stored ({} emitted), {} caustic ({} emitted), {:.2f} s tracing, "
+  spdlog::info("photon pass: {} global photons stored ({} emitted), {} caustic ({} emitted), {:.2f} s tracing on {}, "
                "{:.2f} s building kd-trees, {:.1f} MB ({} bytes a photon)",
-               st.storedGlobal, st.emittedGlobal, st.storedCaustic, st.emittedCaustic, st.traceSeconds,
+               st.storedGlobal, st.emittedGlobal, st.storedCaustic, st.emittedCaustic, st.traceSeconds, st.device,
                st.buildSeconds, st.bytes / 1e6,
                st.storedGlobal + st.storedCaustic > 0 ? st.bytes / (st.storedGlobal + st.storedCaustic) : 0);
 }
@@ -43,6 +43,7 @@ PhotonShootSettings photonShootSettings(const Scene& scene, const RenderOptions&
   shoot.irradianceStride = precompute ? 4 : 0;
   shoot.seed = scene.sampler.seed;
   shoot.progress = opts.progress;
+  shoot.tracer = opts.photonTracer;
   return shoot;
 }
 

@@ -12,6 +12,7 @@
 #include "image/Image.h"
 #include "integrators/Sppm.h"
 #include "render/PassExecutor.h"
+#include "render/PhotonShooter.h"
 #include "render/PixelKernel.h"
 #include "scene/Scene.h"
 
@@ -34,6 +35,8 @@ struct RenderOptions {
   // estimators, as Mitsuba's render tests use).
   std::vector<float>* varianceOut = nullptr;
   CpuTracer cpuTracer = CpuTracer::Embree;
+  // Where the photon and grid integrators trace their photon maps; null: the CPU (Embree).
+  std::shared_ptr<PhotonBatchTracer> photonTracer;
 };
 
 struct RenderStats {

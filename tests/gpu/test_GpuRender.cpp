@@ -3,7 +3,9 @@
 // skipped) where there is no CUDA device; the build alone proves the kernels compile.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <tuple>
 
 #include "accel/Bvh.h"
 #include "accel/EmbreeAccel.h"
@@ -128,6 +130,56 @@ TEST(GpuRender, SppmMatchesTheCpuDriver) {
                 name.c_str(), mg / mc, worst, 1e3 * gs.seconds / 16, st.photonSeconds, 1e3 * cs.seconds / 16);
     EXPECT_NEAR(mg / mc, 1.0, 0.01) << name;
     EXPECT_LT(worst, 0.05) << name;
+  }
+}
+
+// The photon-map pass on the GPU against the CPU's, same seed: the same photons up to traversal
+// rounding, so the counts, the stored power and its spatial histogram (8^3 cells over the
+// scene's bounds) agree closely.
+TEST(GpuRender, PhotonMapsMatchTheCpu) {
+  for (std::string name : {"cornell-box", "teapot-glass", "buddha"}) {
+    Scene s;
+    loadScene(test::bundledScenesDir() + "/" + name + ".xml", {}, s);
+    s.finalize();
+    EmbreeAccel accel(s);
+    Bvh bvh(s);
+    PhotonShootSettings ps;
+    ps.globalPhotons = 500000;
+    ps.causticPhotons = 200000;
+    ps.progress = false;
+    PhotonMap cg, cc, gg, gc;
+    PhotonShootStats cs, gs;
+    shootPhotons(s, accel, ps, &cg, &cc, &cs);
+    ps.tracer = gpu::makeCudaPhotonTracer(s, bvh, 0, ps.maxDepth);
+    shootPhotons(s, accel, ps, &gg, &gc, &gs);
+    std::printf("%-12s photons: CPU %.2f s, GPU %.2f s tracing (%llu + %llu emitted)\n", name.c_str(),
+                cs.traceSeconds, gs.traceSeconds, (unsigned long long)gs.emittedGlobal,
+                (unsigned long long)gs.emittedCaustic);
+    const SceneView& sc = s.view();
+    auto histogram = [&](const PhotonMap& m) {
+      std::vector<double> h(512, 0.0);
+      Vec3f ext = sc.boundsMax - sc.boundsMin;
+      for (const Photon& p : m.photons()) {
+        int c[3];
+        for (int a = 0; a < 3; ++a)
+          c[a] = std::clamp(int(8.f * (p.p[a] - sc.boundsMin[a]) / std::max(ext[a], 1e-6f)), 0, 7);
+        h[size_t(c[0] + 8 * (c[1] + 8 * c[2]))] += luminance(p.power);
+      }
+      return h;
+    };
+    for (auto [cpu, gpuMap, what] : {std::tuple{&cg, &gg, "global"}, std::tuple{&cc, &gc, "caustic"}}) {
+      if (cpu->size() == 0) continue;
+      EXPECT_NEAR(double(gpuMap->size()) / double(cpu->size()), 1.0, 0.005) << name << " " << what;
+      std::vector<double> a = histogram(*cpu), b = histogram(*gpuMap);
+      double total = 0.0, totalB = 0.0;
+      for (size_t i = 0; i < a.size(); ++i) {
+        total += a[i];
+        totalB += b[i];
+      }
+      EXPECT_NEAR(totalB / total, 1.0, 0.005) << name << " " << what;
+      for (size_t i = 0; i < a.size(); ++i)
+        if (a[i] > 0.01 * total) EXPECT_NEAR(b[i] / a[i], 1.0, 0.03) << name << " " << what << " cell " << i;
+    }
   }
 }
 
