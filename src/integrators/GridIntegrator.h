@@ -2,12 +2,13 @@
 // glass to the first diffuse-like surface, which gets direct light from the map (Algorithm 1,
 // shadow rays, MIS) and indirect light from the illumination grid, trilinearly interpolated,
 // times its albedo / pi. The grid's points are filled by gridGather: rays from each point
-// that read the photon maps one bounce away. Host/device except the photon lookups, which the
-// caller passes in.
+// that read the photon maps' precomputed irradiance one bounce away. Host and device.
 #pragma once
 
+#include "integrators/GatherHit.h"
 #include "integrators/SpecularChain.h"
 #include "photon/IlluminationGrid.h"
+#include "photon/IrradianceCache.h"
 #include "sampling/Warp.h"
 
 namespace envgi {
@@ -64,5 +65,50 @@ ENVGI_HD Color gridGather(const SceneView& sc, const Tracer& tracer, Ray ray, Sa
   }
   return Color(0.f);
 }
+
+// Rays [first, first + rays) of grid point i at p: radiance gathered by gridGather, projected
+// on L1 SH (*sum, Monte Carlo over the sphere); *back counts rays whose first hit was a back
+// face. Each point has its own Sobol sequence, so rays cover the sphere evenly and later calls
+// refine the same estimate.
+template <class Tracer>
+ENVGI_HD void gridPointGather(const SceneView& sc, const Tracer& tracer, Vec3f p, uint64_t i, const ChainParams& cp,
+                              const IrradianceCacheView& global, const IrradianceCacheView& caustic, uint32_t seed,
+                              int first, int rays, ShL1* sum, int* back, uint64_t* rayCount) {
+  auto hitRadiance = [&](const SurfaceInteraction& si, Vec3f wi, Sampler& smp, uint64_t* r) {
+    return gatherHitRadiance(sc, tracer, si, wi, smp, cp.strategy, global, caustic, r);
+  };
+  Sampler smp;
+  smp.type = SamplerType::Sobol;
+  smp.spp = uint32_t(first + rays);
+  smp.seed = seed ^ kGridGatherStream;
+  *sum = ShL1{};
+  *back = 0;
+  for (int k = first; k < first + rays; ++k) {
+    smp.start(i, uint32_t(k));
+    Vec3f d = sampleUniformSphere(smp.get2D());
+    bool isBack = false;
+    Color L = gridGather(sc, tracer, Ray{p, d, INFINITY}, smp, cp, hitRadiance, &isBack, rayCount);
+    *back += isBack;
+    if (!isFiniteVec(L)) continue;
+    float y[4];
+    shL1Basis(d, y);
+    for (int c = 0; c < 4; ++c) sum->c[c] += L * (y[c] / uniformSpherePdf());
+  }
+}
+
+// One camera sample of the grid integrator, on either device: caustics from the caustic map's
+// precomputed irradiance, the rest from the grid.
+template <class Tracer>
+struct GridSample {
+  const SceneView* scene = nullptr;
+  Tracer tracer;
+  IlluminationGridView grid;
+  IrradianceCacheView caustic;
+  GridParams params;
+  ENVGI_HD Color operator()(const Ray& ray, Sampler& smp, uint64_t* rays) const {
+    auto caustics = [&](Vec3f p, Vec3f n) { return caustic.irradiance(p, n); };
+    return gridTrace(*scene, tracer, ray, smp, grid, caustics, params, rays);
+  }
+};
 
 }  // namespace envgi

@@ -5,6 +5,7 @@
 // gather_samples is 0). CPU only: the maps live in kd-trees.
 #pragma once
 
+#include "integrators/GatherHit.h"
 #include "integrators/SpecularChain.h"
 #include "photon/PhotonMap.h"
 
@@ -15,17 +16,6 @@ struct PhotonRenderParams {
   PhotonLookup global, caustic;
   int gatherSamples = 8;
 };
-
-// Light leaving a gather ray's diffuse-like hit gs towards -wi: direct light by one light
-// sample, plus the precomputed photon irradiance (indirect and caustic) times the albedo / pi.
-template <class Tracer>
-Color gatherHitRadiance(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& gs, Vec3f wi,
-                        Sampler& smp, EnvStrategy strategy, const PhotonMap& global, const PhotonMap& caustic,
-                        uint64_t* rays) {
-  Vec3f ny = faceForward(gs.ng, -wi);
-  return directLighting(sc, tracer, gs, -wi, smp, strategy, 1, 0, rays) +
-         diffuseAlbedo(sc.bsdfs[gs.bsdf]) * kInvPi * (global.irradiance(gs.p, ny) + caustic.irradiance(gs.p, ny));
-}
 
 template <class Tracer>
 Color photonTrace(const SceneView& sc, const Tracer& tracer, const Ray& ray, Sampler& smp, const PhotonMap& global,
@@ -51,7 +41,8 @@ Color photonTrace(const SceneView& sc, const Tracer& tracer, const Ray& ray, Sam
       if (!tracer.intersect(gr, &gh)) continue;  // the environment is direct light, counted already
       SurfaceInteraction gs = sc.interaction(gr, gh);
       if (bsdfIsDelta(sc.bsdfs[gs.bsdf])) continue;
-      gather += bs.weight * gatherHitRadiance(sc, tracer, gs, wi, s, pp.chain.strategy, global, caustic, r);
+      gather += bs.weight * gatherHitRadiance(sc, tracer, gs, wi, s, pp.chain.strategy, global.irradianceCache().view(),
+                                                caustic.irradianceCache().view(), r);
     }
     return L + gather / float(pp.gatherSamples);
   };

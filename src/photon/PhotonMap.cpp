@@ -38,15 +38,13 @@ void PhotonMap::build(std::vector<Photon> photons) {
 
 size_t PhotonMap::bytes() const {
   // The kd-trees hold one index per point plus nodes of about 16 points each.
-  size_t n = photons_.size(), m = irr_.size();
-  return n * (sizeof(Photon) + sizeof(uint32_t)) + n / 16 * 48 +
-         m * (sizeof(IrradiancePoint) + sizeof(Photon) + sizeof(uint32_t)) + m / 16 * 48;
+  size_t n = photons_.size();
+  return n * (sizeof(Photon) + sizeof(uint32_t)) + n / 16 * 48 + cache_.bytes();
 }
 
 size_t PhotonMap::beginIrradiance(int stride) {
   irr_.clear();
-  irrPhotons_.clear();
-  irrIndex_.reset();
+  cache_ = IrradianceCache();
   irrStride_ = stride;
   if (!index_ || stride < 1) return 0;
   irr_.resize((photons_.size() + size_t(stride) - 1) / size_t(stride));
@@ -76,25 +74,8 @@ void PhotonMap::estimateIrradiance(size_t i, int k, float maxRadius) {
 }
 
 void PhotonMap::endIrradiance() {
-  if (irr_.empty()) return;
-  irrPhotons_.resize(irr_.size());
-  for (size_t i = 0; i < irr_.size(); ++i) irrPhotons_[i].p = irr_[i].p;
-  irrIndex_ = std::make_unique<Index>(&irrPhotons_);
-}
-
-Color PhotonMap::irradiance(Vec3f p, Vec3f n) const {
-  if (!irrIndex_) return Color(0.f);
-  uint32_t idx[8];
-  float d2[8];
-  float q[3] = {p.x, p.y, p.z};
-  size_t found = irrIndex_->tree.knnSearch(q, 8, idx, d2);
-  // Only a point whose own estimate covered p (Christensen 1999): a gather ray that lands
-  // where no photons arrived must not borrow irradiance from a distant surface.
-  for (size_t j = 0; j < found; ++j) {
-    const IrradiancePoint& ip = irr_[idx[j]];
-    if (d2[j] <= ip.r2 && dot(ip.n, n) > kSameSurfaceCos) return ip.e;
-  }
-  return Color(0.f);
+  cache_.build(std::move(irr_));
+  irr_.clear();
 }
 
 Color PhotonMap::estimate(const SceneView& sc, const SurfaceInteraction& si, Vec3f woWorld, const PhotonLookup& q) const {

@@ -5,14 +5,11 @@
 #include <memory>
 #include <vector>
 
+#include "photon/IrradianceCache.h"
 #include "photon/PhotonTracing.h"
 #include "scene/IntegratorSettings.h"
 
 namespace envgi {
-
-// Photons and irradiance points count as on the surface being shaded when their normals are
-// this close to its normal (not the far side of a thin wall, not a nearby crease).
-inline constexpr float kSameSurfaceCos = 0.9f;
 
 struct PhotonLookup {
   int k = 120;              // photons in the estimate
@@ -41,26 +38,20 @@ class PhotonMap {
   // Christensen's precomputation: irradiance from the k nearest photons at every stride-th
   // photon, so that a final-gather ray needs one nearest-neighbour lookup, not k. Three steps,
   // so that the caller picks the threads: begin (returns how many points), estimate each point
-  // (any order, any thread), then end (builds their kd-tree).
+  // (any order, any thread), then end (builds their IrradianceCache).
   size_t beginIrradiance(int stride);
   void estimateIrradiance(size_t i, int k, float maxRadius);
   void endIrradiance();
-  // Irradiance near p on a surface facing n: that of the nearest precomputed point facing the
-  // same way whose estimate radius covers p, zero where none does.
-  Color irradiance(Vec3f p, Vec3f n) const;
+  // Irradiance near p on a surface facing n (IrradianceCacheView::irradiance).
+  Color irradiance(Vec3f p, Vec3f n) const { return cache_.view().irradiance(p, n); }
+  const IrradianceCache& irradianceCache() const { return cache_; }
 
  private:
   struct Index;
-  struct IrradiancePoint {
-    Vec3f p, n;
-    Color e;
-    float r2;  // squared radius of the photons it was estimated from
-  };
   std::vector<Photon> photons_;
   std::unique_ptr<Index> index_;
-  std::vector<IrradiancePoint> irr_;
-  std::vector<Photon> irrPhotons_;  // positions of irr_, for their own kd-tree
-  std::unique_ptr<Index> irrIndex_;
+  std::vector<IrradiancePoint> irr_;  // being estimated, between begin and end
+  IrradianceCache cache_;
   int irrStride_ = 0;
 };
 

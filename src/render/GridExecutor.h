@@ -14,19 +14,6 @@
 
 namespace envgi {
 
-// One camera sample of the grid integrator on the CPU (caustics from the caustic map).
-struct GridSample {
-  const SceneView* scene;
-  EmbreeTracer tracer;
-  IlluminationGridView grid;
-  const PhotonMap* caustic;
-  GridParams params;
-  Color operator()(const Ray& ray, Sampler& smp, uint64_t* rays) const {
-    auto caustics = [&](Vec3f p, Vec3f n) { return caustic->irradiance(p, n); };
-    return gridTrace(*scene, tracer, ray, smp, grid, caustics, params, rays);
-  }
-};
-
 struct GridExecutorSettings {
   PhotonShootSettings photons;
   GridParams params;
@@ -54,7 +41,7 @@ class GridExecutor final : public PassExecutor {
   PhotonShootStats photonStats_;
   IlluminationGrid grid_;
   GridBuildStats gridStats_;
-  std::unique_ptr<CpuExecutor<GridSample>> camera_;
+  std::unique_ptr<CpuExecutor<GridSample<EmbreeTracer>>> camera_;
 };
 
 }  // namespace envgi

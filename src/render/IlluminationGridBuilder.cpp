@@ -6,7 +6,6 @@
 #include <atomic>
 #include <chrono>
 
-#include "integrators/PhotonIntegrator.h"
 
 namespace envgi {
 
@@ -28,29 +27,12 @@ void gatherIntoGrid(IlluminationGrid& grid, const Scene& scene, const EmbreeAcce
   const SceneView& sc = scene.view();
   EmbreeTracer tracer{&accel};
   std::atomic<uint64_t> rayCount{0};
-  auto hitRadiance = [&](const SurfaceInteraction& si, Vec3f wi, Sampler& smp, uint64_t* r) {
-    return gatherHitRadiance(sc, tracer, si, wi, smp, cp.strategy, global, caustic, r);
-  };
+  const IrradianceCacheView &g = global.irradianceCache().view(), &c = caustic.irradianceCache().view();
   tbb::parallel_for(size_t(0), grid.pointCount(), [&](size_t i) {
-    Sampler smp;
-    smp.type = SamplerType::Sobol;  // the point's rays cover the sphere evenly
-    smp.spp = uint32_t(first + rays);
-    smp.seed = seed ^ kGridGatherStream;
-    Vec3f p = grid.point(i);
     ShL1 sum;
     int back = 0;
     uint64_t r = 0;
-    for (int k = first; k < first + rays; ++k) {
-      smp.start(i, uint32_t(k));
-      Vec3f d = sampleUniformSphere(smp.get2D());
-      bool isBack = false;
-      Color L = gridGather(sc, tracer, Ray{p, d, INFINITY}, smp, cp, hitRadiance, &isBack, &r);
-      back += isBack;
-      if (!isFiniteVec(L)) continue;
-      float y[4];
-      shL1Basis(d, y);
-      for (int c = 0; c < 4; ++c) sum.c[c] += L * (y[c] / uniformSpherePdf());
-    }
+    gridPointGather(sc, tracer, grid.point(i), i, cp, g, c, seed, first, rays, &sum, &back, &r);
     grid.accumulate(i, sum, rays, back);
     rayCount += r;
   });

@@ -164,6 +164,41 @@ TEST(HashGrid, SortedKeysGiveTheCountingSortsArrays) {
   for (int i = 0; i < start.back(); ++i) ASSERT_EQ(pairs[size_t(i)].second, v.items[i]);
 }
 
+// The irradiance lookup (CPU and GPU alike) is the nearest point facing the same way whose own
+// radius covers the query: against a brute-force search over points of mixed radii and normals.
+TEST(IrradianceCache, NearestCoveringPointFacingTheSameWay) {
+  Pcg32 rng(11);
+  std::vector<IrradiancePoint> pts(4000);
+  for (size_t i = 0; i < pts.size(); ++i) {
+    IrradiancePoint& ip = pts[i];
+    ip.p = Vec3f(rng.nextFloat() * 2, rng.nextFloat() * 2, rng.nextFloat() * 0.1f);
+    ip.n = rng.nextFloat() < 0.8f ? Vec3f(0, 0, 1) : Vec3f(0, 0, -1);
+    float r = 0.01f + 0.09f * rng.nextFloat();
+    ip.r2 = r * r;
+    ip.e = Color(float(i));
+  }
+  IrradianceCache cache;
+  cache.build(pts);
+  int hits = 0;
+  for (int t = 0; t < 3000; ++t) {
+    Vec3f q(rng.nextFloat() * 2, rng.nextFloat() * 2, rng.nextFloat() * 0.1f);
+    Vec3f n = t % 3 ? Vec3f(0, 0, 1) : Vec3f(0, 0, -1);
+    float best = INFINITY;
+    Color expect(0.f);
+    for (const IrradiancePoint& ip : pts) {
+      float d2 = lengthSq(ip.p - q);
+      if (d2 <= ip.r2 && d2 < best && dot(ip.n, n) > kSameSurfaceCos) {
+        best = d2;
+        expect = ip.e;
+      }
+    }
+    hits += best < INFINITY;
+    ASSERT_EQ(cache.view().irradiance(q, n).x, expect.x) << "query " << t;
+  }
+  EXPECT_GT(hits, 1000);
+  EXPECT_LT(hits, 3000);
+}
+
 // An all-black map is a light of zero power: no photons, a black image, no NaN.
 TEST(PhotonIntegrators, BlackMapShootsNothingAndRendersBlack) {
   Bsdf b;
