@@ -5,7 +5,9 @@
 // --frames), M samples/s and M rays/s over a --spp run (default 64; the CPU runs --cpu-spp).
 // Then SPPM on the bundled buddha scene at the same resolution: milliseconds a pass (median)
 // and photons traced and splatted a second, with --sppm-photons a pass. And the photon-map pass
-// (1M global photons stored, no caustic map): photons emitted a second, tracing only.
+// (1M global photons stored, no caustic map): photons emitted a second, tracing only. And the
+// grid integrator on the buddha scene (its own settings): ms a 1-spp frame once the grid is
+// built, and what building it took.
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -21,6 +23,7 @@
 #include "render/CpuExecutor.h"
 #include "render/PhotonShooter.h"
 #include "render/Renderer.h"
+#include "render/GridExecutor.h"
 #include "render/SppmExecutor.h"
 #include "scene/SceneLoader.h"
 #include "support/FrameMesh.h"
@@ -186,6 +189,32 @@ int main(int argc, char** argv) {
       sppmRows.push_back(measureSppm(ex, 3));
     }
     EmbreeAccel accel(s);
+    {
+      Scene g;
+      loadScene(test::bundledScenesDir() + "/buddha.xml", {}, g);
+      g.camera.width = g.camera.height = res;
+      g.integrator.type = IntegratorType::Grid;
+      g.finalize();
+      RenderOptions go;
+      go.progress = false;
+      SequenceAndSpp q = gridSequence(g, go);
+      Bvh gb(g);
+      if (gpus > 0) {
+        auto t0 = std::chrono::steady_clock::now();
+        auto ex = gpu::makeCudaGridExecutor(g, gb, gridExecutorSettings(g, go), q.sequence, 0, false);
+        std::printf("grid on the GPU: photon maps and grid built in %.2f s\n", seconds(t0));
+        rows.push_back(measure(*ex, "buddha (grid)", res, res, frames, spp));
+      }
+      if (cpu) {
+        EmbreeAccel ga(g);
+        GridExecutorSettings ge = gridExecutorSettings(g, go);
+        ge.photons.tracer = makeCpuPhotonTracer(g, ga);
+        auto t0 = std::chrono::steady_clock::now();
+        GridExecutor<EmbreeTracer> ex(g, EmbreeTracer{&ga}, ge, q.sequence, 0, false, 16);
+        std::printf("grid on the CPU: photon maps and grid built in %.2f s\n", seconds(t0));
+        rows.push_back(measure(ex, "buddha (grid)", res, res, std::min(frames, 3), cpuSpp));
+      }
+    }
     PhotonShootSettings ps;
     ps.globalPhotons = 1000000;
     ps.causticPhotons = 0;
@@ -202,7 +231,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "envgi_bench_gpu: error: %s\n", e.what());
     return 1;
   }
-  std::printf("\n%dx%d, path, max_depth 8, GGX conductor alpha 0.15, Grace map\n", res, res);
+  std::printf("\n%dx%d, path, max_depth 8, GGX conductor alpha 0.15, Grace map (grid rows: the grid integrator on "
+              "the buddha scene as bundled)\n", res, res);
   std::printf("| scene | device | ms / 1-spp frame | spp run | M samples/s | M rays/s |\n|---|---|---|---|---|---|\n");
   for (const Row& r : rows)
     std::printf("| %s | %s | %.2f | %d | %.2f | %.1f |\n", r.scene.c_str(), r.device.c_str(), r.frameMs, r.spp,

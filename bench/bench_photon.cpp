@@ -105,7 +105,7 @@ BENCHMARK(BM_SppmPass)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)
 static void BM_GridFrame(benchmark::State& state) {
   static Scene scene;
   static std::unique_ptr<EmbreeAccel> accel;
-  static std::unique_ptr<GridExecutor> ex;
+  static std::unique_ptr<GridExecutor<EmbreeTracer>> ex;
   if (!ex) {
     loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/buddha.xml", {{"res", "512"}}, scene);
     scene.finalize();
@@ -117,9 +117,10 @@ static void BM_GridFrame(benchmark::State& state) {
     s.photons.irradianceRadius = 0.05f * makePhotonEmitter(scene).radius;
     s.photons.causticIrradianceRadius = 0.25f * s.photons.irradianceRadius;
     s.photons.progress = false;
+    s.photons.tracer = makeCpuPhotonTracer(scene, *accel);
     s.params.chain.strategy = EnvStrategy::Alias;
     SampleSequence seq{SamplerType::Sobol, 1024, 0};
-    ex = std::make_unique<GridExecutor>(scene, *accel, s, seq, 0, false, 16);
+    ex = std::make_unique<GridExecutor<EmbreeTracer>>(scene, EmbreeTracer{accel.get()}, s, seq, 0, false, 16);
   }
   Progress quiet(1, false);
   int frame = 0;
@@ -128,8 +129,8 @@ static void BM_GridFrame(benchmark::State& state) {
     ex->runPass(frame, frame + 1, quiet, &c);
     ++frame;
   }
-  state.counters["grid_fill_s"] = ex->gridStats().seconds;
-  state.counters["photon_trace_s"] = ex->photonStats().traceSeconds;
+  state.counters["grid_fill_s"] = ex->build().gridStats.seconds;
+  state.counters["photon_trace_s"] = ex->build().photonStats.traceSeconds;
   state.counters["Mrays/s"] = benchmark::Counter(double(c.rays) / 1e6, benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_GridFrame)->Unit(benchmark::kMillisecond)->UseRealTime();

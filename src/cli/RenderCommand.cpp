@@ -44,8 +44,9 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// cpu, cuda or auto (CUDA when a device is present). path, direct and sppm run wholly on the
-// GPU; photon and grid trace their photon maps there and the rest on the CPU.
+// cpu, cuda or auto (CUDA when a device is present). path, direct, sppm and grid run wholly on
+// the GPU (the grid's kd-trees and irradiance precomputation on the host); photon traces its
+// photon maps there and gathers on the CPU.
 bool chooseCuda(const RenderArgs& a) {
   if (a.device != "cpu" && a.device != "cuda" && a.device != "auto")
     throw std::runtime_error("unknown device '" + a.device + "' (cpu, cuda, auto)");
@@ -111,11 +112,10 @@ void runRender(const RenderArgs& a) {
                samplerName(scene.sampler.type));
   Image img;
   IntegratorType type = scene.integrator.type;
-  bool photonsOnly = type == IntegratorType::Photon || type == IntegratorType::Grid;
+  bool photonsOnly = type == IntegratorType::Photon;
   if (cuda && photonsOnly) {
     Bvh bvh(scene);
-    int depth = type == IntegratorType::Photon ? scene.integrator.photon.maxDepth : scene.integrator.grid.maxDepth;
-    ro.photonTracer = gpu::makeCudaPhotonTracer(scene, bvh, a.gpu, depth);
+    ro.photonTracer = gpu::makeCudaPhotonTracer(scene, bvh, a.gpu, scene.integrator.photon.maxDepth);
     spdlog::info("device: photon maps on {}, the rest on the CPU", ro.photonTracer->deviceName());
   }
   if (cuda && !photonsOnly) {
@@ -127,9 +127,13 @@ void runRender(const RenderArgs& a) {
     size_t bytes = 0;
     std::unique_ptr<PassExecutor> ex;
     int passes = 0;
-    if (scene.integrator.type == IntegratorType::Sppm) {
+    if (type == IntegratorType::Sppm) {
       ex = gpu::makeCudaSppmExecutor(scene, bvh, sppmParams(scene), makePhotonEmitter(scene), a.gpu, &bytes);
       passes = sppmPasses(scene, ro);
+    } else if (type == IntegratorType::Grid) {
+      SequenceAndSpp q = gridSequence(scene, ro);
+      ex = gpu::makeCudaGridExecutor(scene, bvh, gridExecutorSettings(scene, ro), q.sequence, a.gpu, false, &bytes);
+      passes = q.spp;
     } else {
       KernelSettings k = kernelSettings(scene, ro);
       ex = gpu::makeCudaExecutor(scene, bvh, k, a.gpu, false, &bytes);

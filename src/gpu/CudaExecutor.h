@@ -8,6 +8,7 @@
 #include "accel/Bvh.h"
 #include "integrators/Sppm.h"
 #include "render/PassExecutor.h"
+#include "render/IlluminationGridBuilder.h"
 #include "render/PhotonShooter.h"
 #include "render/PixelKernel.h"
 
@@ -34,5 +35,11 @@ std::unique_ptr<PassExecutor> makeCudaSppmExecutor(const Scene& scene, const Bvh
 // Traces photon-map passes on GPU `gpu` (photons of paths up to maxDepth bounces); the maps
 // are then built on the host as the CPU's.
 std::shared_ptr<PhotonBatchTracer> makeCudaPhotonTracer(const Scene& scene, const Bvh& bvh, int gpu, int maxDepth);
+
+// The grid integrator: photon maps traced on GPU `gpu` (unless s.photons.tracer says otherwise),
+// the grid filled there, camera passes there.
+std::unique_ptr<PassExecutor> makeCudaGridExecutor(const Scene& scene, const Bvh& bvh, GridExecutorSettings s,
+                                                   SampleSequence seq, int gpu, bool keepVariance,
+                                                   size_t* deviceBytes = nullptr);
 
 }  // namespace envgi::gpu

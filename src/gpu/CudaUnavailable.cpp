@@ -23,6 +23,11 @@ std::shared_ptr<PhotonBatchTracer> makeCudaPhotonTracer(const Scene&, const Bvh&
   throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
 }
 
+std::unique_ptr<PassExecutor> makeCudaGridExecutor(const Scene&, const Bvh&, GridExecutorSettings, SampleSequence, int,
+                                                   bool, size_t*) {
+  throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
+}
+
 std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene&, const Bvh&, const KernelSettings&, int, bool, size_t*) {
   throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
 }

@@ -26,11 +26,7 @@ IlluminationGrid::IlluminationGrid(Vec3f lo, Vec3f hi, int nx, int ny, int nz) {
   view_.weight = weight_.data();
 }
 
-Vec3f IlluminationGrid::point(size_t i) const {
-  int x = int(i % size_t(view_.nx)), y = int(i / size_t(view_.nx) % size_t(view_.ny)),
-      z = int(i / (size_t(view_.nx) * size_t(view_.ny)));
-  return view_.point(x, y, z);
-}
+Vec3f IlluminationGrid::point(size_t i) const { return view_.point(i); }
 
 void IlluminationGrid::accumulate(size_t i, const ShL1& s, int n, int backHits) {
   for (int c = 0; c < 4; ++c) sum_[i].c[c] += s.c[c];

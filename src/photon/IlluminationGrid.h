@@ -45,6 +45,10 @@ struct IlluminationGridView {
     return lo + Vec3f(spacing.x * float(i), spacing.y * float(j), spacing.z * float(k));
   }
   ENVGI_HD int index(int i, int j, int k) const { return (k * ny + j) * nx + i; }
+  // Point number i, x fastest.
+  ENVGI_HD Vec3f point(size_t i) const {
+    return point(int(i % size_t(nx)), int(i / size_t(nx) % size_t(ny)), int(i / (size_t(nx) * size_t(ny))));
+  }
 
   // Irradiance at p for normal n: the 8 surrounding points' SH, trilinearly weighted; points
   // inside geometry or behind the surface count less, so light leaks less through walls.
@@ -76,6 +80,7 @@ struct IlluminationGridView {
 // The grid on the host: running sums of gather rays per point, averaged on request.
 class IlluminationGrid {
  public:
+  IlluminationGrid() = default;  // no points
   // A grid of the given resolution (at least 2 a side) spanning [lo, hi].
   IlluminationGrid(Vec3f lo, Vec3f hi, int nx, int ny, int nz);
   size_t pointCount() const { return size_t(view_.nx) * view_.ny * view_.nz; }

@@ -1,10 +1,13 @@
 #include "render/IlluminationGridBuilder.h"
 
+#include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+
+#include "accel/BvhView.h"
 
 
 namespace envgi {
@@ -20,12 +23,12 @@ IlluminationGrid makeIlluminationGrid(const Scene& scene, int resolution) {
                           count(ext.z + 2 * pad.z));
 }
 
-void gatherIntoGrid(IlluminationGrid& grid, const Scene& scene, const EmbreeAccel& accel, const PhotonMap& global,
+template <class Tracer>
+void gatherIntoGrid(IlluminationGrid& grid, const Scene& scene, const Tracer& tracer, const PhotonMap& global,
                     const PhotonMap& caustic, const ChainParams& cp, uint32_t seed, int first, int rays,
                     GridBuildStats* stats) {
   auto t0 = std::chrono::steady_clock::now();
   const SceneView& sc = scene.view();
-  EmbreeTracer tracer{&accel};
   std::atomic<uint64_t> rayCount{0};
   const IrradianceCacheView &g = global.irradianceCache().view(), &c = caustic.irradianceCache().view();
   tbb::parallel_for(size_t(0), grid.pointCount(), [&](size_t i) {
@@ -36,14 +39,41 @@ void gatherIntoGrid(IlluminationGrid& grid, const Scene& scene, const EmbreeAcce
     grid.accumulate(i, sum, rays, back);
     rayCount += r;
   });
-  grid.finish();
-  if (stats) {
-    stats->points = grid.pointCount();
-    stats->insidePoints = 0;
-    for (size_t i = 0; i < grid.pointCount(); ++i) stats->insidePoints += grid.view().weight[i] == 0.f;
-    stats->rays += rayCount.load();
-    stats->seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  }
+  finishGather(grid, rayCount.load(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+               stats);
 }
+
+void finishGather(IlluminationGrid& grid, uint64_t rays, double seconds, GridBuildStats* stats) {
+  grid.finish();
+  if (!stats) return;
+  stats->points = grid.pointCount();
+  stats->insidePoints = 0;
+  for (size_t i = 0; i < grid.pointCount(); ++i) stats->insidePoints += grid.view().weight[i] == 0.f;
+  stats->rays += rays;
+  stats->seconds += seconds;
+}
+
+template <class Tracer>
+void buildGridOnCpu(const Scene& scene, const Tracer& tracer, const GridExecutorSettings& s, GridBuild* out) {
+  out->grid = makeIlluminationGrid(scene, s.resolution);
+  shootPhotons(scene, s.photons, &out->global, &out->caustic, &out->photonStats);
+  gatherIntoGrid(out->grid, scene, tracer, out->global, out->caustic, s.params.chain, s.seed, 0, s.gatherRays,
+                 &out->gridStats);
+}
+
+void logGridBuild(const GridBuild& b, int gatherRays) {
+  logPhotonStats(b.photonStats);
+  const GridBuildStats& gst = b.gridStats;
+  const IlluminationGridView& gv = b.grid.view();
+  spdlog::info("grid: {}x{}x{} points ({} inside geometry), {} gather rays each, {:.2f} M rays in {:.2f} s, {:.1f} MB",
+               gv.nx, gv.ny, gv.nz, gst.insidePoints, gatherRays, gst.rays / 1e6, gst.seconds, b.grid.bytes() / 1e6);
+}
+
+template void gatherIntoGrid(IlluminationGrid&, const Scene&, const EmbreeTracer&, const PhotonMap&, const PhotonMap&,
+                             const ChainParams&, uint32_t, int, int, GridBuildStats*);
+template void gatherIntoGrid(IlluminationGrid&, const Scene&, const BvhTracer&, const PhotonMap&, const PhotonMap&,
+                             const ChainParams&, uint32_t, int, int, GridBuildStats*);
+template void buildGridOnCpu(const Scene&, const EmbreeTracer&, const GridExecutorSettings&, GridBuild*);
+template void buildGridOnCpu(const Scene&, const BvhTracer&, const GridExecutorSettings&, GridBuild*);
 
 }  // namespace envgi

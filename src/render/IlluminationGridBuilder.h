@@ -1,10 +1,13 @@
-// Fills the illumination grid on the CPU (oneTBB over grid points, Embree): gather rays from
-// every point read the photon maps one bounce away, projected on L1 spherical harmonics.
+// Builds what the grid integrator reads (the paper's GPU steps, Section 3): the photon maps,
+// then an illumination grid whose points gather rays that read the maps one bounce away,
+// projected on L1 spherical harmonics. The fill here runs on the CPU (oneTBB, any tracer); a
+// GPU driver runs the same gridPointGather in a kernel and hands its sums to finishGather.
 #pragma once
 
 #include "accel/EmbreeAccel.h"
 #include "integrators/GridIntegrator.h"
 #include "photon/PhotonMap.h"
+#include "render/PhotonShooter.h"
 #include "scene/Scene.h"
 
 namespace envgi {
@@ -15,13 +18,41 @@ struct GridBuildStats {
   double seconds = 0.0;
 };
 
+struct GridExecutorSettings {
+  PhotonShootSettings photons;
+  GridParams params;
+  int resolution = 32;
+  int gatherRays = 128;
+  uint32_t seed = 0;
+};
+
+// The photon maps and the grid, with how long each took.
+struct GridBuild {
+  PhotonMap global, caustic;
+  PhotonShootStats photonStats;
+  IlluminationGrid grid;
+  GridBuildStats gridStats;
+};
+
 // A grid over the scene's bounds with `resolution` points along its longest side.
 IlluminationGrid makeIlluminationGrid(const Scene& scene, int resolution);
 
 // Adds `rays` gather rays to every point (rays [first, first + rays) of each point's sequence,
 // so calls can refine a grid progressively) and re-averages it.
-void gatherIntoGrid(IlluminationGrid& grid, const Scene& scene, const EmbreeAccel& accel, const PhotonMap& global,
+template <class Tracer>
+void gatherIntoGrid(IlluminationGrid& grid, const Scene& scene, const Tracer& tracer, const PhotonMap& global,
                     const PhotonMap& caustic, const ChainParams& cp, uint32_t seed, int first, int rays,
                     GridBuildStats* stats);
+
+// After every point got its gather sums (IlluminationGrid::accumulate): averages the grid and
+// adds the fill's figures to *stats.
+void finishGather(IlluminationGrid& grid, uint64_t rays, double seconds, GridBuildStats* stats);
+
+// Photon maps (traced where s.photons.tracer says), then the grid filled on the CPU by tracer.
+template <class Tracer>
+void buildGridOnCpu(const Scene& scene, const Tracer& tracer, const GridExecutorSettings& s, GridBuild* out);
+
+// One log line each for the photon maps and the grid.
+void logGridBuild(const GridBuild& b, int gatherRays);
 
 }  // namespace envgi

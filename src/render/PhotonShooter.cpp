@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <chrono>
+#include <stdexcept>
 
 namespace envgi {
 
@@ -68,11 +69,27 @@ std::unique_ptr<PhotonBatchTracer> makeCpuPhotonTracer(const Scene& scene, const
 
 void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShootSettings& s, PhotonMap* global,
                   PhotonMap* caustic, PhotonShootStats* stats) {
+  if (s.tracer) return shootPhotons(scene, s, global, caustic, stats);
+  PhotonShootSettings cpu = s;
+  cpu.tracer = makeCpuPhotonTracer(scene, accel);
+  shootPhotons(scene, cpu, global, caustic, stats);
+}
+
+void logPhotonStats(const PhotonShootStats& st) {
+  spdlog::info("photon pass: {} global photons stored ({} emitted), {} caustic ({} emitted), {:.2f} s tracing on {}, "
+               "{:.2f} s building kd-trees, {:.1f} MB ({} bytes a photon)",
+               st.storedGlobal, st.emittedGlobal, st.storedCaustic, st.emittedCaustic, st.traceSeconds, st.device,
+               st.buildSeconds, st.bytes / 1e6,
+               st.storedGlobal + st.storedCaustic > 0 ? st.bytes / (st.storedGlobal + st.storedCaustic) : 0);
+}
+
+void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* global, PhotonMap* caustic,
+                  PhotonShootStats* stats) {
   using Clock = std::chrono::steady_clock;
   auto t0 = Clock::now();
   const SceneView& sc = scene.view();
-  std::shared_ptr<PhotonBatchTracer> tracer = s.tracer;
-  if (!tracer) tracer = makeCpuPhotonTracer(scene, accel);
+  if (!s.tracer) throw std::logic_error("shootPhotons: no photon tracer");
+  PhotonBatchTracer* tracer = s.tracer.get();
   bool anyLight = makePhotonEmitter(scene).emitsLight(sc);
   std::vector<Photon> g, c;
   bool gDone = s.globalPhotons == 0, cDone = s.causticPhotons == 0;

@@ -73,7 +73,14 @@ struct PhotonShootStats {
 // The emitter for a scene: bounding sphere, and the environment's share of the emitted power.
 PhotonEmitter makePhotonEmitter(const Scene& scene);
 
+// With s.tracer null the photons are traced on the CPU with accel.
 void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShootSettings& s, PhotonMap* global,
                   PhotonMap* caustic, PhotonShootStats* stats);
+// s.tracer must be set.
+void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* global, PhotonMap* caustic,
+                  PhotonShootStats* stats);
+
+// One log line: photons stored and emitted, times, memory.
+void logPhotonStats(const PhotonShootStats& st);
 
 }  // namespace envgi

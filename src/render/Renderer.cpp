@@ -21,14 +21,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-void logPhotonStats(const PhotonShootStats& st) {
-  spdlog::info("photon pass: {} global photons stored ({} emitted), {} caustic ({} emitted), {:.2f} s tracing on {}, "
-               "{:.2f} s building kd-trees, {:.1f} MB ({} bytes a photon)",
-               st.storedGlobal, st.emittedGlobal, st.storedCaustic, st.emittedCaustic, st.traceSeconds, st.device,
-               st.buildSeconds, st.bytes / 1e6,
-               st.storedGlobal + st.storedCaustic > 0 ? st.bytes / (st.storedGlobal + st.storedCaustic) : 0);
-}
-
 // The first pass for the photon and grid integrators, with precomputed irradiance (stride 4)
 // when final gathers will read it.
 PhotonShootSettings photonShootSettings(const Scene& scene, const RenderOptions& opts, const PhotonSettings& ps,
@@ -98,6 +90,26 @@ int sppmPasses(const Scene& scene, const RenderOptions& opts) {
   return passes;
 }
 
+GridExecutorSettings gridExecutorSettings(const Scene& scene, const RenderOptions& opts) {
+  const GridSettings& gs = scene.integrator.grid;
+  PhotonSettings maps;  // the photon integrator's lookup radii, the grid's photon counts
+  maps.globalPhotons = gs.globalPhotons;
+  maps.causticPhotons = gs.causticPhotons;
+  maps.maxDepth = gs.maxDepth;
+  GridExecutorSettings ge;
+  ge.photons = photonShootSettings(scene, opts, maps, true);
+  ge.params.chain = chainParams(scene, gs.maxDepth, gs.rrDepth, gs.hideEmitters);
+  ge.resolution = gs.resolution;
+  ge.gatherRays = gs.gatherRays;
+  ge.seed = scene.sampler.seed;
+  return ge;
+}
+
+SequenceAndSpp gridSequence(const Scene& scene, const RenderOptions& opts) {
+  int spp = samplesOf(scene, opts);
+  return {sequenceOf(scene, spp), spp};
+}
+
 void logExecutorStats(const PassExecutor& ex) {
   if (auto* sppm = dynamic_cast<const SppmPassExecutor*>(&ex)) {
     SppmStats st = sppm->stats();
@@ -116,27 +128,13 @@ PreparedRender prepareSppm(const Scene& scene, const EmbreeAccel& accel, const R
 }
 
 PreparedRender prepareGrid(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
-  const GridSettings& gs = scene.integrator.grid;
-  int spp = samplesOf(scene, opts);
-  PhotonSettings maps;  // the photon integrator's lookup radii, the grid's photon counts
-  maps.globalPhotons = gs.globalPhotons;
-  maps.causticPhotons = gs.causticPhotons;
-  maps.maxDepth = gs.maxDepth;
-  GridExecutorSettings ge;
-  ge.photons = photonShootSettings(scene, opts, maps, true);
-  ge.params.chain = chainParams(scene, gs.maxDepth, gs.rrDepth, gs.hideEmitters);
-  ge.resolution = gs.resolution;
-  ge.gatherRays = gs.gatherRays;
-  ge.seed = scene.sampler.seed;
-  auto ex = std::make_unique<GridExecutor>(scene, accel, ge, sequenceOf(scene, spp), opts.threads,
-                                           opts.varianceOut != nullptr, opts.tileSize);
-  logPhotonStats(ex->photonStats());
-  const GridBuildStats& gst = ex->gridStats();
-  const IlluminationGridView& gv = ex->grid().view();
-  spdlog::info("grid: {}x{}x{} points ({} inside geometry), {} gather rays each, {:.2f} M rays in {:.2f} s, {:.1f} MB",
-               gv.nx, gv.ny, gv.nz, gst.insidePoints, gs.gatherRays, gst.rays / 1e6, gst.seconds,
-               ex->grid().bytes() / 1e6);
-  return {std::move(ex), spp};
+  GridExecutorSettings ge = gridExecutorSettings(scene, opts);
+  if (!ge.photons.tracer) ge.photons.tracer = makeCpuPhotonTracer(scene, accel);
+  auto ex = std::make_unique<GridExecutor<EmbreeTracer>>(scene, EmbreeTracer{&accel}, ge,
+                                                         sequenceOf(scene, samplesOf(scene, opts)), opts.threads,
+                                                         opts.varianceOut != nullptr, opts.tileSize);
+  logGridBuild(ex->build(), ge.gatherRays);
+  return {std::move(ex), samplesOf(scene, opts)};
 }
 
 PreparedRender preparePhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
@@ -284,6 +282,16 @@ PreparedRender prepareRender(const Scene& scene, const EmbreeAccel& accel, const
 
 Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
   const Camera& cam = scene.view().camera;
+  if (opts.cpuTracer == CpuTracer::Bvh && scene.integrator.type == IntegratorType::Grid) {
+    Bvh bvh(scene);
+    GridExecutorSettings ge = gridExecutorSettings(scene, opts);
+    if (!ge.photons.tracer) ge.photons.tracer = makeCpuPhotonTracer(scene, bvh.view());
+    SequenceAndSpp q = gridSequence(scene, opts);
+    GridExecutor<BvhTracer> ex(scene, BvhTracer{bvh.view()}, ge, q.sequence, opts.threads, opts.varianceOut != nullptr,
+                               opts.tileSize);
+    logGridBuild(ex.build(), ge.gatherRays);
+    return renderPasses(ex, cam.width, cam.height, q.spp, opts, stats);
+  }
   if (opts.cpuTracer == CpuTracer::Bvh && scene.integrator.type == IntegratorType::Sppm) {
     Bvh bvh(scene);
     SppmExecutor<BvhTracer> ex(scene, BvhTracer{bvh.view()}, sppmParams(scene), opts.threads);

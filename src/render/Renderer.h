@@ -12,6 +12,7 @@
 #include "image/Image.h"
 #include "integrators/Sppm.h"
 #include "render/PassExecutor.h"
+#include "render/IlluminationGridBuilder.h"
 #include "render/PhotonShooter.h"
 #include "render/PixelKernel.h"
 #include "scene/Scene.h"
@@ -55,6 +56,15 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts);
 // SPPM's options from the scene, checked, and the passes to run (opts.spp overrides).
 SppmParams sppmParams(const Scene& scene);
 int sppmPasses(const Scene& scene, const RenderOptions& opts);
+
+// The grid integrator's build settings from the scene (photon tracer: opts.photonTracer), and
+// the sample sequence and count its camera passes run.
+GridExecutorSettings gridExecutorSettings(const Scene& scene, const RenderOptions& opts);
+struct SequenceAndSpp {
+  SampleSequence sequence;
+  int spp = 0;
+};
+SequenceAndSpp gridSequence(const Scene& scene, const RenderOptions& opts);
 
 // Logs what an executor counted beyond rays (SPPM's passes, photons and radius).
 void logExecutorStats(const PassExecutor& ex);

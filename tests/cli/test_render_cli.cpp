@@ -166,9 +166,9 @@ TEST(RenderCli, DeviceChoice) {
   CliResult bad = runCli("render " + scene + " -o " + d.file("bad.exr") + " --device tpu");
   EXPECT_EQ(bad.code, 1);
   EXPECT_NE(bad.output.find("unknown device 'tpu'"), std::string::npos) << bad.output;
-  // Every integrator has a GPU part (photon and grid: the photon maps), so with a GPU each
-  // renders with --device cuda; without one each is the same one error line.
-  for (std::string integ : {"sppm", "photon"}) {
+  // Every integrator has a GPU part (photon: its photon maps), so with a GPU each renders with
+  // --device cuda; without one each is the same one error line.
+  for (std::string integ : {"sppm", "photon", "grid"}) {
     CliResult r = runCli("render " + scene + " -o " + d.file(integ + ".exr") + " --device cuda --integrator " + integ +
                          " --spp 1 --no-progress");
     if (gpu) {
