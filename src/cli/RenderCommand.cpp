@@ -44,19 +44,6 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-// cpu, cuda or auto (CUDA when a device is present). path, direct, sppm and grid run wholly on
-// the GPU (the grid's kd-trees and irradiance precomputation on the host); photon traces its
-// photon maps there and gathers on the CPU.
-bool chooseCuda(const RenderArgs& a) {
-  if (a.device != "cpu" && a.device != "cuda" && a.device != "auto")
-    throw std::runtime_error("unknown device '" + a.device + "' (cpu, cuda, auto)");
-  if (a.device == "cpu") return false;
-  std::string why;
-  int n = gpu::deviceCount(&why);
-  if (a.device == "cuda" && n == 0) throw std::runtime_error("--device cuda: no CUDA device (" + why + ")");
-  if (n == 0) spdlog::info("device: CPU ({})", why);
-  return n > 0;
-}
 
 void runRender(const RenderArgs& a) {
   namespace fs = std::filesystem;
@@ -78,7 +65,7 @@ void runRender(const RenderArgs& a) {
   if (!a.sampler.empty()) scene.sampler.type = findSampler(a.sampler);
   if (!a.filter.empty()) scene.camera.filter = findName(kFilterNames, a.filter, "filter");
   scene.finalize();
-  bool cuda = chooseCuda(a);
+  bool cuda = chooseCuda(a.device);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   spdlog::info("scene {}: {} triangles, {} spheres, {} area-light primitives{}, {:.1f} MB of geometry, loaded in {:.2f} s",
                a.scene, scene.triangleCount(), scene.spheres.size(), scene.lightCount(),
@@ -111,38 +98,20 @@ void runRender(const RenderArgs& a) {
                integratorName(is.type), is.env.strategy, a.spp > 0 ? a.spp : scene.sampler.sampleCount,
                samplerName(scene.sampler.type));
   Image img;
-  IntegratorType type = scene.integrator.type;
-  bool photonsOnly = type == IntegratorType::Photon;
-  if (cuda && photonsOnly) {
-    Bvh bvh(scene);
-    ro.photonTracer = gpu::makeCudaPhotonTracer(scene, bvh, a.gpu, scene.integrator.photon.maxDepth);
-    spdlog::info("device: photon maps on {}, the rest on the CPU", ro.photonTracer->deviceName());
-  }
-  if (cuda && !photonsOnly) {
+  if (cuda) {
     Bvh bvh(scene);
     const BvhBuildStats& bs = bvh.stats();
     spdlog::info("BVH: {} triangles, {} nodes, depth {}, {:.1f} bytes a triangle, built in {:.2f} s", bs.triangles,
                  bs.nodes, bs.maxDepth, bs.triangles ? double(bs.bytes()) / double(bs.triangles) : 0.0, bs.seconds);
+    std::unique_ptr<EmbreeAccel> accel;
+    if (scene.integrator.type == IntegratorType::Photon) accel = std::make_unique<EmbreeAccel>(scene);
     auto t2 = std::chrono::steady_clock::now();
     size_t bytes = 0;
-    std::unique_ptr<PassExecutor> ex;
-    int passes = 0;
-    if (type == IntegratorType::Sppm) {
-      ex = gpu::makeCudaSppmExecutor(scene, bvh, sppmParams(scene), makePhotonEmitter(scene), a.gpu, &bytes);
-      passes = sppmPasses(scene, ro);
-    } else if (type == IntegratorType::Grid) {
-      SequenceAndSpp q = gridSequence(scene, ro);
-      ex = gpu::makeCudaGridExecutor(scene, bvh, gridExecutorSettings(scene, ro), q.sequence, a.gpu, false, &bytes);
-      passes = q.spp;
-    } else {
-      KernelSettings k = kernelSettings(scene, ro);
-      ex = gpu::makeCudaExecutor(scene, bvh, k, a.gpu, false, &bytes);
-      passes = k.spp;
-    }
-    spdlog::info("device: {}: scene uploaded in {:.2f} s, {:.1f} MB of device memory", ex->deviceName(),
+    PreparedRender pr = gpu::prepareCudaRender(scene, bvh, accel.get(), ro, a.gpu, &bytes);
+    spdlog::info("device: {}: ready in {:.2f} s, {:.1f} MB of device memory", pr.executor->deviceName(),
                  secondsSince(t2), bytes / 1e6);
-    img = renderPasses(*ex, scene.camera.width, scene.camera.height, passes, ro, &st);
-    logExecutorStats(*ex);
+    img = renderPasses(*pr.executor, scene.camera.width, scene.camera.height, pr.spp, ro, &st);
+    logExecutorStats(*pr.executor);
   } else {
     auto t1 = std::chrono::steady_clock::now();
     EmbreeAccel accel(scene);
@@ -160,6 +129,17 @@ void runRender(const RenderArgs& a) {
 }
 
 }  // namespace
+
+bool chooseCuda(const std::string& device) {
+  if (device != "cpu" && device != "cuda" && device != "auto")
+    throw std::runtime_error("unknown device '" + device + "' (cpu, cuda, auto)");
+  if (device == "cpu") return false;
+  std::string why;
+  int n = gpu::deviceCount(&why);
+  if (device == "cuda" && n == 0) throw std::runtime_error("--device cuda: no CUDA device (" + why + ")");
+  if (n == 0) spdlog::info("device: CPU ({})", why);
+  return n > 0;
+}
 
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds) {
   std::map<std::string, std::string> out;

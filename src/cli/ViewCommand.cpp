@@ -5,6 +5,7 @@
 #include <random>
 
 #include "cli/Commands.h"
+#include "gpu/CudaExecutor.h"
 #include "scene/NameTables.h"
 #include "scene/SceneLoader.h"
 #include "view/ViewServer.h"
@@ -13,8 +14,8 @@ namespace envgi::cli {
 
 namespace {
 struct ViewArgs {
-  std::string scene, host = "127.0.0.1", integrator, strategy;
-  int port = 8000, threads = 0, maxSpp = 4096;
+  std::string scene, host = "127.0.0.1", integrator, strategy, device = "auto";
+  int port = 8000, threads = 0, maxSpp = 4096, gpu = 0;
   std::vector<std::string> defines;
 };
 
@@ -34,6 +35,16 @@ void runView(const ViewArgs& a) {
   ViewOptions vo;
   vo.threads = a.threads;
   vo.maxSpp = a.maxSpp;
+  if (chooseCuda(a.device)) {
+    // The GPU's BVH is built once, on first use: the viewer never changes the geometry.
+    auto bvh = std::make_shared<std::unique_ptr<Bvh>>();
+    int gpu = a.gpu;
+    vo.prepare = [bvh, gpu](const Scene& s, const EmbreeAccel& accel, const RenderOptions& ro) {
+      if (!*bvh) *bvh = std::make_unique<Bvh>(s);
+      return gpu::prepareCudaRender(s, **bvh, &accel, ro, gpu);
+    };
+    spdlog::info("view: rendering on {}", gpu::deviceName(gpu));
+  }
   ViewSession session(std::move(scene), a.scene, vo);
   ViewServerOptions so;
   so.host = a.host;
@@ -61,6 +72,8 @@ void addViewCommand(CLI::App& app) {
   c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
   c->add_option("--max-spp", a->maxSpp, "Stop refining at this many samples per pixel")->check(CLI::PositiveNumber);
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
+  c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
+  c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(CLI::NonNegativeNumber);
   c->callback([a] { runView(*a); });
 }
 

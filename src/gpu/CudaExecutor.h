@@ -11,6 +11,7 @@
 #include "render/IlluminationGridBuilder.h"
 #include "render/PhotonShooter.h"
 #include "render/PixelKernel.h"
+#include "render/Renderer.h"
 
 namespace envgi::gpu {
 
@@ -41,5 +42,10 @@ std::shared_ptr<PhotonBatchTracer> makeCudaPhotonTracer(const Scene& scene, cons
 std::unique_ptr<PassExecutor> makeCudaGridExecutor(const Scene& scene, const Bvh& bvh, GridExecutorSettings s,
                                                    SampleSequence seq, int gpu, bool keepVariance,
                                                    size_t* deviceBytes = nullptr);
+
+// The scene's integrator on GPU `gpu`, as prepareRender does it on the CPU: path, direct, sppm
+// and grid wholly there; photon traces its maps there and needs accel for the rest.
+PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const EmbreeAccel* accel, RenderOptions opts,
+                                 int gpu, size_t* deviceBytes = nullptr);
 
 }  // namespace envgi::gpu

@@ -60,6 +60,17 @@ class CudaPassExecutor final : public PassExecutor {
     progress.add(size_t(cam_.width) * cam_.height * size_t(s1 - s0));
   }
 
+  // A new camera of the same size keeps everything on the device (scene, BVH, a grid) and
+  // clears the film; another size needs a new film, so a new executor.
+  bool restart(const Camera& cam) override {
+    if (cam.width != cam_.width || cam.height != cam_.height) return false;
+    cam_ = cam;
+    size_t px = size_t(cam_.width) * cam_.height;
+    check(cudaMemset(film_.sum, 0, px * sizeof(Color)), "clearing the film");
+    if (film_.sumSqLum) check(cudaMemset(film_.sumSqLum, 0, px * sizeof(double)), "clearing the film");
+    return true;
+  }
+
   void readFilm(FilmSums* out) override {
     size_t px = size_t(cam_.width) * cam_.height;
     out->sum.resize(px);

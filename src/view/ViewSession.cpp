@@ -262,7 +262,7 @@ void ViewSession::run() {
           ro.spp = opts_.maxSpp;
           auto tp = Clock::now();
           pr = PreparedRender{};  // free the old executor's maps first
-          pr = prepareRender(*scene_, *accel_, ro);
+          pr = opts_.prepare ? opts_.prepare(*scene_, *accel_, ro) : prepareRender(*scene_, *accel_, ro);
           ++preparations_;
           spdlog::info("view: {} ready in {:.2f} s", s.integrator,
                        std::chrono::duration<double>(Clock::now() - tp).count());

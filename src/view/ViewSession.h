@@ -25,6 +25,9 @@ struct ViewFrame {
 };
 
 struct ViewOptions {
+  // Makes the executor for the scene's integrator; unset: prepareRender on the CPU (Embree).
+  // `envgi view` sets it to the GPU's where one is used.
+  std::function<PreparedRender(const Scene&, const EmbreeAccel&, const RenderOptions&)> prepare;
   int threads = 0;
   int maxSpp = 4096;  // stop refining here
   int jpegQuality = 85;

@@ -180,7 +180,7 @@ TEST(ViewBrowser, WiderBindingRequiresTheToken) {
 TEST(ViewBrowser, BadArgumentsAreOneErrorLine) {
   TempDir d;
   std::string scene = writeScene(d);
-  for (std::string bad : {"--host not-an-address", "--integrator bdpt", "--strategy magic", "--port 70000"}) {
+  for (std::string bad : {"--host not-an-address", "--integrator bdpt", "--strategy magic", "--port 70000", "--device tpu"}) {
     CliResult r = runCli("view " + scene + " " + bad);
     EXPECT_NE(r.code, 0) << bad;
     EXPECT_NE(r.output.find("error"), std::string::npos) << bad << ": " << r.output;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <atomic>
 #include <condition_variable>
 #include <filesystem>
 #include <mutex>
@@ -41,7 +42,7 @@ struct Sink {
   }
 };
 
-std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& sink) {
+std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& sink, ViewOptions vo = {}) {
   std::string xml = dir + "/ball.xml";
   test::writeBallScene(xml, 24, 16, "");
   auto scene = std::make_unique<Scene>();
@@ -51,7 +52,6 @@ std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& sink) {
   grid.causticPhotons = 0;
   grid.resolution = 8;
   grid.gatherRays = 16;
-  ViewOptions vo;
   vo.threads = 1;
   vo.maxSpp = 16;
   auto s = std::make_unique<ViewSession>(std::move(scene), xml, vo);
@@ -196,4 +196,32 @@ TEST(ViewSession, SwitchingBackReusesThePreparedIntegrator) {
   session->handle(R"({"type":"strategy","value":"importance"})");
   showing("grid", "importance");
   EXPECT_EQ(session->preparations(), base + 2) << "a new strategy makes the grid anew";
+}
+
+// `envgi view --device cuda` hands the session the GPU's preparer; the session makes every
+// executor through it (here a counting stand-in over the CPU's), and a camera move reuses it.
+TEST(ViewSession, ExecutorsComeFromTheInjectedPreparer) {
+  test::TempDir d;
+  Sink sink;
+  auto calls = std::make_shared<std::atomic<int>>(0);
+  ViewOptions vo;
+  vo.prepare = [calls](const Scene& s, const EmbreeAccel& accel, const RenderOptions& ro) {
+    ++*calls;
+    return prepareRender(s, accel, ro);
+  };
+  auto session = makeSession(d.path.string(), sink, vo);
+  session->requestFrame();
+  EXPECT_FALSE(sink.waitFor(0).is_null());
+  session->handle(R"({"type":"camera","origin":[0,1.5,4],"target":[0,0,0],"up":[0,1,0]})");
+  session->requestFrame();
+  EXPECT_FALSE(sink.waitFor(1).is_null());
+  EXPECT_EQ(calls->load(), 1) << "the camera move restarted the executor";
+  session->handle(R"({"type":"integrator","value":"direct"})");
+  for (size_t n = 2; n < 200; ++n) {
+    session->requestFrame();
+    json f = sink.waitFor(n);
+    if (f.is_null() || f["integrator"] == "direct") break;
+  }
+  EXPECT_EQ(calls->load(), 2);
+  EXPECT_EQ(session->preparations(), calls->load());
 }

@@ -1,0 +1,46 @@
+#include <spdlog/spdlog.h>
+
+#include <stdexcept>
+
+#include "gpu/CudaExecutor.h"
+#include "render/Renderer.h"
+
+namespace envgi::gpu {
+
+PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const EmbreeAccel* accel, RenderOptions opts,
+                                 int gpu, size_t* deviceBytes) {
+  size_t bytes = 0;
+  PreparedRender pr;
+  switch (scene.integrator.type) {
+    case IntegratorType::Path:
+    case IntegratorType::Direct: {
+      KernelSettings k = kernelSettings(scene, opts);
+      pr.executor = makeCudaExecutor(scene, bvh, k, gpu, opts.varianceOut != nullptr, &bytes);
+      pr.spp = k.spp;
+      break;
+    }
+    case IntegratorType::Sppm:
+      pr.executor = makeCudaSppmExecutor(scene, bvh, sppmParams(scene), makePhotonEmitter(scene), gpu, &bytes);
+      pr.spp = sppmPasses(scene, opts);
+      break;
+    case IntegratorType::Grid: {
+      SequenceAndSpp q = gridSequence(scene, opts);
+      pr.executor = makeCudaGridExecutor(scene, bvh, gridExecutorSettings(scene, opts), q.sequence, gpu,
+                                         opts.varianceOut != nullptr, &bytes);
+      pr.spp = q.spp;
+      break;
+    }
+    case IntegratorType::Photon: {
+      // The final gathers read kd-trees on the CPU: only the photons are traced on the GPU.
+      if (!accel) throw std::logic_error("prepareCudaRender: photon needs the CPU's Embree scene");
+      opts.photonTracer = makeCudaPhotonTracer(scene, bvh, gpu, scene.integrator.photon.maxDepth);
+      spdlog::info("device: photon maps on {}, camera passes on the CPU", opts.photonTracer->deviceName());
+      pr = prepareRender(scene, *accel, opts);
+      break;
+    }
+  }
+  if (deviceBytes) *deviceBytes = bytes;
+  return pr;
+}
+
+}  // namespace envgi::gpu
