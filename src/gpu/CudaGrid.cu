@@ -1,9 +1,9 @@
 // The grid integrator on a CUDA GPU: photon maps traced on the device (CudaPhotons) and built on
 // the host, their precomputed irradiance uploaded as IrradianceCaches, then one thread a grid
 // point runs gridPointGather (the CPU's body), the host averages the sums into the grid
-// (finishGather, as the CPU), and the camera passes run GridSample, the CPU's per-sample body.
-#include <spdlog/spdlog.h>
-
+// (finishGather, as the CPU) and uploads it, and the camera passes run GridSample, the CPU's
+// per-sample body. Before each pass after the first, refine_rays more rays a point refine the
+// grid, as on the CPU.
 #include <chrono>
 
 #include "gpu/CudaPassExecutor.cuh"
@@ -17,12 +17,12 @@ constexpr int kThreads = 64;
 
 __global__ void gridGatherKernel(const SceneView* sc, BvhTracer tracer, IlluminationGridView grid, ChainParams cp,
                                  IrradianceCacheView global, IrradianceCacheView caustic, uint32_t seed, int first,
-                                 int rays, int n, ShL1* sums, int* backs, unsigned long long* rayCount) {
+                                 int rays, int length, int n, ShL1* sums, int* backs, unsigned long long* rayCount) {
   int i = int(blockIdx.x * blockDim.x + threadIdx.x);
   if (i >= n) return;
   uint64_t r = 0;
-  gridPointGather(*sc, tracer, grid.point(size_t(i)), uint64_t(i), cp, global, caustic, seed, first, rays, &sums[i],
-                  &backs[i], &r);
+  gridPointGather(*sc, tracer, grid.point(size_t(i)), uint64_t(i), cp, global, caustic, seed, first, rays, length,
+                  &sums[i], &backs[i], &r);
   atomicAdd(rayCount, (unsigned long long)r);
 }
 
@@ -36,6 +36,87 @@ IrradianceCacheView uploadCache(DeviceArena& a, const IrradianceCache& c) {
   return v;
 }
 
+class CudaGridExecutor final : public PassExecutor {
+ public:
+  CudaGridExecutor(const Scene& scene, const Bvh& bvh, const GridExecutorSettings& s, SampleSequence seq, int gpu,
+                   bool keepVariance)
+      : s_(s) {
+    build_.grid = makeIlluminationGrid(scene, s.resolution);
+    shootPhotons(scene, s.photons, &build_.global, &build_.caustic, &build_.photonStats);
+    auto ds = std::make_unique<DeviceScene>(scene, bvh);
+    DeviceArena& a = ds->arena;
+    sceneView_ = ds->deviceView;
+    tracer_ = BvhTracer{ds->bvh};
+    global_ = uploadCache(a, build_.global.irradianceCache());
+    caustic_ = uploadCache(a, build_.caustic.irradianceCache());
+    n_ = int(build_.grid.pointCount());
+    sums_ = a.allocate<ShL1>(size_t(n_), "grid gather sums");
+    backs_ = a.allocate<int>(size_t(n_), "grid gather sums");
+    rays_ = a.allocate<unsigned long long>(1, "counters");
+    gridView_ = build_.grid.view();
+    gridView_.sh = a.allocate<ShL1>(size_t(n_), "illumination grid");
+    gridView_.weight = a.allocate<float>(size_t(n_), "illumination grid");
+    gather(0, s.gatherRays);
+    done_ = s.gatherRays;
+    logGridBuild(build_, s.gatherRays);
+    GridSample<BvhTracer> sample{sceneView_, tracer_, gridView_, caustic_, s.params};
+    camera_ = std::make_unique<CudaPassExecutor<GridSample<BvhTracer>>>(std::move(ds), sample, scene.view().camera,
+                                                                        seq, gpu, keepVariance);
+  }
+
+  std::string deviceName() const override { return camera_->deviceName(); }
+  void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
+    if (passes_++ > 0) {
+      int add = s_.raysToAdd(done_);
+      if (add > 0) gather(done_, add);
+      done_ += add;
+    }
+    camera_->runPass(s0, s1, progress, counters);
+  }
+  void readFilm(FilmSums* out) override { camera_->readFilm(out); }
+  bool restart(const Camera& cam) override { return camera_->restart(cam); }
+  size_t deviceBytes() const { return camera_->deviceBytes(); }
+
+ private:
+  // Rays [first, first + rays) of every point on the device; the host adds them to the grid and
+  // uploads the averaged coefficients.
+  void gather(int first, int rays) {
+    auto t0 = std::chrono::steady_clock::now();
+    check(cudaMemset(rays_, 0, sizeof(unsigned long long)), "clearing counters");
+    gridGatherKernel<<<(n_ + kThreads - 1) / kThreads, kThreads>>>(sceneView_, tracer_, gridView_, s_.params.chain,
+                                                                   global_, caustic_, s_.seed, first, rays,
+                                                                   s_.sequenceLength(), n_, sums_, backs_, rays_);
+    check(cudaGetLastError(), "launching the grid gather kernel");
+    std::vector<ShL1> sums(static_cast<size_t>(n_));
+    std::vector<int> backs(static_cast<size_t>(n_));
+    unsigned long long rayCount = 0;
+    check(cudaMemcpy(sums.data(), sums_, size_t(n_) * sizeof(ShL1), cudaMemcpyDeviceToHost), "filling the grid");
+    check(cudaMemcpy(backs.data(), backs_, size_t(n_) * sizeof(int), cudaMemcpyDeviceToHost), "filling the grid");
+    check(cudaMemcpy(&rayCount, rays_, sizeof(rayCount), cudaMemcpyDeviceToHost), "filling the grid");
+    for (int i = 0; i < n_; ++i) build_.grid.accumulate(size_t(i), sums[size_t(i)], rays, backs[size_t(i)]);
+    finishGather(build_.grid, rayCount, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
+                 &build_.gridStats);
+    const IlluminationGridView& hv = build_.grid.view();
+    check(cudaMemcpy(const_cast<ShL1*>(gridView_.sh), hv.sh, size_t(n_) * sizeof(ShL1), cudaMemcpyHostToDevice),
+          "uploading the grid");
+    check(cudaMemcpy(const_cast<float*>(gridView_.weight), hv.weight, size_t(n_) * sizeof(float),
+                     cudaMemcpyHostToDevice),
+          "uploading the grid");
+  }
+
+  GridExecutorSettings s_;
+  GridBuild build_;
+  const SceneView* sceneView_ = nullptr;
+  BvhTracer tracer_;
+  IrradianceCacheView global_, caustic_;
+  IlluminationGridView gridView_;  // device pointers
+  int n_ = 0, done_ = 0, passes_ = 0;
+  ShL1* sums_ = nullptr;
+  int* backs_ = nullptr;
+  unsigned long long* rays_ = nullptr;
+  std::unique_ptr<CudaPassExecutor<GridSample<BvhTracer>>> camera_;
+};
+
 }  // namespace
 
 std::unique_ptr<PassExecutor> makeCudaGridExecutor(const Scene& scene, const Bvh& bvh, GridExecutorSettings s,
@@ -43,41 +124,7 @@ std::unique_ptr<PassExecutor> makeCudaGridExecutor(const Scene& scene, const Bvh
                                                    size_t* deviceBytes) {
   selectDevice(gpu);
   if (!s.photons.tracer) s.photons.tracer = makeCudaPhotonTracer(scene, bvh, gpu, s.photons.maxDepth);
-  GridBuild b;
-  b.grid = makeIlluminationGrid(scene, s.resolution);
-  shootPhotons(scene, s.photons, &b.global, &b.caustic, &b.photonStats);
-
-  auto t0 = std::chrono::steady_clock::now();
-  auto ds = std::make_unique<DeviceScene>(scene, bvh);
-  DeviceArena& a = ds->arena;
-  IrradianceCacheView global = uploadCache(a, b.global.irradianceCache());
-  IrradianceCacheView caustic = uploadCache(a, b.caustic.irradianceCache());
-  int n = int(b.grid.pointCount());
-  ShL1* sums = a.allocate<ShL1>(size_t(n), "grid gather sums");
-  int* backs = a.allocate<int>(size_t(n), "grid gather sums");
-  unsigned long long* rays = a.allocate<unsigned long long>(1, "counters");
-  check(cudaMemset(rays, 0, sizeof(unsigned long long)), "clearing counters");
-  gridGatherKernel<<<(n + kThreads - 1) / kThreads, kThreads>>>(ds->deviceView, BvhTracer{ds->bvh}, b.grid.view(),
-                                                                s.params.chain, global, caustic, s.seed, 0,
-                                                                s.gatherRays, n, sums, backs, rays);
-  check(cudaGetLastError(), "launching the grid gather kernel");
-  std::vector<ShL1> hostSums(static_cast<size_t>(n));
-  std::vector<int> hostBacks(static_cast<size_t>(n));
-  unsigned long long rayCount = 0;
-  check(cudaMemcpy(hostSums.data(), sums, size_t(n) * sizeof(ShL1), cudaMemcpyDeviceToHost), "filling the grid");
-  check(cudaMemcpy(hostBacks.data(), backs, size_t(n) * sizeof(int), cudaMemcpyDeviceToHost), "filling the grid");
-  check(cudaMemcpy(&rayCount, rays, sizeof(rayCount), cudaMemcpyDeviceToHost), "filling the grid");
-  for (int i = 0; i < n; ++i) b.grid.accumulate(size_t(i), hostSums[size_t(i)], s.gatherRays, hostBacks[size_t(i)]);
-  finishGather(b.grid, rayCount, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
-               &b.gridStats);
-  logGridBuild(b, s.gatherRays);
-
-  IlluminationGridView gv = b.grid.view();
-  gv.sh = a.upload(gv.sh, size_t(n), "illumination grid");
-  gv.weight = a.upload(gv.weight, size_t(n), "illumination grid");
-  GridSample<BvhTracer> sample{ds->deviceView, BvhTracer{ds->bvh}, gv, caustic, s.params};
-  auto ex = std::make_unique<CudaPassExecutor<GridSample<BvhTracer>>>(std::move(ds), sample, scene.view().camera, seq,
-                                                                      gpu, keepVariance);
+  auto ex = std::make_unique<CudaGridExecutor>(scene, bvh, s, seq, gpu, keepVariance);
   if (deviceBytes) *deviceBytes = ex->deviceBytes();
   return ex;
 }

@@ -68,18 +68,18 @@ ENVGI_HD Color gridGather(const SceneView& sc, const Tracer& tracer, Ray ray, Sa
 
 // Rays [first, first + rays) of grid point i at p: radiance gathered by gridGather, projected
 // on L1 SH (*sum, Monte Carlo over the sphere); *back counts rays whose first hit was a back
-// face. Each point has its own Sobol sequence, so rays cover the sphere evenly and later calls
-// refine the same estimate.
+// face. Each point has its own Sobol sequence of `length` rays (the most it will ever get), so
+// rays cover the sphere evenly and later calls refine the same estimate.
 template <class Tracer>
 ENVGI_HD void gridPointGather(const SceneView& sc, const Tracer& tracer, Vec3f p, uint64_t i, const ChainParams& cp,
                               const IrradianceCacheView& global, const IrradianceCacheView& caustic, uint32_t seed,
-                              int first, int rays, ShL1* sum, int* back, uint64_t* rayCount) {
+                              int first, int rays, int length, ShL1* sum, int* back, uint64_t* rayCount) {
   auto hitRadiance = [&](const SurfaceInteraction& si, Vec3f wi, Sampler& smp, uint64_t* r) {
     return gatherHitRadiance(sc, tracer, si, wi, smp, cp.strategy, global, caustic, r);
   };
   Sampler smp;
   smp.type = SamplerType::Sobol;
-  smp.spp = uint32_t(first + rays);
+  smp.spp = uint32_t(length);
   smp.seed = seed ^ kGridGatherStream;
   *sum = ShL1{};
   *back = 0;

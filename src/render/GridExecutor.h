@@ -1,7 +1,8 @@
 // The grid integrator's CPU driver: photon maps, then the illumination grid filled from them,
-// at construction; then camera passes (oneTBB over tiles) that read the grid. The tracer is
-// Embree, or the BVH the GPU traverses (to check the GPU's bodies on the CPU). The grid is not
-// refined while the passes run.
+// at construction; then camera passes (oneTBB over tiles) that read the grid, with refine_rays
+// more gather rays a point before each pass after the first, up to max_gather_rays (the paper's
+// grid "refined as the time budget allows"). The tracer is Embree, or the BVH the GPU
+// traverses (to check the GPU's bodies on the CPU).
 #pragma once
 
 #include <memory>
@@ -15,7 +16,8 @@ template <class Tracer>
 class GridExecutor final : public PassExecutor {
  public:
   GridExecutor(const Scene& scene, Tracer tracer, const GridExecutorSettings& s, SampleSequence seq, int threads,
-               bool keepVariance, int tileSize) {
+               bool keepVariance, int tileSize)
+      : scene_(scene), tracer_(tracer), settings_(s), rays_(s.gatherRays) {
     buildGridOnCpu(scene, tracer, s, &build_);
     GridSample<Tracer> sample{&scene.view(), tracer, build_.grid.view(), build_.caustic.irradianceCache().view(),
                               s.params};
@@ -24,13 +26,27 @@ class GridExecutor final : public PassExecutor {
   }
   std::string deviceName() const override { return "cpu"; }
   void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
+    if (passes_++ > 0) refine();
     camera_->runPass(s0, s1, progress, counters);
   }
   void readFilm(FilmSums* out) override { camera_->readFilm(out); }
   bool restart(const Camera& cam) override { return camera_->restart(cam); }
   const GridBuild& build() const { return build_; }
+  int gatherRaysDone() const { return rays_; }
 
  private:
+  void refine() {
+    int add = settings_.raysToAdd(rays_);
+    if (add <= 0) return;
+    gatherIntoGrid(build_.grid, scene_, tracer_, build_.global, build_.caustic, settings_, rays_, add,
+                   &build_.gridStats);
+    rays_ += add;
+  }
+
+  const Scene& scene_;
+  Tracer tracer_;
+  GridExecutorSettings settings_;
+  int rays_ = 0, passes_ = 0;
   GridBuild build_;
   std::unique_ptr<CpuExecutor<GridSample<Tracer>>> camera_;
 };

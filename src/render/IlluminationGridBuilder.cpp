@@ -25,7 +25,7 @@ IlluminationGrid makeIlluminationGrid(const Scene& scene, int resolution) {
 
 template <class Tracer>
 void gatherIntoGrid(IlluminationGrid& grid, const Scene& scene, const Tracer& tracer, const PhotonMap& global,
-                    const PhotonMap& caustic, const ChainParams& cp, uint32_t seed, int first, int rays,
+                    const PhotonMap& caustic, const GridExecutorSettings& s, int first, int rays,
                     GridBuildStats* stats) {
   auto t0 = std::chrono::steady_clock::now();
   const SceneView& sc = scene.view();
@@ -35,7 +35,8 @@ void gatherIntoGrid(IlluminationGrid& grid, const Scene& scene, const Tracer& tr
     ShL1 sum;
     int back = 0;
     uint64_t r = 0;
-    gridPointGather(sc, tracer, grid.point(i), i, cp, g, c, seed, first, rays, &sum, &back, &r);
+    gridPointGather(sc, tracer, grid.point(i), i, s.params.chain, g, c, s.seed, first, rays, s.sequenceLength(), &sum,
+                    &back, &r);
     grid.accumulate(i, sum, rays, back);
     rayCount += r;
   });
@@ -57,8 +58,7 @@ template <class Tracer>
 void buildGridOnCpu(const Scene& scene, const Tracer& tracer, const GridExecutorSettings& s, GridBuild* out) {
   out->grid = makeIlluminationGrid(scene, s.resolution);
   shootPhotons(scene, s.photons, &out->global, &out->caustic, &out->photonStats);
-  gatherIntoGrid(out->grid, scene, tracer, out->global, out->caustic, s.params.chain, s.seed, 0, s.gatherRays,
-                 &out->gridStats);
+  gatherIntoGrid(out->grid, scene, tracer, out->global, out->caustic, s, 0, s.gatherRays, &out->gridStats);
 }
 
 void logGridBuild(const GridBuild& b, int gatherRays) {
@@ -70,9 +70,9 @@ void logGridBuild(const GridBuild& b, int gatherRays) {
 }
 
 template void gatherIntoGrid(IlluminationGrid&, const Scene&, const EmbreeTracer&, const PhotonMap&, const PhotonMap&,
-                             const ChainParams&, uint32_t, int, int, GridBuildStats*);
+                             const GridExecutorSettings&, int, int, GridBuildStats*);
 template void gatherIntoGrid(IlluminationGrid&, const Scene&, const BvhTracer&, const PhotonMap&, const PhotonMap&,
-                             const ChainParams&, uint32_t, int, int, GridBuildStats*);
+                             const GridExecutorSettings&, int, int, GridBuildStats*);
 template void buildGridOnCpu(const Scene&, const EmbreeTracer&, const GridExecutorSettings&, GridBuild*);
 template void buildGridOnCpu(const Scene&, const BvhTracer&, const GridExecutorSettings&, GridBuild*);
 

@@ -4,6 +4,8 @@
 // GPU driver runs the same gridPointGather in a kernel and hands its sums to finishGather.
 #pragma once
 
+#include <algorithm>
+
 #include "accel/EmbreeAccel.h"
 #include "integrators/GridIntegrator.h"
 #include "photon/PhotonMap.h"
@@ -23,7 +25,13 @@ struct GridExecutorSettings {
   GridParams params;
   int resolution = 32;
   int gatherRays = 128;
+  int refineRays = 0;      // added before every camera pass after the first
+  int maxGatherRays = 128;
   uint32_t seed = 0;
+  // The length of each point's ray sequence: the most rays it will get.
+  int sequenceLength() const { return refineRays > 0 ? std::max(maxGatherRays, gatherRays) : gatherRays; }
+  // Rays to add before a camera pass, when the grid already has `done` a point.
+  int raysToAdd(int done) const { return refineRays > 0 ? std::max(0, std::min(refineRays, maxGatherRays - done)) : 0; }
 };
 
 // The photon maps and the grid, with how long each took.
@@ -37,11 +45,11 @@ struct GridBuild {
 // A grid over the scene's bounds with `resolution` points along its longest side.
 IlluminationGrid makeIlluminationGrid(const Scene& scene, int resolution);
 
-// Adds `rays` gather rays to every point (rays [first, first + rays) of each point's sequence,
-// so calls can refine a grid progressively) and re-averages it.
+// Adds `rays` gather rays to every point (rays [first, first + rays) of each point's sequence
+// of s.sequenceLength(), so calls refine a grid progressively) and re-averages it.
 template <class Tracer>
 void gatherIntoGrid(IlluminationGrid& grid, const Scene& scene, const Tracer& tracer, const PhotonMap& global,
-                    const PhotonMap& caustic, const ChainParams& cp, uint32_t seed, int first, int rays,
+                    const PhotonMap& caustic, const GridExecutorSettings& s, int first, int rays,
                     GridBuildStats* stats);
 
 // After every point got its gather sums (IlluminationGrid::accumulate): averages the grid and

@@ -101,6 +101,8 @@ GridExecutorSettings gridExecutorSettings(const Scene& scene, const RenderOption
   ge.params.chain = chainParams(scene, gs.maxDepth, gs.rrDepth, gs.hideEmitters);
   ge.resolution = gs.resolution;
   ge.gatherRays = gs.gatherRays;
+  ge.refineRays = gs.refineRays;
+  ge.maxGatherRays = gs.maxGatherRays;
   ge.seed = scene.sampler.seed;
   return ge;
 }

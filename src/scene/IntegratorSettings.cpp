@@ -1,5 +1,7 @@
 #include "scene/IntegratorSettings.h"
 
+#include <algorithm>
+
 #include "scene/NameTables.h"
 
 namespace envgi {
@@ -87,9 +89,13 @@ GridSettings GridSettings::fromProperties(Properties& p) {
   readPathProperties(p, &s.maxDepth, &s.rrDepth, &s.hideEmitters);
   s.resolution = p.getInt("resolution", s.resolution);
   s.gatherRays = p.getInt("gather_rays", s.gatherRays);
+  s.refineRays = p.getInt("refine_rays", s.refineRays);
+  s.maxGatherRays = p.getInt("max_gather_rays", std::max(s.maxGatherRays, s.gatherRays));
   int g = p.getInt("global_photons", int(s.globalPhotons)), c = p.getInt("caustic_photons", int(s.causticPhotons));
   if (s.resolution < 2 || s.resolution > 512) p.fail("resolution must be between 2 and 512");
   if (s.gatherRays < 1) p.fail("gather_rays must be positive");
+  if (s.refineRays < 0) p.fail("refine_rays must not be negative");
+  if (s.maxGatherRays < s.gatherRays) p.fail("max_gather_rays must be at least gather_rays");
   if (g < 0 || c < 0) p.fail("photon counts must not be negative");
   s.globalPhotons = size_t(g);
   s.causticPhotons = size_t(c);

@@ -74,7 +74,9 @@ struct SppmSettings {
 // point, then per pixel direct light plus the grid's interpolated indirect light.
 struct GridSettings {
   int resolution = 32;          // grid points along the scene's longest side (others in proportion)
-  int gatherRays = 128;         // rays from each grid point
+  int gatherRays = 128;         // rays from each grid point before the first camera pass
+  int refineRays = 0;           // rays added to each point before every later pass (0: none)
+  int maxGatherRays = 1024;     // refinement stops here
   size_t globalPhotons = 200000;
   size_t causticPhotons = 50000;
   int maxDepth = kSpecularChainDepth;

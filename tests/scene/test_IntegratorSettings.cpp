@@ -115,6 +115,10 @@ TEST(IntegratorSettings, RefusesBadValuesAtThePluginsLine) {
   EXPECT_EQ(errorOf(IntegratorType::Direct, with("emitter_samples", "integer", "-2")),
             "s.xml:2: sample counts must not be negative");
   EXPECT_EQ(errorOf(IntegratorType::Grid, with("gather_rays", "integer", "0")), "s.xml:2: gather_rays must be positive");
+  EXPECT_EQ(errorOf(IntegratorType::Grid, with("refine_rays", "integer", "-1")),
+            "s.xml:2: refine_rays must not be negative");
+  EXPECT_EQ(errorOf(IntegratorType::Grid, with("max_gather_rays", "integer", "64")),
+            "s.xml:2: max_gather_rays must be at least gather_rays");
   EXPECT_EQ(errorOf(IntegratorType::Path, with("point_method", "string", "kmeans")),
             "s.xml:2: unknown point_method 'kmeans' (sample, mediancut)");
 }
