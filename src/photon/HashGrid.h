@@ -70,6 +70,13 @@ ENVGI_INLINE void hashGridBucketStarts(const int* sortedKeys, int n, int tableSi
 
 class HashGrid {
  public:
+  // The view points into this object's arrays: moving keeps them valid, copying would not.
+  HashGrid() = default;
+  HashGrid(const HashGrid&) = delete;
+  HashGrid& operator=(const HashGrid&) = delete;
+  HashGrid(HashGrid&&) noexcept = default;
+  HashGrid& operator=(HashGrid&&) noexcept = default;
+
   // Points with valid[i] == false are left out. cellSize must be at least the search radius.
   void build(const std::vector<Vec3f>& points, const std::vector<char>& valid, float cellSize) {
     size_t n = 0;
