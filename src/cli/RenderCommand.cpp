@@ -13,7 +13,6 @@
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
 #include "gpu/CudaExecutor.h"
-#include "render/PhotonShooter.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
 #include "scene/NameTables.h"

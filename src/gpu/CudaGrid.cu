@@ -57,7 +57,6 @@ class CudaGridExecutor final : public PassExecutor {
     gridView_.sh = a.allocate<ShL1>(size_t(n_), "illumination grid");
     gridView_.weight = a.allocate<float>(size_t(n_), "illumination grid");
     gather(0, s.gatherRays);
-    done_ = s.gatherRays;
     logGridBuild(build_, s.gatherRays);
     GridSample<BvhTracer> sample{sceneView_, tracer_, gridView_, caustic_, s.params};
     camera_ = std::make_unique<CudaPassExecutor<GridSample<BvhTracer>>>(std::move(ds), sample, scene.view().camera,
@@ -67,9 +66,8 @@ class CudaGridExecutor final : public PassExecutor {
   std::string deviceName() const override { return camera_->deviceName(); }
   void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
     if (passes_++ > 0) {
-      int add = s_.raysToAdd(done_);
-      if (add > 0) gather(done_, add);
-      done_ += add;
+      int done = build_.grid.raysPerPoint(), add = s_.raysToAdd(done);
+      if (add > 0) gather(done, add);
     }
     camera_->runPass(s0, s1, progress, counters);
   }
@@ -110,7 +108,7 @@ class CudaGridExecutor final : public PassExecutor {
   BvhTracer tracer_;
   IrradianceCacheView global_, caustic_;
   IlluminationGridView gridView_;  // device pointers
-  int n_ = 0, done_ = 0, passes_ = 0;
+  int n_ = 0, passes_ = 0;
   ShL1* sums_ = nullptr;
   int* backs_ = nullptr;
   unsigned long long* rays_ = nullptr;

@@ -237,6 +237,7 @@ class CudaSppmExecutor final : public SppmPassExecutor {
 
 std::unique_ptr<PassExecutor> makeCudaSppmExecutor(const Scene& scene, const Bvh& bvh, const SppmParams& params,
                                                    const PhotonEmitter& emitter, int gpu, size_t* deviceBytes) {
+  checkSppmParams(params);  // before anything is uploaded
   selectDevice(gpu);
   auto ex = std::make_unique<CudaSppmExecutor>(scene, bvh, params, emitter, gpu);
   if (deviceBytes) *deviceBytes = ex->deviceBytes();

@@ -17,7 +17,7 @@ class GridExecutor final : public PassExecutor {
  public:
   GridExecutor(const Scene& scene, Tracer tracer, const GridExecutorSettings& s, SampleSequence seq, int threads,
                bool keepVariance, int tileSize)
-      : scene_(scene), tracer_(tracer), settings_(s), rays_(s.gatherRays) {
+      : scene_(scene), tracer_(tracer), settings_(s) {
     buildGridOnCpu(scene, tracer, s, &build_);
     GridSample<Tracer> sample{&scene.view(), tracer, build_.grid.view(), build_.caustic.irradianceCache().view(),
                               s.params};
@@ -32,21 +32,20 @@ class GridExecutor final : public PassExecutor {
   void readFilm(FilmSums* out) override { camera_->readFilm(out); }
   bool restart(const Camera& cam) override { return camera_->restart(cam); }
   const GridBuild& build() const { return build_; }
-  int gatherRaysDone() const { return rays_; }
+  int gatherRaysDone() const { return build_.grid.raysPerPoint(); }
 
  private:
   void refine() {
-    int add = settings_.raysToAdd(rays_);
-    if (add <= 0) return;
-    gatherIntoGrid(build_.grid, scene_, tracer_, build_.global, build_.caustic, settings_, rays_, add,
-                   &build_.gridStats);
-    rays_ += add;
+    int done = build_.grid.raysPerPoint(), add = settings_.raysToAdd(done);
+    if (add > 0)
+      gatherIntoGrid(build_.grid, scene_, tracer_, build_.global, build_.caustic, settings_, done, add,
+                     &build_.gridStats);
   }
 
   const Scene& scene_;
   Tracer tracer_;
   GridExecutorSettings settings_;
-  int rays_ = 0, passes_ = 0;
+  int passes_ = 0;
   GridBuild build_;
   std::unique_ptr<CpuExecutor<GridSample<Tracer>>> camera_;
 };

@@ -80,7 +80,6 @@ SppmParams sppmParams(const Scene& scene) {
   sp.maxDepth = ss.maxDepth;
   sp.seed = scene.sampler.seed;
   sp.strategy = findStrategy(scene.integrator.env.strategy).env;
-  checkSppmParams(sp);
   return sp;
 }
 
@@ -124,19 +123,42 @@ void logExecutorStats(const PassExecutor& ex) {
 
 namespace {
 
-PreparedRender prepareSppm(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
-  return {std::make_unique<SppmExecutor<EmbreeTracer>>(scene, EmbreeTracer{&accel}, sppmParams(scene), opts.threads),
-          sppmPasses(scene, opts)};
+// A CPU photon tracer over the same tracer as the camera passes.
+std::shared_ptr<PhotonBatchTracer> cpuPhotonTracer(const Scene& scene, const EmbreeTracer& t) {
+  return makeCpuPhotonTracer(scene, *t.accel);
+}
+std::shared_ptr<PhotonBatchTracer> cpuPhotonTracer(const Scene& scene, const BvhTracer& t) {
+  return makeCpuPhotonTracer(scene, t.bvh);
 }
 
-PreparedRender prepareGrid(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
-  GridExecutorSettings ge = gridExecutorSettings(scene, opts);
-  if (!ge.photons.tracer) ge.photons.tracer = makeCpuPhotonTracer(scene, accel);
-  auto ex = std::make_unique<GridExecutor<EmbreeTracer>>(scene, EmbreeTracer{&accel}, ge,
-                                                         sequenceOf(scene, samplesOf(scene, opts)), opts.threads,
-                                                         opts.varianceOut != nullptr, opts.tileSize);
-  logGridBuild(ex->build(), ge.gatherRays);
-  return {std::move(ex), samplesOf(scene, opts)};
+// The integrators whose every step is a template over the tracer (path, direct, sppm, grid), on
+// the CPU: with Embree, or with the GPU's BVH to check the GPU's bodies without a GPU.
+template <class Tracer>
+PreparedRender prepareOnTracer(const Scene& scene, const Tracer& tracer, const RenderOptions& opts, const char* name) {
+  switch (scene.integrator.type) {
+    case IntegratorType::Sppm:
+      return {std::make_unique<SppmExecutor<Tracer>>(scene, tracer, sppmParams(scene), opts.threads),
+              sppmPasses(scene, opts)};
+    case IntegratorType::Grid: {
+      GridExecutorSettings ge = gridExecutorSettings(scene, opts);
+      if (!ge.photons.tracer) ge.photons.tracer = cpuPhotonTracer(scene, tracer);
+      SequenceAndSpp q = gridSequence(scene, opts);
+      auto ex = std::make_unique<GridExecutor<Tracer>>(scene, tracer, ge, q.sequence, opts.threads,
+                                                       opts.varianceOut != nullptr, opts.tileSize);
+      logGridBuild(ex->build(), ge.gatherRays);
+      return {std::move(ex), q.spp};
+    }
+    case IntegratorType::Photon:
+      throw std::logic_error("the photon integrator's kd-tree lookups run with Embree only");
+    case IntegratorType::Path:
+    case IntegratorType::Direct: break;
+  }
+  KernelSettings k = kernelSettings(scene, opts);
+  const SceneView& sc = scene.view();
+  SampleIntegrator<Tracer> integ{k.type, k.path, k.direct, &sc, tracer};
+  return {std::make_unique<CpuExecutor<decltype(integ)>>(sc.camera, k.sequence, integ, opts.threads,
+                                                         opts.varianceOut != nullptr, name, opts.tileSize),
+          k.spp};
 }
 
 PreparedRender preparePhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
@@ -267,49 +289,20 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
 }
 
 PreparedRender prepareRender(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
-  switch (scene.integrator.type) {
-    case IntegratorType::Sppm: return prepareSppm(scene, accel, opts);
-    case IntegratorType::Photon: return preparePhoton(scene, accel, opts);
-    case IntegratorType::Grid: return prepareGrid(scene, accel, opts);
-    case IntegratorType::Path:
-    case IntegratorType::Direct: break;
-  }
-  KernelSettings k = kernelSettings(scene, opts);
-  const SceneView& sc = scene.view();
-  SampleIntegrator<EmbreeTracer> integ{k.type, k.path, k.direct, &sc, EmbreeTracer{&accel}};
-  return {std::make_unique<CpuExecutor<decltype(integ)>>(sc.camera, k.sequence, integ, opts.threads,
-                                                         opts.varianceOut != nullptr, "cpu", opts.tileSize),
-          k.spp};
+  if (scene.integrator.type == IntegratorType::Photon) return preparePhoton(scene, accel, opts);
+  return prepareOnTracer(scene, EmbreeTracer{&accel}, opts, "cpu");
 }
 
 Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts, RenderStats* stats) {
   const Camera& cam = scene.view().camera;
-  if (opts.cpuTracer == CpuTracer::Bvh && scene.integrator.type == IntegratorType::Grid) {
-    Bvh bvh(scene);
-    GridExecutorSettings ge = gridExecutorSettings(scene, opts);
-    if (!ge.photons.tracer) ge.photons.tracer = makeCpuPhotonTracer(scene, bvh.view());
-    SequenceAndSpp q = gridSequence(scene, opts);
-    GridExecutor<BvhTracer> ex(scene, BvhTracer{bvh.view()}, ge, q.sequence, opts.threads, opts.varianceOut != nullptr,
-                               opts.tileSize);
-    logGridBuild(ex.build(), ge.gatherRays);
-    return renderPasses(ex, cam.width, cam.height, q.spp, opts, stats);
+  std::unique_ptr<Bvh> bvh;  // outlives the executor that reads it
+  PreparedRender pr;
+  if (opts.cpuTracer == CpuTracer::Bvh && scene.integrator.type != IntegratorType::Photon) {
+    bvh = std::make_unique<Bvh>(scene);
+    pr = prepareOnTracer(scene, BvhTracer{bvh->view()}, opts, "cpu (envgi BVH)");
+  } else {
+    pr = prepareRender(scene, accel, opts);
   }
-  if (opts.cpuTracer == CpuTracer::Bvh && scene.integrator.type == IntegratorType::Sppm) {
-    Bvh bvh(scene);
-    SppmExecutor<BvhTracer> ex(scene, BvhTracer{bvh.view()}, sppmParams(scene), opts.threads);
-    Image img = renderPasses(ex, cam.width, cam.height, sppmPasses(scene, opts), opts, stats);
-    logExecutorStats(ex);
-    return img;
-  }
-  if (opts.cpuTracer == CpuTracer::Bvh && hasSampleKernel(scene.integrator.type)) {
-    KernelSettings k = kernelSettings(scene, opts);
-    Bvh bvh(scene);
-    SampleIntegrator<BvhTracer> integ{k.type, k.path, k.direct, &scene.view(), BvhTracer{bvh.view()}};
-    CpuExecutor<decltype(integ)> ex(cam, k.sequence, integ, opts.threads, opts.varianceOut != nullptr,
-                                    "cpu (envgi BVH)", opts.tileSize);
-    return renderPasses(ex, cam.width, cam.height, k.spp, opts, stats);
-  }
-  PreparedRender pr = prepareRender(scene, accel, opts);
   Image img = renderPasses(*pr.executor, cam.width, cam.height, pr.spp, opts, stats);
   logExecutorStats(*pr.executor);
   return img;

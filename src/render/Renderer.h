@@ -53,7 +53,8 @@ struct RenderStats {
 // throws for integrators that have no per-sample kernel (photon, sppm).
 KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts);
 
-// SPPM's options from the scene, checked, and the passes to run (opts.spp overrides).
+// SPPM's options from the scene (each SPPM driver checks them), and the passes to run
+// (opts.spp overrides).
 SppmParams sppmParams(const Scene& scene);
 int sppmPasses(const Scene& scene, const RenderOptions& opts);
 

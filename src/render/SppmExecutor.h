@@ -46,7 +46,4 @@ class SppmExecutor final : public SppmPassExecutor {
   SppmStats st_;
 };
 
-// Checks the options every SPPM driver shares; throws with the option's name.
-void checkSppmParams(const SppmParams& p);
-
 }  // namespace envgi

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "integrators/Sppm.h"
 #include "render/PassExecutor.h"
 
 namespace envgi {
@@ -16,6 +17,9 @@ struct SppmStats {
   size_t bytes = 0;
   float meanRadius = 0.f;
 };
+
+// Checks the options every SPPM driver takes; throws with the option's name.
+void checkSppmParams(const SppmParams& p);
 
 class SppmPassExecutor : public PassExecutor {
  public:

@@ -56,6 +56,13 @@ void loadBundled(const std::string& name, IntegratorType type, Scene* s) {
   s->integrator.type = type;
 }
 
+RenderOptions quietOptions(int spp) {
+  RenderOptions o;
+  o.progress = false;
+  o.spp = spp;
+  return o;
+}
+
 Image renderOnCpu(const Scene& s, const RenderOptions& o, RenderStats* st) {
   EmbreeAccel accel(s);
   return render(s, accel, o, st);
@@ -110,9 +117,7 @@ TEST(GpuRender, SppmMatchesTheCpuDriver) {
     loadBundled(name, IntegratorType::Sppm, &s);
     s.integrator.sppm.photonCount = 200000;
     s.finalize();
-    RenderOptions o;
-    o.progress = false;
-    o.spp = 16;
+    RenderOptions o = quietOptions(16);
     RenderStats cs, gs;
     Image cpu = renderOnCpu(s, o, &cs);
     Bvh bvh(s);
@@ -175,7 +180,9 @@ TEST(GpuRender, PhotonMapsMatchTheCpu) {
       }
       EXPECT_NEAR(totalB / total, 1.0, 0.005) << name << " " << what;
       for (size_t i = 0; i < a.size(); ++i)
-        if (a[i] > 0.01 * total) EXPECT_NEAR(b[i] / a[i], 1.0, 0.03) << name << " " << what << " cell " << i;
+        if (a[i] > 0.01 * total) {
+          EXPECT_NEAR(b[i] / a[i], 1.0, 0.03) << name << " " << what << " cell " << i;
+        }
     }
   }
 }
@@ -187,9 +194,7 @@ TEST(GpuRender, GridMatchesTheCpu) {
     Scene s;
     loadBundled(name, IntegratorType::Grid, &s);
     s.finalize();
-    RenderOptions o;
-    o.progress = false;
-    o.spp = 16;
+    RenderOptions o = quietOptions(16);
     RenderStats cs, gs;
     Image cpu = renderOnCpu(s, o, &cs);
     Bvh bvh(s);
