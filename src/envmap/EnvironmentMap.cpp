@@ -100,6 +100,8 @@ EnvironmentMap::EnvironmentMap(Image img, const EnvironmentMapOptions& opts, con
   std::vector<float> weight = samplingWeights(image_, opts.bilinear, opts.misCompensation);
   dist_ = PiecewiseConstant2D(weight.data(), image_.width, image_.height);
   alias_ = AliasTable(weight.data(), weight.size());
+  // A black map leaves the product strategy to Algorithm 1's (uniform) fallback.
+  if (dist_.integral() > 0.f) product_ = CosineProduct(weight.data(), image_.width, image_.height);
   // The quadtree baseline balances plain map power, never compensated power.
   std::vector<float> plain = opts.misCompensation ? samplingWeights(image_, opts.bilinear, false) : weight;
   adaptive_ = AdaptiveQuadtree(plain.data(), image_.width, image_.height, opts.adaptiveLeaves);
@@ -138,6 +140,7 @@ EnvironmentMapView EnvironmentMap::view() const {
   v.alias = alias_.view();
   v.emission = opts_.misCompensation ? emission_.view() : v.alias;
   v.adaptive = adaptive_.view();
+  v.product = product_.view();
   v.points = points_.empty() ? nullptr : points_.data();
   v.pointCount = int(points_.size());
   return v;

@@ -50,7 +50,7 @@ class EnvironmentMap {
   EnvironmentMapStats stats() const;
   // Luminance power, integral of Y(L) over the sphere (zero for an all-black map).
   float luminancePower() const;
-  size_t samplingBytes() const { return dist_.bytes() + alias_.bytes() + emission_.bytes(); }
+  size_t samplingBytes() const { return dist_.bytes() + alias_.bytes() + emission_.bytes() + product_.bytes(); }
 
   // The collapsed map that the `points` strategy uses (envmap/CollapsedMap.h makes one).
   // Fills each light's selection pmf and cdf (by luminance; uniform when all are black).
@@ -66,6 +66,7 @@ class EnvironmentMap {
   PiecewiseConstant2D dist_;
   AliasTable alias_;
   AliasTable emission_;  // plain luminance; built only when alias_ is compensated
+  CosineProduct product_;
   std::vector<DirectionalLight> points_;
   AdaptiveQuadtree adaptive_;
   size_t invalid_ = 0;

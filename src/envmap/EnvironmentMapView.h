@@ -10,6 +10,7 @@
 #include "core/Frame.h"
 #include "core/Transform.h"
 #include "envmap/AdaptiveQuadtree.h"
+#include "envmap/CosineProduct.h"
 #include "sampling/AliasTable.h"
 #include "sampling/PiecewiseConstant2D.h"
 #include "sampling/Warp.h"
@@ -23,6 +24,7 @@ enum class EnvStrategy : int {
   Alias = 3,       // the same density through an alias table
   Adaptive = 4,    // energy-balanced quadtree baseline
   Points = 5,      // the collapsed map: a fixed set of directional lights (biased)
+  Product = 6,     // Algorithm 1's density times a cosine bound about the normal (CosineProduct)
 };
 
 // One light of the collapsed map (the paper's Section 2): a direction and the irradiance it
@@ -55,6 +57,7 @@ struct EnvironmentMapView {
   // MIS compensation made dist and alias sample max(L - mean, 0), which misses dim directions.
   AliasTableView emission;
   AdaptiveQuadtreeView adaptive;
+  CosineProductView product;  // over the same weights as dist
   const DirectionalLight* points = nullptr;  // the collapsed map, when one was made
   int pointCount = 0;
 
@@ -132,10 +135,15 @@ struct EnvironmentMapView {
     return dist.pdf(uv) / (2.f * kPi * kPi * st);
   }
 
-  // Draws a direction; `normal` (world space) is used by the cosine strategy only.
+  // Draws a direction; `normal` (world space) is used by the cosine and product strategies
+  // only. A zero normal (a BSDF that also transmits) means the whole sphere: the cosine strategy
+  // then samples uniformly and the product strategy by Algorithm 1's density.
   ENVGI_HD EnvSample sample(EnvStrategy s, Vec2f u, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
     EnvSample out;
     Vec3f local;
+    bool wholeSphere = lengthSq(normal) == 0.f;
+    if (wholeSphere && s == EnvStrategy::Cosine) s = EnvStrategy::Uniform;
+    if (s == EnvStrategy::Product && (wholeSphere || !product.valid())) s = EnvStrategy::Importance;
     switch (s) {
       case EnvStrategy::Uniform: {
         local = sampleUniformSphere(u);
@@ -171,6 +179,14 @@ struct EnvironmentMapView {
         local = uvToDir(out.uv);
         break;
       }
+      case EnvStrategy::Product: {
+        float pdfUV;
+        if (!product.sample(u, toLocal(normal), dist.condFunc, &out.uv, &pdfUV)) return out;
+        local = uvToDir(out.uv);
+        float st = std::sin(kPi * out.uv.y);
+        out.pdf = st > 0.f ? pdfUV / (2.f * kPi * kPi * st) : 0.f;
+        break;
+      }
       case EnvStrategy::Points: {
         // One light chosen by its share of the irradiance: radiance / pmf estimates sum_i f E_i.
         if (pointCount == 0) return out;
@@ -195,6 +211,9 @@ struct EnvironmentMapView {
   }
 
   ENVGI_HD float pdf(EnvStrategy s, Vec3f worldDir, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
+    bool wholeSphere = lengthSq(normal) == 0.f;
+    if (wholeSphere && s == EnvStrategy::Cosine) s = EnvStrategy::Uniform;
+    if (s == EnvStrategy::Product && (wholeSphere || !product.valid())) s = EnvStrategy::Importance;
     switch (s) {
       case EnvStrategy::Uniform: return uniformSpherePdf();
       case EnvStrategy::Cosine: return cosineHemispherePdf(dot(normalize(worldDir), normal));
@@ -202,6 +221,11 @@ struct EnvironmentMapView {
       case EnvStrategy::Alias: return importancePdfUV(dirToUV(toLocal(worldDir)));
       case EnvStrategy::Adaptive: return adaptive.pdf(dirToUV(toLocal(worldDir)));
       case EnvStrategy::Points: return 0.f;  // no direction drawn by BSDF sampling hits a point
+      case EnvStrategy::Product: {
+        Vec2f uv = dirToUV(toLocal(worldDir));
+        float st = std::sin(kPi * uv.y);
+        return st > 0.f ? product.pdf(uv, toLocal(normal), dist.condFunc) / (2.f * kPi * kPi * st) : 0.f;
+      }
     }
     return 0.f;
   }

@@ -17,6 +17,16 @@ EnvironmentMapView uploadEnvironment(DeviceArena& a, EnvironmentMapView v) {
   v.adaptive.leafNodes = a.upload(v.adaptive.leafNodes, size_t(v.adaptive.leafCount), "adaptive quadtree");
   v.points = a.upload(v.points, size_t(v.pointCount), "collapsed map");
   v.adaptive.leafSolidAngle = a.upload(v.adaptive.leafSolidAngle, size_t(v.adaptive.leafCount), "adaptive quadtree");
+  if (v.product.valid()) {
+    CosineProductView& p = v.product;
+    size_t cells = size_t(p.cells()), buckets = size_t(p.bucketsPerSide) * p.bucketsPerSide;
+    p.bucketFunc = a.upload(p.bucketFunc, buckets * cells, "cosine product tables");
+    p.bucketCdf = a.upload(p.bucketCdf, buckets * (cells + 1), "cosine product tables");
+    p.bucketInt = a.upload(p.bucketInt, buckets, "cosine product tables");
+    p.cellCdf = a.upload(p.cellCdf, px + cells, "cosine product tables");
+    p.cellCdfStart = a.upload(p.cellCdfStart, cells, "cosine product tables");
+    p.cellSum = a.upload(p.cellSum, cells, "cosine product tables");
+  }
   return v;
 }
 

@@ -25,7 +25,7 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
   Color L(0.f);
   const Bsdf& bsdf = sc.bsdfs[si.bsdf];
   Vec3f woLocal = si.shading.toLocal(wo);
-  Vec3f axis = cosineAxis(si, wo);
+  Vec3f axis = envSamplingAxis(si, wo, bsdf);
   float nE = float(emitterSamples), nB = float(bsdfSamples);
 
   for (int i = 0; i < emitterSamples; ++i)

@@ -49,7 +49,7 @@ ENVGI_HD Color pathTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sam
     if (pp.maxDepth >= 0 && depth >= pp.maxDepth) break;
     const Bsdf& bsdf = sc.bsdfs[si.bsdf];
     Vec3f woLocal = si.shading.toLocal(wo);
-    Vec3f axis = cosineAxis(si, wo);
+    Vec3f axis = envSamplingAxis(si, wo, bsdf);
 
     // Next-event estimation, weighted against this bounce's BSDF sample.
     L += beta * sampleLd(sc, tracer, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, rayCount);

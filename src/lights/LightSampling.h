@@ -15,8 +15,11 @@ struct LightSample {
   bool delta = false;   // a collapsed-map light: no MIS, BSDF sampling cannot find it
 };
 
-// The cosine strategy samples about the normal on the side the viewer is on.
-ENVGI_INLINE Vec3f cosineAxis(const SurfaceInteraction& si, Vec3f wo) {
+// The cosine and product strategies sample about the shading normal on the side the viewer is
+// on, where a reflecting BSDF is non-zero; a BSDF that transmits gets the zero axis, which
+// those strategies read as the whole sphere.
+ENVGI_INLINE Vec3f envSamplingAxis(const SurfaceInteraction& si, Vec3f wo, const Bsdf& bsdf) {
+  if (bsdfTransmits(bsdf)) return Vec3f(0.f);
   return dot(si.shading.n, wo) >= 0.f ? si.shading.n : -si.shading.n;
 }
 

@@ -13,8 +13,8 @@ using namespace envgi;
 namespace {
 
 constexpr int kSamples = 1000000;
-// 5 strategies x 5 maps (+ compensation), Sidak-corrected to a family-wise 0.01.
-const double kAlpha = test::sidakAlpha(30);
+// 6 strategies x 5 maps (+ compensation), Sidak-corrected to a family-wise 0.01.
+const double kAlpha = test::sidakAlpha(35);
 
 Image sunMap() {
   Image img(128, 64);
@@ -45,7 +45,7 @@ struct Case {
 void PrintTo(const Case& c, std::ostream* os) { *os << c.map << " strategy " << int(c.strategy); }
 
 std::string caseName(const ::testing::TestParamInfo<Case>& info) {
-  static const char* names[] = {"Uniform", "Cosine", "Importance", "Alias", "Adaptive"};
+  static const char* names[] = {"Uniform", "Cosine", "Importance", "Alias", "Adaptive", "Points", "Product"};
   return info.param.map + names[int(info.param.strategy)] + (info.param.compensation ? "Compensated" : "");
 }
 
@@ -99,7 +99,7 @@ std::vector<Case> cases() {
   std::vector<Case> out;
   for (std::string m : {"Grace", "Sun", "Constant", "Black", "Nearest"})
     for (EnvStrategy s : {EnvStrategy::Uniform, EnvStrategy::Cosine, EnvStrategy::Importance, EnvStrategy::Alias,
-                          EnvStrategy::Adaptive}) {
+                          EnvStrategy::Adaptive, EnvStrategy::Product}) {
       if ((m == "Constant" || m == "Black" || m == "Nearest") && (s == EnvStrategy::Uniform || s == EnvStrategy::Cosine))
         continue;  // map-independent strategies are covered on the other maps
       out.push_back({m, s, false});

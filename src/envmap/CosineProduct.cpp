@@ -1,0 +1,133 @@
+#include "envmap/CosineProduct.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace envgi {
+
+namespace {
+
+struct Dir {
+  double x, y, z;
+};
+
+// The map's convention (EnvironmentMapView::uvToDir), in double for the bounds.
+Dir uvDir(double u, double v) {
+  double phi = 2.0 * M_PI * u, theta = M_PI * v, st = std::sin(theta);
+  return {st * std::sin(phi), std::cos(theta), -st * std::cos(phi)};
+}
+
+double angleBetween(const Dir& a, const Dir& b) {
+  double d = a.x * b.x + a.y * b.y + a.z * b.z;
+  return std::acos(std::clamp(d, -1.0, 1.0));
+}
+
+Dir toDir(Vec3f v) { return {v.x, v.y, v.z}; }
+
+// Centre and angular radius of a region sampled on a (k+1) x (k+1) grid of its parameters,
+// widened by a margin so that the cap holds the edges between the grid points too.
+template <class F>
+void boundingCap(F at, Dir centre, double* radius) {
+  const int k = 8;
+  double r = 0.0;
+  for (int j = 0; j <= k; ++j)
+    for (int i = 0; i <= k; ++i) r = std::max(r, angleBetween(centre, at(double(i) / k, double(j) / k)));
+  *radius = r * 1.05 + 1e-3;
+}
+
+}  // namespace
+
+CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, int cellsY, int bucketsPerSide)
+    : width_(width), height_(height), cellsX_(std::min(cellsX, width)), cellsY_(std::min(cellsY, height)),
+      buckets_(bucketsPerSide) {
+  if (width <= 0 || height <= 0 || cellsX <= 0 || cellsY <= 0 || bucketsPerSide <= 0)
+    throw std::runtime_error("cosine product: empty map or grid");
+  CosineProductView v;
+  v.width = width_;
+  v.height = height_;
+  v.cellsX = cellsX_;
+  v.cellsY = cellsY_;
+  const int cells = cellsX_ * cellsY_;
+
+  // Per cell: the cdf of its pixels' weights and their sum; its bounding cap on the sphere.
+  cellCdfStart_.resize(size_t(cells));
+  cellSum_.resize(size_t(cells));
+  std::vector<Dir> cellCentre(static_cast<size_t>(cells));
+  std::vector<double> cellRadius(static_cast<size_t>(cells));
+  std::vector<float> f;
+  for (int cy = 0; cy < cellsY_; ++cy)
+    for (int cx = 0; cx < cellsX_; ++cx) {
+      int c = cy * cellsX_ + cx;
+      int x0 = v.cellX0(cx), x1 = v.cellX0(cx + 1), y0 = v.cellY0(cy), y1 = v.cellY0(cy + 1);
+      f.clear();
+      double sum = 0.0;
+      for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+          f.push_back(w[size_t(y) * width + x]);
+          sum += f.back();
+        }
+      cellCdfStart_[size_t(c)] = int(cellCdf_.size());
+      cellCdf_.resize(cellCdf_.size() + f.size() + 1);
+      std::vector<float> func(f.size());
+      float integral;
+      PiecewiseConstant1D::build(f.data(), int(f.size()), func.data(), cellCdf_.data() + cellCdfStart_[size_t(c)],
+                                 &integral);
+      cellSum_[size_t(c)] = float(sum);
+      double u0 = double(x0) / width, u1 = double(x1) / width, v0 = double(y0) / height, v1 = double(y1) / height;
+      auto at = [&](double s, double t) { return uvDir(u0 + s * (u1 - u0), v0 + t * (v1 - v0)); };
+      cellCentre[size_t(c)] = at(0.5, 0.5);
+      boundingCap(at, cellCentre[size_t(c)], &cellRadius[size_t(c)]);
+    }
+
+  // Per bucket of normals: cell power times the largest cosine any of its normals can have
+  // with any direction in the cell (zero only where the whole cell is below every normal).
+  const int buckets = buckets_ * buckets_;
+  bucketFunc_.resize(size_t(buckets) * cells);
+  bucketCdf_.resize(size_t(buckets) * (cells + 1));
+  bucketInt_.resize(size_t(buckets));
+  std::vector<float> weights(static_cast<size_t>(cells));
+  for (int by = 0; by < buckets_; ++by)
+    for (int bx = 0; bx < buckets_; ++bx) {
+      int k = by * buckets_ + bx;
+      double s0 = double(bx) / buckets_, t0 = double(by) / buckets_, step = 1.0 / buckets_;
+      auto at = [&](double s, double t) {
+        return toDir(octahedralDecode(Vec2f(float(s0 + s * step), float(t0 + t * step))));
+      };
+      Dir n = at(0.5, 0.5);
+      double delta;
+      boundingCap(at, n, &delta);
+      for (int c = 0; c < cells; ++c) {
+        double gap = angleBetween(n, cellCentre[size_t(c)]) - cellRadius[size_t(c)] - delta;
+        double g = gap <= 0.0 ? 1.0 : (gap < M_PI / 2 ? std::cos(gap) : 0.0);
+        weights[size_t(c)] = float(double(cellSum_[size_t(c)]) * g);
+      }
+      PiecewiseConstant1D::build(weights.data(), cells, bucketFunc_.data() + size_t(k) * cells,
+                                 bucketCdf_.data() + size_t(k) * (cells + 1), &bucketInt_[size_t(k)]);
+    }
+}
+
+CosineProductView CosineProduct::view() const {
+  CosineProductView v;
+  if (buckets_ == 0) return v;
+  v.bucketFunc = bucketFunc_.data();
+  v.bucketCdf = bucketCdf_.data();
+  v.bucketInt = bucketInt_.data();
+  v.cellCdf = cellCdf_.data();
+  v.cellCdfStart = cellCdfStart_.data();
+  v.cellSum = cellSum_.data();
+  v.width = width_;
+  v.height = height_;
+  v.cellsX = cellsX_;
+  v.cellsY = cellsY_;
+  v.bucketsPerSide = buckets_;
+  return v;
+}
+
+size_t CosineProduct::bytes() const {
+  return sizeof(float) * (bucketFunc_.size() + bucketCdf_.size() + bucketInt_.size() + cellCdf_.size() +
+                          cellSum_.size()) +
+         sizeof(int) * cellCdfStart_.size();
+}
+
+}  // namespace envgi

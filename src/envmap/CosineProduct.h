@@ -1,0 +1,129 @@
+// The map's density times a bound on the clamped cosine about a surface normal: the `product`
+// strategy. Next-event estimation with Algorithm 1's density sends about half its samples
+// below the surface (where a reflecting BSDF is zero); this one samples in proportion to
+// L(w) g(n, w), with g >= max(0, n.w) over each cell of the map and each bucket of normals,
+// so that every direction the BSDF can use keeps a non-zero density.
+//
+// Two levels: normals fall into an octahedral grid of buckets, and each bucket holds a 1D
+// distribution over coarse cells of the map (cell power times g); within a cell a pixel is
+// drawn by the map's own per-pixel weights (luminance x sin theta, the same as Algorithm 1's),
+// and a point inside the pixel uniformly.
+#pragma once
+
+#include <vector>
+
+#include "core/Vec.h"
+#include "sampling/PiecewiseConstant1D.h"
+
+namespace envgi {
+
+// Octahedral mapping of a unit vector to [0,1)^2 (Meyer et al. 2010), for bucketing normals.
+ENVGI_INLINE Vec2f octahedralEncode(Vec3f n) {
+  float s = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
+  float px = n.x / s, py = n.y / s;
+  if (n.z < 0.f) {
+    float ox = (1.f - std::fabs(py)) * (px >= 0.f ? 1.f : -1.f);
+    float oy = (1.f - std::fabs(px)) * (py >= 0.f ? 1.f : -1.f);
+    px = ox;
+    py = oy;
+  }
+  return {px * 0.5f + 0.5f, py * 0.5f + 0.5f};
+}
+
+ENVGI_INLINE Vec3f octahedralDecode(Vec2f uv) {
+  float px = uv.x * 2.f - 1.f, py = uv.y * 2.f - 1.f;
+  float z = 1.f - std::fabs(px) - std::fabs(py);
+  if (z < 0.f) {
+    float ox = (1.f - std::fabs(py)) * (px >= 0.f ? 1.f : -1.f);
+    float oy = (1.f - std::fabs(px)) * (py >= 0.f ? 1.f : -1.f);
+    px = ox;
+    py = oy;
+  }
+  return normalize(Vec3f(px, py, z));
+}
+
+struct CosineProductView {
+  const float* bucketFunc = nullptr;  // buckets x cells: cell power times the cosine bound
+  const float* bucketCdf = nullptr;   // buckets x (cells + 1)
+  const float* bucketInt = nullptr;   // buckets: the mean of each bucket's row of bucketFunc
+  const float* cellCdf = nullptr;     // each cell's pixels (row-major inside the cell): pixels + 1 values
+  const int* cellCdfStart = nullptr;  // cells: where a cell's cdf begins in cellCdf
+  const float* cellSum = nullptr;     // cells: the sum of the pixel weights inside each cell
+  int width = 0, height = 0;          // the map's pixels
+  int cellsX = 0, cellsY = 0;
+  int bucketsPerSide = 0;             // buckets = bucketsPerSide^2
+
+  ENVGI_HD bool valid() const { return bucketsPerSide > 0; }
+  ENVGI_HD int cells() const { return cellsX * cellsY; }
+  ENVGI_HD int bucket(Vec3f nLocal) const {
+    Vec2f o = octahedralEncode(nLocal);
+    int bx = clampi(int(o.x * float(bucketsPerSide)), 0, bucketsPerSide - 1);
+    int by = clampi(int(o.y * float(bucketsPerSide)), 0, bucketsPerSide - 1);
+    return by * bucketsPerSide + bx;
+  }
+  // Cell i spans pixels [i W / cellsX, (i + 1) W / cellsX) across, likewise down.
+  ENVGI_HD int cellX0(int cx) const { return int((long long)cx * width / cellsX); }
+  ENVGI_HD int cellY0(int cy) const { return int((long long)cy * height / cellsY); }
+  ENVGI_HD int cellOfPixel(int px, int py) const {
+    int cx = int(((long long)(px + 1) * cellsX - 1) / width);
+    int cy = int(((long long)(py + 1) * cellsY - 1) / height);
+    return cy * cellsX + cx;
+  }
+
+  // Density in (u, v) of drawing pixel (px, py) for a normal in bucket k; pixelWeight is that
+  // pixel's entry in the map's weights.
+  ENVGI_HD float pdfUV(int k, int px, int py, float pixelWeight) const {
+    int n = cells(), c = cellOfPixel(px, py);
+    float total = bucketInt[k] * float(n), sum = cellSum[c];
+    if (!(total > 0.f) || !(sum > 0.f)) return 0.f;
+    return bucketFunc[size_t(k) * n + c] / total * (pixelWeight / sum) * float(width) * float(height);
+  }
+
+  // Draws (u, v) for a normal in the map's frame; false where the bucket sees no light.
+  // pixelWeights: the map's per-pixel weights, width x height.
+  ENVGI_HD bool sample(Vec2f u, Vec3f nLocal, const float* pixelWeights, Vec2f* uv, float* pdfOut) const {
+    int k = bucket(nLocal), n = cells();
+    if (!(bucketInt[k] > 0.f)) return false;
+    const float* cdf = bucketCdf + size_t(k) * (n + 1);
+    int c = findInterval(cdf, n + 1, u.x);
+    float w1 = cdf[c + 1] - cdf[c];
+    float r1 = w1 > 0.f ? (u.x - cdf[c]) / w1 : 0.5f;
+    int cx = c % cellsX, cy = c / cellsX;
+    int x0 = cellX0(cx), x1 = cellX0(cx + 1), y0 = cellY0(cy), y1 = cellY0(cy + 1);
+    int cw = x1 - x0, pixels = cw * (y1 - y0);
+    const float* pc = cellCdf + cellCdfStart[c];
+    int j = findInterval(pc, pixels + 1, u.y);
+    float w2 = pc[j + 1] - pc[j];
+    float r2 = w2 > 0.f ? (u.y - pc[j]) / w2 : 0.5f;
+    int px = x0 + j % cw, py = y0 + j / cw;
+    r1 = r1 < kOneMinusEpsilon ? r1 : kOneMinusEpsilon;
+    r2 = r2 < kOneMinusEpsilon ? r2 : kOneMinusEpsilon;
+    float fx = (float(px) + r1) / float(width), fy = (float(py) + r2) / float(height);
+    *uv = {fx < kOneMinusEpsilon ? fx : kOneMinusEpsilon, fy < kOneMinusEpsilon ? fy : kOneMinusEpsilon};
+    *pdfOut = pdfUV(k, px, py, pixelWeights[size_t(py) * width + px]);
+    return *pdfOut > 0.f;
+  }
+
+  ENVGI_HD float pdf(Vec2f uv, Vec3f nLocal, const float* pixelWeights) const {
+    int px = clampi(int(uv.x * float(width)), 0, width - 1), py = clampi(int(uv.y * float(height)), 0, height - 1);
+    return pdfUV(bucket(nLocal), px, py, pixelWeights[size_t(py) * width + px]);
+  }
+};
+
+class CosineProduct {
+ public:
+  CosineProduct() = default;
+  // pixelWeights: width x height, the map's sampling weights (luminance x sin theta).
+  CosineProduct(const float* pixelWeights, int width, int height, int cellsX = 64, int cellsY = 32,
+                int bucketsPerSide = 16);
+
+  CosineProductView view() const;
+  size_t bytes() const;
+
+ private:
+  std::vector<float> bucketFunc_, bucketCdf_, bucketInt_, cellCdf_, cellSum_;
+  std::vector<int> cellCdfStart_;
+  int width_ = 0, height_ = 0, cellsX_ = 0, cellsY_ = 0, buckets_ = 0;
+};
+
+}  // namespace envgi

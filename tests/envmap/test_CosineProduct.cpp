@@ -1,0 +1,140 @@
+// The product strategy: its cosine bound really bounds the cosine (so no direction a reflecting
+// BSDF can use is left without density), and it pays: lower variance than Algorithm 1's density
+// for irradiance, with the same mean. The chi-square and pdf checks are in
+// test_EnvironmentSampling.cpp with the other strategies.
+#include <gtest/gtest.h>
+
+#include "envmap/EnvironmentMap.h"
+#include "sampling/Pcg32.h"
+#include "sampling/Warp.h"
+
+using namespace envgi;
+
+namespace {
+
+Image skyWithSun(int w, int h) {
+  Image img(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) img.set(x, y, Color(y < h / 2 ? 0.8f : 0.1f, 0.5f, 0.4f));
+  img.set(w / 3, h / 5, Color(3000.f));  // a sun above the horizon
+  img.set(w / 2, h * 3 / 4, Color(800.f));  // and a bright spot below it
+  return img;
+}
+
+}  // namespace
+
+TEST(CosineProduct, OctahedralMappingRoundTrips) {
+  Pcg32 rng(3);
+  for (int i = 0; i < 10000; ++i) {
+    Vec3f n = sampleUniformSphere(Vec2f(rng.nextFloat(), rng.nextFloat()));
+    Vec2f o = octahedralEncode(n);
+    ASSERT_GE(o.x, 0.f);
+    ASSERT_LE(o.x, 1.f);
+    ASSERT_GE(o.y, 0.f);
+    ASSERT_LE(o.y, 1.f);
+    Vec3f back = octahedralDecode(o);
+    ASSERT_NEAR(dot(n, back), 1.f, 1e-5f) << i;
+  }
+}
+
+// g(bucket, cell) >= n.w for every normal n in the bucket and direction w in the cell: checked
+// on random pairs, on a map whose every cell holds light.
+TEST(CosineProduct, BoundIsAtLeastTheCosine) {
+  Image img(256, 128);
+  std::fill(img.rgb.begin(), img.rgb.end(), 1.f);
+  EnvironmentMap env(img, {});
+  EnvironmentMapView v = env.view();
+  const CosineProductView& p = v.product;
+  ASSERT_TRUE(p.valid());
+  Pcg32 rng(11);
+  int violations = 0, tight = 0;
+  const int n = 200000;
+  for (int i = 0; i < n; ++i) {
+    Vec3f nl = sampleUniformSphere(Vec2f(rng.nextFloat(), rng.nextFloat()));
+    Vec2f uv(rng.nextFloat(), rng.nextFloat());
+    Vec3f w = EnvironmentMapView::uvToDir(uv);
+    int px = clampi(int(uv.x * p.width), 0, p.width - 1), py = clampi(int(uv.y * p.height), 0, p.height - 1);
+    int k = p.bucket(nl), c = p.cellOfPixel(px, py);
+    ASSERT_GT(p.cellSum[c], 0.f);
+    float g = p.bucketFunc[size_t(k) * p.cells() + c] / p.cellSum[c];
+    float cosine = dot(nl, w);
+    if (g < cosine - 1e-5f) ++violations;
+    if (cosine > 0.f && g < cosine + 0.5f) ++tight;
+  }
+  EXPECT_EQ(violations, 0);
+  // ... and it is a useful bound, not 1 everywhere: most pairs above the horizon sit within 0.5.
+  EXPECT_GT(tight, n / 2 * 9 / 10);
+}
+
+// Each cell's pixel cdf ends at 1, and cellOfPixel inverts the cells' pixel ranges, also for a
+// map whose size is not a multiple of the cell grid.
+TEST(CosineProduct, CellsPartitionAnOddSizedMap) {
+  Image img(101, 47);
+  for (int y = 0; y < 47; ++y)
+    for (int x = 0; x < 101; ++x) img.set(x, y, Color(1.f + float((x * 7 + y * 3) % 5)));
+  EnvironmentMap env(img, {});
+  const CosineProductView& p = env.view().product;
+  ASSERT_TRUE(p.valid());
+  std::vector<int> seen(size_t(p.cells()), 0);
+  for (int cy = 0; cy < p.cellsY; ++cy)
+    for (int cx = 0; cx < p.cellsX; ++cx)
+      for (int y = p.cellY0(cy); y < p.cellY0(cy + 1); ++y)
+        for (int x = p.cellX0(cx); x < p.cellX0(cx + 1); ++x) {
+          ASSERT_EQ(p.cellOfPixel(x, y), cy * p.cellsX + cx) << x << "," << y;
+          ++seen[size_t(cy * p.cellsX + cx)];
+        }
+  int total = 0;
+  for (int c = 0; c < p.cells(); ++c) {
+    ASSERT_GT(seen[size_t(c)], 0);
+    total += seen[size_t(c)];
+    EXPECT_FLOAT_EQ(p.cellCdf[p.cellCdfStart[c] + seen[size_t(c)]], 1.f);
+  }
+  EXPECT_EQ(total, 101 * 47);
+}
+
+// Irradiance E(n) = integral of L max(0, n.w): the product strategy's estimate has the same
+// mean as Algorithm 1's, and less than 0.6 of its variance, for normals all round the sphere
+// (measured: 0.15 to 0.53; the sun's own share of the variance is what neither removes).
+TEST(CosineProduct, IrradianceUnbiasedWithLessVariance) {
+  EnvironmentMapOptions o;
+  o.toWorld = rotate(Vec3f(0.3f, 1.f, 0.2f), 25.f);
+  EnvironmentMap env(skyWithSun(128, 64), o);
+  EnvironmentMapView v = env.view();
+  const Vec3f normals[] = {Vec3f(0, 1, 0), Vec3f(0, -1, 0), normalize(Vec3f(1, 0.2f, 0.3f)),
+                           normalize(Vec3f(-0.4f, -0.3f, 0.8f))};
+  for (Vec3f n : normals) {
+    double mean[2], var[2];
+    int s = 0;
+    for (EnvStrategy strategy : {EnvStrategy::Importance, EnvStrategy::Product}) {
+      Pcg32 rng(21);
+      const int count = 200000;
+      double sum = 0.0, sum2 = 0.0;
+      for (int i = 0; i < count; ++i) {
+        EnvSample es = v.sample(strategy, Vec2f(rng.nextFloat(), rng.nextFloat()), n);
+        double f = es.pdf > 0.f ? luminance(es.radiance) * std::max(0.f, dot(n, es.dir)) / es.pdf : 0.0;
+        sum += f;
+        sum2 += f * f;
+      }
+      mean[s] = sum / count;
+      var[s] = std::max(0.0, sum2 / count - mean[s] * mean[s]);
+      ++s;
+    }
+    double se = std::sqrt((var[0] + var[1]) / 200000.0);
+    EXPECT_NEAR(mean[1], mean[0], 5.0 * se) << "normal " << n.x << "," << n.y << "," << n.z;
+    EXPECT_LT(var[1], 0.6 * var[0]) << "normal " << n.x << "," << n.y << "," << n.z;
+  }
+}
+
+// A zero axis (a BSDF that transmits) gets Algorithm 1's density over the whole sphere.
+TEST(CosineProduct, ZeroAxisIsTheWholeSphere) {
+  EnvironmentMap env(skyWithSun(64, 32), {});
+  EnvironmentMapView v = env.view();
+  Pcg32 rng(5);
+  for (int i = 0; i < 1000; ++i) {
+    Vec2f u(rng.nextFloat(), rng.nextFloat());
+    EnvSample a = v.sample(EnvStrategy::Product, u, Vec3f(0.f)), b = v.sample(EnvStrategy::Importance, u);
+    ASSERT_EQ(a.uv.x, b.uv.x);
+    ASSERT_EQ(a.uv.y, b.uv.y);
+    ASSERT_EQ(v.pdf(EnvStrategy::Product, a.dir, Vec3f(0.f)), v.pdf(EnvStrategy::Importance, a.dir));
+  }
+}
