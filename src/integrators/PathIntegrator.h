@@ -15,7 +15,7 @@ struct PathParams {
   int maxDepth = -1;
   int rrDepth = kRouletteDepth;
   bool hideEmitters = false;
-  EnvStrategy envStrategy = EnvStrategy::Importance;
+  EnvStrategy envStrategy = EnvStrategy::Product;
 };
 
 template <class Tracer>

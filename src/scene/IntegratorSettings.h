@@ -23,7 +23,7 @@ inline constexpr int kMaxPhotonLookup = 512;
 
 // How light samples draw the environment; shared by every integrator.
 struct EnvSamplingSettings {
-  std::string strategy = "mis";        // a name from kStrategyNames
+  std::string strategy = "product";    // a name from kStrategyNames
   int pointCount = 64;                 // points: lights in the collapsed map
   std::string pointMethod = "sample";  // points: sample (Algorithm 1 draws) | mediancut
   static EnvSamplingSettings fromProperties(Properties& p);

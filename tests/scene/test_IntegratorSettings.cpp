@@ -62,7 +62,8 @@ TEST(IntegratorSettings, KernelDefaultsAgreeWithSettings) {
   IntegratorSettings path = IntegratorSettings::fromProperties(IntegratorType::Path, none);
   EXPECT_EQ(path.path.maxDepth, PathParams{}.maxDepth);
   EXPECT_EQ(path.path.rrDepth, PathParams{}.rrDepth);
-  EXPECT_EQ(path.env.strategy, "mis");
+  EXPECT_EQ(path.env.strategy, "product");
+  EXPECT_EQ(findStrategy(path.env.strategy).env, PathParams{}.envStrategy);
   IntegratorSettings photon = IntegratorSettings::fromProperties(IntegratorType::Photon, none);
   EXPECT_EQ(photon.photon.gatherSamples, PhotonRenderParams{}.gatherSamples);
   EXPECT_EQ(photon.photon.maxDepth, PhotonRenderParams{}.chain.maxDepth);

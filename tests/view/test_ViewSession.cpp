@@ -180,17 +180,17 @@ TEST(ViewSession, SwitchingBackReusesThePreparedIntegrator) {
     }
     ADD_FAILURE() << "no frame from " << integrator;
   };
-  showing("path", "mis");
+  showing("path", "product");
   int base = session->preparations();
   session->handle(R"({"type":"integrator","value":"grid"})");
-  showing("grid", "mis");
+  showing("grid", "product");
   EXPECT_EQ(session->preparations(), base + 1);
   for (int i = 0; i < 2; ++i) {
     session->handle(R"({"type":"integrator","value":"path"})");
     session->handle(R"({"type":"camera","origin":[0,1.5,4],"target":[0,0,0],"up":[0,1,0]})");
-    showing("path", "mis");
+    showing("path", "product");
     session->handle(R"({"type":"integrator","value":"grid"})");
-    showing("grid", "mis");
+    showing("grid", "product");
   }
   EXPECT_EQ(session->preparations(), base + 1) << "path and grid were both kept";
   session->handle(R"({"type":"strategy","value":"importance"})");
