@@ -90,7 +90,9 @@ struct EnvironmentMapView {
     float x0f = std::floor(fx), y0f = std::floor(fy);
     float tx = fx - x0f, ty = fy - y0f;
     int x0 = int(x0f), y0 = int(y0f);
-    int xa = ((x0 % width) + width) % width, xb = (xa + 1) % width;
+    // u in [0,1) puts x0 in [-1, width - 1]: wrap by comparison, not by integer division.
+    int xa = x0 < 0 ? x0 + width : (x0 >= width ? x0 - width : x0);
+    int xb = xa + 1 < width ? xa + 1 : 0;
     int ya = clampi(y0, 0, height - 1), yb = clampi(y0 + 1, 0, height - 1);
     Color c = (texel(xa, ya) * (1.f - tx) + texel(xb, ya) * tx) * (1.f - ty) +
               (texel(xa, yb) * (1.f - tx) + texel(xb, yb) * tx) * ty;
