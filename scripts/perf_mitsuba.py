@@ -20,9 +20,9 @@ import numpy as np
 from crosscheck_mitsuba import ENVGI_ONLY
 
 
-def envgi_render(envgi, xml, out, spp, seed, res, threads):
+def envgi_render(envgi, xml, out, spp, seed, res, threads, strategy='product'):
     cmd = [envgi, 'render', xml, '-o', out, '--spp', str(spp), '--seed', str(seed), '--no-progress',
-           '--device', 'cpu', '--integrator', 'path', '--strategy', 'mis', '-D', f'res={res}', '--threads', str(threads),
+           '--device', 'cpu', '--integrator', 'path', '--strategy', strategy, '-D', f'res={res}', '--threads', str(threads),
            '--filter', 'box']
     log = subprocess.run(cmd, check=True, capture_output=True, text=True)
     m = re.search(r'done in ([0-9.]+) s', log.stdout + log.stderr)
@@ -62,6 +62,7 @@ def main():
     ap.add_argument('--ref-spp', type=int, default=2048)
     ap.add_argument('--spp', default='16,64')
     ap.add_argument('--threads', type=int, default=os.cpu_count())
+    ap.add_argument('--strategy', default='product', help="envgi's environment strategy (its default: product)")
     args = ap.parse_args()
     mi.set_variant(args.variant)
     tmp = tempfile.mkdtemp(prefix='envgi_perf_')
@@ -69,19 +70,19 @@ def main():
     rows = []
     for name in ('buddha', 'cornell-box', 'teapot-glass'):
         xml = os.path.join(args.scenes, name + '.xml')
-        eref, _ = envgi_render(args.envgi, xml, out, args.ref_spp, 1, args.res, args.threads)
+        eref, _ = envgi_render(args.envgi, xml, out, args.ref_spp, 1, args.res, args.threads, args.strategy)
         scene = mitsuba_scene(xml, args.res)
         mitsuba_render(scene, 4, 0)  # compiles its kernels
         mref, _ = mitsuba_render(scene, args.ref_spp, 1)
         for spp in (int(s) for s in args.spp.split(',')):
             mimg, mt = mitsuba_render(scene, spp, 7)
-            eimg, et = envgi_render(args.envgi, xml, out, spp, 7, args.res, args.threads)
+            eimg, et = envgi_render(args.envgi, xml, out, spp, 7, args.res, args.threads, args.strategy)
             espp = max(1, int(round(spp * mt / et)))
-            eimg2, et2 = envgi_render(args.envgi, xml, out, espp, 7, args.res, args.threads)
+            eimg2, et2 = envgi_render(args.envgi, xml, out, espp, 7, args.res, args.threads, args.strategy)
             rm, re_, re2 = rmse(mimg, mref), rmse(eimg, eref), rmse(eimg2, eref)
             rows.append((name, spp, mt, rm, et, re_, espp, et2, re2, (re2 * re2 * et2) / (rm * rm * mt)))
             print(rows[-1], flush=True)
-    print(f'\nMitsuba {mi.__version__} {args.variant} vs envgi path (strategy mis), {args.res}^2, '
+    print(f'\nMitsuba {mi.__version__} {args.variant} vs envgi path (strategy {args.strategy}), {args.res}^2, '
           f'{args.threads} threads; RMSE against each renderer\'s own {args.ref_spp}-spp reference\n')
     print('| scene | spp | Mitsuba s | Mitsuba RMSE | envgi s | envgi RMSE | envgi spp, same time | s | RMSE | '
           'envgi RMSE² t / Mitsuba\'s |')

@@ -30,7 +30,7 @@ namespace {
 namespace fs = std::filesystem;
 
 struct StudyArgs {
-  std::string scene, out, reference, strategies = "uniform,cosine,bsdf,adaptive,importance,mis,points-64",
+  std::string scene, out, reference, strategies = "uniform,cosine,bsdf,adaptive,importance,mis,product,points-64",
                                      spp = "1,4,16,64,256", times, integrator = "direct";
   std::vector<std::string> defines;
   int seeds = 2, referenceSpp = 4096, threads = 0;
