@@ -243,7 +243,7 @@ void addStudyCommand(CLI::App& app) {
   CLI::App* c = app.add_subcommand("study", "Compare environment strategies against a reference (RMSE, plots, report)");
   c->add_option("scene", a->scene, "Scene file (.xml)")->required()->check(CLI::ExistingFile);
   c->add_option("-o,--output", a->out, "Output folder (results.csv, results.json, report.html, runs/)")->required();
-  c->add_option("--strategies", a->strategies, "Comma-separated: uniform,cosine,bsdf,importance,alias,adaptive,mis,points-N");
+  c->add_option("--strategies", a->strategies, "Comma-separated: uniform,cosine,bsdf,importance,alias,adaptive,mis,product,points-N");
   c->add_option("--spp", a->spp, "Comma-separated sample counts (default 1,4,16,64,256)");
   c->add_option("--time", a->times, "Comma-separated time budgets in seconds for equal-time runs");
   c->add_option("--seeds", a->seeds, "Seeds per configuration (default 2)");
