@@ -22,6 +22,7 @@ namespace {
 struct SampleArgs {
   std::string map, out, strategy = "importance", sampler = "independent";
   int count = 1000;
+  std::vector<float> normal{0.f, 1.f, 0.f};  // cosine and product sample about it (map frame)
   uint32_t seed = 0;
   bool misCompensation = false;
 };
@@ -29,7 +30,10 @@ struct SampleArgs {
 std::vector<EnvSample> drawSamples(const EnvironmentMap& env, const SampleArgs& a) {
   if (a.count <= 0) throw std::runtime_error("--count must be positive");
   EnvStrategy s = EnvStrategy(parseStrategyName(a.strategy));
+  Vec3f n(a.normal[0], a.normal[1], a.normal[2]);
+  if (!(lengthSq(n) > 0.f) || !isFiniteVec(n)) throw std::runtime_error("--normal must be a non-zero direction x,y,z");
   EnvironmentMapView v = env.view();
+  n = v.fromLocal(normalize(n));
   Sampler smp;
   smp.type = findSampler(a.sampler);
   smp.spp = uint32_t(a.count);
@@ -37,7 +41,7 @@ std::vector<EnvSample> drawSamples(const EnvironmentMap& env, const SampleArgs& 
   std::vector<EnvSample> out(a.count);
   for (int i = 0; i < a.count; ++i) {
     smp.start(0, uint32_t(i));
-    out[i] = v.sample(s, smp.get2D(), Vec3f(0.f, 1.f, 0.f));
+    out[i] = v.sample(s, smp.get2D(), n);
   }
   return out;
 }
@@ -45,7 +49,10 @@ std::vector<EnvSample> drawSamples(const EnvironmentMap& env, const SampleArgs& 
 void addSampleOptions(CLI::App* c, SampleArgs& a) {
   c->add_option("map", a.map, "Lat-long map (.hdr, .exr, .pfm)")->required();
   c->add_option("--count,-n", a.count, "Number of samples")->check(CLI::PositiveNumber);
-  c->add_option("--strategy,-s", a.strategy, "uniform|cosine|importance|alias|adaptive (cosine is about +Y)");
+  c->add_option("--strategy,-s", a.strategy, strategyNameList(true) + " (cosine and product about --normal)");
+  c->add_option("--normal", a.normal, "x,y,z: the surface normal, in the map's frame, for cosine and product (default 0,1,0)")
+      ->expected(3)
+      ->delimiter(',');
   c->add_option("--sampler", a.sampler, nameList(kSamplerNames));
   c->add_option("--seed", a.seed, "Seed");
   c->add_flag("--mis-compensation", a.misCompensation, "Sample max(L - mean, 0) (Karlik et al. 2019)");

@@ -82,7 +82,7 @@ inline constexpr StrategyName kStrategyNames[] = {
     {"importance", EnvStrategy::Importance, 1, 0, true}, {"alias", EnvStrategy::Alias, 1, 0, true},
     {"adaptive", EnvStrategy::Adaptive, 1, 0, true},     {"bsdf", EnvStrategy::Alias, 0, 1, false},
     {"mis", EnvStrategy::Alias, 1, 1, false},            {"points", EnvStrategy::Points, 1, 0, false},
-    {"product", EnvStrategy::Product, 1, 1, false},
+    {"product", EnvStrategy::Product, 1, 1, true},
 };
 
 inline std::string strategyNameList(bool mapOnly = false) {

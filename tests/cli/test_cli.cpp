@@ -14,6 +14,21 @@ namespace fs = std::filesystem;
 
 namespace {
 std::string bundledMap() { return std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/studio.hdr"; }
+
+// The rows of a samples.csv (u, v, x, y, z, pdf), after checking its header and each row's form.
+std::vector<std::array<float, 6>> readSamples(const std::string& path) {
+  std::ifstream f(path);
+  std::string line;
+  std::getline(f, line);
+  EXPECT_EQ(line, "u,v,x,y,z,pdf");
+  std::vector<std::array<float, 6>> rows;
+  while (std::getline(f, line)) {
+    std::array<float, 6> r;
+    EXPECT_EQ(std::sscanf(line.c_str(), "%f,%f,%f,%f,%f,%f", &r[0], &r[1], &r[2], &r[3], &r[4], &r[5]), 6) << line;
+    rows.push_back(r);
+  }
+  return rows;
+}
 }  // namespace
 
 TEST(CliEnvmap, InfoPrintsStatistics) {
@@ -28,21 +43,14 @@ TEST(CliEnvmap, SamplesCsvContract) {
   std::string out = d.file("s.csv");
   CliResult r = runCli("envmap samples " + bundledMap() + " --count 500 --strategy importance --seed 3 -o " + out);
   ASSERT_EQ(r.code, 0) << r.output;
-  std::ifstream f(out);
-  std::string line;
-  std::getline(f, line);
-  EXPECT_EQ(line, "u,v,x,y,z,pdf");
-  int rows = 0;
-  while (std::getline(f, line)) {
-    float u, v, x, y, z, pdf;
-    ASSERT_EQ(std::sscanf(line.c_str(), "%f,%f,%f,%f,%f,%f", &u, &v, &x, &y, &z, &pdf), 6) << line;
+  auto rows = readSamples(out);
+  for (const auto& [u, v, x, y, z, pdf] : rows) {
     EXPECT_GE(u, 0.f);
     EXPECT_LT(u, 1.f);
     EXPECT_NEAR(x * x + y * y + z * z, 1.f, 1e-4f);
     EXPECT_GT(pdf, 0.f);
-    ++rows;
   }
-  EXPECT_EQ(rows, 500);
+  EXPECT_EQ(rows.size(), 500u);
   // Same seed, same file.
   std::string out2 = d.file("s2.csv");
   ASSERT_EQ(runCli("envmap samples " + bundledMap() + " --count 500 --strategy importance --seed 3 -o " + out2).code, 0);
@@ -51,6 +59,27 @@ TEST(CliEnvmap, SamplesCsvContract) {
   sa << a.rdbuf();
   sb << b.rdbuf();
   EXPECT_EQ(sa.str(), sb.str());
+}
+
+// The product strategy about --normal: its samples stay above that normal's horizon, but for
+// the bound's margin (the buckets and cells are a few degrees wide).
+TEST(CliEnvmap, ProductSamplesAboutTheNormal) {
+  TempDir d;
+  std::string out = d.file("p.csv");
+  CliResult r = runCli("envmap samples " + bundledMap() + " --count 2000 --strategy product --normal 0,-1,0 -o " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  auto rows = readSamples(out);
+  int below = 0;
+  for (const auto& r : rows) {
+    EXPECT_GT(r[5], 0.f);
+    below += r[3] > 0.3f;  // y: more than 17 degrees on the wrong side of the horizon
+  }
+  EXPECT_EQ(rows.size(), 2000u);
+  EXPECT_EQ(below, 0);
+  CliResult zero = runCli("envmap samples " + bundledMap() + " --strategy product --normal 0,0,0 -o " + out + "2");
+  EXPECT_NE(zero.code, 0);
+  EXPECT_NE(zero.output.find("--normal must be a non-zero direction"), std::string::npos) << zero.output;
+  EXPECT_FALSE(fs::exists(out + "2"));
 }
 
 TEST(CliEnvmap, PlotWritesPng) {
