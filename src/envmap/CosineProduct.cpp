@@ -55,7 +55,7 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
   cellSum_.resize(size_t(cells));
   std::vector<Dir> cellCentre(static_cast<size_t>(cells));
   std::vector<double> cellRadius(static_cast<size_t>(cells));
-  std::vector<float> f;
+  std::vector<float> f, func;  // one cell's pixel weights, and build()'s copy of them
   for (int cy = 0; cy < cellsY_; ++cy)
     for (int cx = 0; cx < cellsX_; ++cx) {
       int c = cy * cellsX_ + cx;
@@ -69,7 +69,7 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
         }
       cellCdfStart_[size_t(c)] = int(cellCdf_.size());
       cellCdf_.resize(cellCdf_.size() + f.size() + 1);
-      std::vector<float> func(f.size());
+      func.resize(f.size());
       float integral;
       PiecewiseConstant1D::build(f.data(), int(f.size()), func.data(), cellCdf_.data() + cellCdfStart_[size_t(c)],
                                  &integral);

@@ -17,29 +17,24 @@
 
 namespace envgi {
 
+// The octahedron's lower half folded over its upper one (its own inverse).
+ENVGI_INLINE Vec2f octahedralFold(float px, float py) {
+  return {(1.f - std::fabs(py)) * (px >= 0.f ? 1.f : -1.f), (1.f - std::fabs(px)) * (py >= 0.f ? 1.f : -1.f)};
+}
+
 // Octahedral mapping of a unit vector to [0,1)^2 (Meyer et al. 2010), for bucketing normals.
 ENVGI_INLINE Vec2f octahedralEncode(Vec3f n) {
   float s = std::fabs(n.x) + std::fabs(n.y) + std::fabs(n.z);
-  float px = n.x / s, py = n.y / s;
-  if (n.z < 0.f) {
-    float ox = (1.f - std::fabs(py)) * (px >= 0.f ? 1.f : -1.f);
-    float oy = (1.f - std::fabs(px)) * (py >= 0.f ? 1.f : -1.f);
-    px = ox;
-    py = oy;
-  }
-  return {px * 0.5f + 0.5f, py * 0.5f + 0.5f};
+  Vec2f p(n.x / s, n.y / s);
+  if (n.z < 0.f) p = octahedralFold(p.x, p.y);
+  return {p.x * 0.5f + 0.5f, p.y * 0.5f + 0.5f};
 }
 
 ENVGI_INLINE Vec3f octahedralDecode(Vec2f uv) {
-  float px = uv.x * 2.f - 1.f, py = uv.y * 2.f - 1.f;
-  float z = 1.f - std::fabs(px) - std::fabs(py);
-  if (z < 0.f) {
-    float ox = (1.f - std::fabs(py)) * (px >= 0.f ? 1.f : -1.f);
-    float oy = (1.f - std::fabs(px)) * (py >= 0.f ? 1.f : -1.f);
-    px = ox;
-    py = oy;
-  }
-  return normalize(Vec3f(px, py, z));
+  Vec2f p(uv.x * 2.f - 1.f, uv.y * 2.f - 1.f);
+  float z = 1.f - std::fabs(p.x) - std::fabs(p.y);
+  if (z < 0.f) p = octahedralFold(p.x, p.y);
+  return normalize(Vec3f(p.x, p.y, z));
 }
 
 struct CosineProductView {

@@ -118,23 +118,35 @@ struct EnvironmentMapView {
     return {(float(px) + ux) / float(width), (float(py) + uy) / float(height)};
   }
 
+  // A density over (u, v) as a density in solid angle: dw = 2 pi^2 sin(theta) du dv; zero at
+  // the poles, where the mapping degenerates.
+  ENVGI_HD static float solidAnglePdf(float pdfUV, float v) {
+    float st = std::sin(kPi * v);
+    return st > 0.f ? pdfUV / (2.f * kPi * kPi * st) : 0.f;
+  }
+
   // A direction for light leaving the map (photon emission), drawn by plain luminance even
   // where MIS compensation is on; pdf in solid angle.
   ENVGI_HD EnvSample sampleEmission(Vec2f u) const {
     EnvSample out;
     float pmf;
     out.uv = sampleTable(emission, u, &pmf);
-    float st = std::sin(kPi * out.uv.y);
-    out.pdf = st > 0.f ? pmf * float(width) * float(height) / (2.f * kPi * kPi * st) : 0.f;
+    out.pdf = solidAnglePdf(pmf * float(width) * float(height), out.uv.y);
     out.dir = fromLocal(uvToDir(out.uv));
     out.radiance = out.pdf > 0.f ? lookupUV(out.uv) : Color(0.f);
     return out;
   }
 
-  ENVGI_HD float importancePdfUV(Vec2f uv) const {
-    float st = std::sin(kPi * uv.y);
-    if (st <= 0.f) return 0.f;
-    return dist.pdf(uv) / (2.f * kPi * kPi * st);
+  ENVGI_HD float importancePdfUV(Vec2f uv) const { return solidAnglePdf(dist.pdf(uv), uv.y); }
+
+  // The strategy that draws for this normal: a zero normal (a BSDF that also transmits) means
+  // the whole sphere, so cosine becomes uniform and product (like a map without its tables,
+  // a black one) becomes Algorithm 1's density. sample() and pdf() both go through it.
+  ENVGI_HD EnvStrategy strategyFor(EnvStrategy s, Vec3f normal) const {
+    bool wholeSphere = lengthSq(normal) == 0.f;
+    if (wholeSphere && s == EnvStrategy::Cosine) return EnvStrategy::Uniform;
+    if (s == EnvStrategy::Product && (wholeSphere || !product.valid())) return EnvStrategy::Importance;
+    return s;
   }
 
   // Draws a direction; `normal` (world space) is used by the cosine and product strategies
@@ -143,10 +155,7 @@ struct EnvironmentMapView {
   ENVGI_HD EnvSample sample(EnvStrategy s, Vec2f u, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
     EnvSample out;
     Vec3f local;
-    bool wholeSphere = lengthSq(normal) == 0.f;
-    if (wholeSphere && s == EnvStrategy::Cosine) s = EnvStrategy::Uniform;
-    if (s == EnvStrategy::Product && (wholeSphere || !product.valid())) s = EnvStrategy::Importance;
-    switch (s) {
+    switch (strategyFor(s, normal)) {
       case EnvStrategy::Uniform: {
         local = sampleUniformSphere(u);
         out.pdf = uniformSpherePdf();
@@ -185,8 +194,7 @@ struct EnvironmentMapView {
         float pdfUV;
         if (!product.sample(u, toLocal(normal), dist.condFunc, &out.uv, &pdfUV)) return out;
         local = uvToDir(out.uv);
-        float st = std::sin(kPi * out.uv.y);
-        out.pdf = st > 0.f ? pdfUV / (2.f * kPi * kPi * st) : 0.f;
+        out.pdf = solidAnglePdf(pdfUV, out.uv.y);
         break;
       }
       case EnvStrategy::Points: {
@@ -213,10 +221,7 @@ struct EnvironmentMapView {
   }
 
   ENVGI_HD float pdf(EnvStrategy s, Vec3f worldDir, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
-    bool wholeSphere = lengthSq(normal) == 0.f;
-    if (wholeSphere && s == EnvStrategy::Cosine) s = EnvStrategy::Uniform;
-    if (s == EnvStrategy::Product && (wholeSphere || !product.valid())) s = EnvStrategy::Importance;
-    switch (s) {
+    switch (strategyFor(s, normal)) {
       case EnvStrategy::Uniform: return uniformSpherePdf();
       case EnvStrategy::Cosine: return cosineHemispherePdf(dot(normalize(worldDir), normal));
       case EnvStrategy::Importance:
@@ -225,8 +230,7 @@ struct EnvironmentMapView {
       case EnvStrategy::Points: return 0.f;  // no direction drawn by BSDF sampling hits a point
       case EnvStrategy::Product: {
         Vec2f uv = dirToUV(toLocal(worldDir));
-        float st = std::sin(kPi * uv.y);
-        return st > 0.f ? product.pdf(uv, toLocal(normal), dist.condFunc) / (2.f * kPi * kPi * st) : 0.f;
+        return solidAnglePdf(product.pdf(uv, toLocal(normal), dist.condFunc), uv.y);
       }
     }
     return 0.f;
