@@ -80,6 +80,9 @@ TEST(CliEnvmap, ProductSamplesAboutTheNormal) {
   EXPECT_NE(zero.code, 0);
   EXPECT_NE(zero.output.find("--normal must be a non-zero direction"), std::string::npos) << zero.output;
   EXPECT_FALSE(fs::exists(out + "2"));
+  CliResult two = runCli("envmap samples " + bundledMap() + " --strategy product --normal 0,1 -o " + out + "2");
+  EXPECT_NE(two.code, 0) << two.output;
+  EXPECT_FALSE(fs::exists(out + "2"));
 }
 
 TEST(CliEnvmap, PlotWritesPng) {

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "envmap/EnvironmentMap.h"
+#include "lights/LightSampling.h"
 #include "sampling/Pcg32.h"
 #include "sampling/Warp.h"
 
@@ -138,3 +139,21 @@ TEST(CosineProduct, ZeroAxisIsTheWholeSphere) {
     ASSERT_EQ(v.pdf(EnvStrategy::Product, a.dir, Vec3f(0.f)), v.pdf(EnvStrategy::Importance, a.dir));
   }
 }
+
+// The axis the integrators hand to cosine and product: the shading normal on the viewer's side
+// for a BSDF that only reflects, the zero axis (the whole sphere) for one that transmits.
+TEST(CosineProduct, SamplingAxisFollowsTheViewerAndTransmission) {
+  SurfaceInteraction si;
+  si.shading = Frame::fromNormal(normalize(Vec3f(0.2f, 1.f, 0.1f)));
+  Bsdf diffuse, glass;
+  glass.type = BsdfType::RoughDielectric;
+  Vec3f above(0.f, 1.f, 0.f), below(0.f, -1.f, 0.f);
+  Vec3f a = envSamplingAxis(si, above, diffuse), b = envSamplingAxis(si, below, diffuse);
+  EXPECT_NEAR(dot(a, si.shading.n), 1.f, 1e-6f);
+  EXPECT_NEAR(dot(b, si.shading.n), -1.f, 1e-6f);
+  for (BsdfType t : {BsdfType::RoughDielectric, BsdfType::Dielectric, BsdfType::ThinDielectric}) {
+    glass.type = t;
+    EXPECT_EQ(lengthSq(envSamplingAxis(si, above, glass)), 0.f) << int(t);
+  }
+}
+
