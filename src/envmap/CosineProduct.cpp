@@ -51,6 +51,12 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
   const int cells = cellsX_ * cellsY_;
 
   // Per cell: the cdf of its pixels' weights and their sum; its bounding cap on the sphere.
+  // Guides: about one entry per 4 pixels of the largest cell (64 at most) and per 4 cells.
+  int maxPixels = (v.cellX0(1) - v.cellX0(0) + 1) * (v.cellY0(1) - v.cellY0(0) + 1);
+  cellGuideSize_ = std::min(guideSize(maxPixels, 4), 64);
+  bucketGuideSize_ = guideSize(cells, 4);
+  cellGuide_.resize(size_t(cells) * (cellGuideSize_ + 1));
+  bucketGuide_.resize(size_t(bucketsPerSide) * bucketsPerSide * (bucketGuideSize_ + 1));
   cellCdfStart_.resize(size_t(cells));
   cellSum_.resize(size_t(cells));
   std::vector<Dir> cellCentre(static_cast<size_t>(cells));
@@ -74,6 +80,8 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
       PiecewiseConstant1D::build(f.data(), int(f.size()), func.data(), cellCdf_.data() + cellCdfStart_[size_t(c)],
                                  &integral);
       cellSum_[size_t(c)] = float(sum);
+      buildGuide(cellCdf_.data() + cellCdfStart_[size_t(c)], int(f.size()) + 1, cellGuideSize_,
+                 cellGuide_.data() + size_t(c) * (cellGuideSize_ + 1));
       double u0 = double(x0) / width, u1 = double(x1) / width, v0 = double(y0) / height, v1 = double(y1) / height;
       auto at = [&](double s, double t) { return uvDir(u0 + s * (u1 - u0), v0 + t * (v1 - v0)); };
       cellCentre[size_t(c)] = at(0.5, 0.5);
@@ -104,6 +112,8 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
       }
       PiecewiseConstant1D::build(weights.data(), cells, bucketFunc_.data() + size_t(k) * cells,
                                  bucketCdf_.data() + size_t(k) * (cells + 1), &bucketInt_[size_t(k)]);
+      buildGuide(bucketCdf_.data() + size_t(k) * (cells + 1), cells + 1, bucketGuideSize_,
+                 bucketGuide_.data() + size_t(k) * (bucketGuideSize_ + 1));
     }
 }
 
@@ -116,6 +126,10 @@ CosineProductView CosineProduct::view() const {
   v.cellCdf = cellCdf_.data();
   v.cellCdfStart = cellCdfStart_.data();
   v.cellSum = cellSum_.data();
+  v.bucketGuide = bucketGuide_.data();
+  v.cellGuide = cellGuide_.data();
+  v.bucketGuideSize = bucketGuideSize_;
+  v.cellGuideSize = cellGuideSize_;
   v.width = width_;
   v.height = height_;
   v.cellsX = cellsX_;
@@ -127,7 +141,7 @@ CosineProductView CosineProduct::view() const {
 size_t CosineProduct::bytes() const {
   return sizeof(float) * (bucketFunc_.size() + bucketCdf_.size() + bucketInt_.size() + cellCdf_.size() +
                           cellSum_.size()) +
-         sizeof(int) * cellCdfStart_.size();
+         sizeof(int) * (cellCdfStart_.size() + bucketGuide_.size() + cellGuide_.size());
 }
 
 }  // namespace envgi

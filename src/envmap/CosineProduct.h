@@ -44,6 +44,11 @@ struct CosineProductView {
   const float* cellCdf = nullptr;     // each cell's pixels (row-major inside the cell): pixels + 1 values
   const int* cellCdfStart = nullptr;  // cells: where a cell's cdf begins in cellCdf
   const float* cellSum = nullptr;     // cells: the sum of the pixel weights inside each cell
+  // Guide tables (findIntervalGuided) over bucketCdf, buckets x (bucketGuideSize + 1), and over
+  // each cell's cdf, cells x (cellGuideSize + 1): the same draws as binary search, fewer loads.
+  const int* bucketGuide = nullptr;
+  const int* cellGuide = nullptr;
+  int bucketGuideSize = 0, cellGuideSize = 0;
   int width = 0, height = 0;          // the map's pixels
   int cellsX = 0, cellsY = 0;
   int bucketsPerSide = 0;             // buckets = bucketsPerSide^2
@@ -80,14 +85,14 @@ struct CosineProductView {
     int k = bucket(nLocal), n = cells();
     if (!(bucketInt[k] > 0.f)) return false;
     const float* cdf = bucketCdf + size_t(k) * (n + 1);
-    int c = findInterval(cdf, n + 1, u.x);
+    int c = findIntervalGuided(cdf, u.x, bucketGuide + size_t(k) * (bucketGuideSize + 1), bucketGuideSize);
     float w1 = cdf[c + 1] - cdf[c];
     float r1 = w1 > 0.f ? (u.x - cdf[c]) / w1 : 0.5f;
     int cx = c % cellsX, cy = c / cellsX;
-    int x0 = cellX0(cx), x1 = cellX0(cx + 1), y0 = cellY0(cy), y1 = cellY0(cy + 1);
-    int cw = x1 - x0, pixels = cw * (y1 - y0);
+    int x0 = cellX0(cx), x1 = cellX0(cx + 1), y0 = cellY0(cy);
+    int cw = x1 - x0;
     const float* pc = cellCdf + cellCdfStart[c];
-    int j = findInterval(pc, pixels + 1, u.y);
+    int j = findIntervalGuided(pc, u.y, cellGuide + size_t(c) * (cellGuideSize + 1), cellGuideSize);
     float w2 = pc[j + 1] - pc[j];
     float r2 = w2 > 0.f ? (u.y - pc[j]) / w2 : 0.5f;
     int px = x0 + j % cw, py = y0 + j / cw;
@@ -117,8 +122,8 @@ class CosineProduct {
 
  private:
   std::vector<float> bucketFunc_, bucketCdf_, bucketInt_, cellCdf_, cellSum_;
-  std::vector<int> cellCdfStart_;
-  int width_ = 0, height_ = 0, cellsX_ = 0, cellsY_ = 0, buckets_ = 0;
+  std::vector<int> cellCdfStart_, bucketGuide_, cellGuide_;
+  int width_ = 0, height_ = 0, cellsX_ = 0, cellsY_ = 0, buckets_ = 0, bucketGuideSize_ = 0, cellGuideSize_ = 0;
 };
 
 }  // namespace envgi

@@ -221,17 +221,31 @@ struct EnvironmentMapView {
   }
 
   ENVGI_HD float pdf(EnvStrategy s, Vec3f worldDir, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
-    switch (strategyFor(s, normal)) {
+    EnvStrategy t = strategyFor(s, normal);
+    bool mapped = t != EnvStrategy::Uniform && t != EnvStrategy::Cosine && t != EnvStrategy::Points;
+    return pdfAt(t, worldDir, mapped ? dirToUV(toLocal(worldDir)) : Vec2f(0.f, 0.f), normal);
+  }
+
+  // Radiance from world direction d and, through *pdfOut, the density strategy s gives it about
+  // `normal`: one mapping to (u, v) serves both, which is what a BSDF-sampled ray that escapes
+  // needs (two atan2 calls and a rotation fewer than eval() and pdf() apart).
+  ENVGI_HD Color evalWithPdf(EnvStrategy s, Vec3f worldDir, Vec3f normal, float* pdfOut) const {
+    Vec2f uv = dirToUV(toLocal(worldDir));
+    *pdfOut = pdfAt(strategyFor(s, normal), worldDir, uv, normal);
+    return lookupUV(uv);
+  }
+
+ private:
+  // t is already resolved by strategyFor(); uv is worldDir's (u, v) where t needs it.
+  ENVGI_HD float pdfAt(EnvStrategy t, Vec3f worldDir, Vec2f uv, Vec3f normal) const {
+    switch (t) {
       case EnvStrategy::Uniform: return uniformSpherePdf();
       case EnvStrategy::Cosine: return cosineHemispherePdf(dot(normalize(worldDir), normal));
       case EnvStrategy::Importance:
-      case EnvStrategy::Alias: return importancePdfUV(dirToUV(toLocal(worldDir)));
-      case EnvStrategy::Adaptive: return adaptive.pdf(dirToUV(toLocal(worldDir)));
+      case EnvStrategy::Alias: return importancePdfUV(uv);
+      case EnvStrategy::Adaptive: return adaptive.pdf(uv);
       case EnvStrategy::Points: return 0.f;  // no direction drawn by BSDF sampling hits a point
-      case EnvStrategy::Product: {
-        Vec2f uv = dirToUV(toLocal(worldDir));
-        return solidAnglePdf(product.pdf(uv, toLocal(normal), dist.condFunc), uv.y);
-      }
+      case EnvStrategy::Product: return solidAnglePdf(product.pdf(uv, toLocal(normal), dist.condFunc), uv.y);
     }
     return 0.f;
   }

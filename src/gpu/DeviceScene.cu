@@ -26,6 +26,8 @@ EnvironmentMapView uploadEnvironment(DeviceArena& a, EnvironmentMapView v) {
     p.cellCdf = a.upload(p.cellCdf, px + cells, "cosine product tables");
     p.cellCdfStart = a.upload(p.cellCdfStart, cells, "cosine product tables");
     p.cellSum = a.upload(p.cellSum, cells, "cosine product tables");
+    p.bucketGuide = a.upload(p.bucketGuide, buckets * (p.bucketGuideSize + 1), "cosine product tables");
+    p.cellGuide = a.upload(p.cellGuide, cells * (p.cellGuideSize + 1), "cosine product tables");
   }
   return v;
 }

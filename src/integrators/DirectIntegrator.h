@@ -44,8 +44,7 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
     float lightPdf = 0.f;
     if (!tracer.intersect(r2, &h2)) {
       if (!sc.hasEnvironment || !envSeenByBsdfSampling(strategy, bs.delta)) continue;
-      Le = sc.env.eval(wi);
-      lightPdf = envLightPdf(sc, strategy, wi, axis);
+      Le = envRadianceAndPdf(sc, strategy, wi, axis, &lightPdf);
     } else {
       SurfaceInteraction s2 = sc.interaction(r2, h2);
       Le = sc.emitted(s2, -wi);

@@ -31,8 +31,9 @@ ENVGI_HD Color pathTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sam
     ++*rayCount;
     if (!tracer.intersect(ray, &h)) {
       if (sc.hasEnvironment && !(depth == 1 && pp.hideEmitters) && envSeenByBsdfSampling(pp.envStrategy, prevDelta)) {
-        Color Le = sc.env.eval(ray.d);
-        float w = prevDelta ? 1.f : powerHeuristic(1.f, prevPdf, 1.f, envLightPdf(sc, pp.envStrategy, ray.d, prevAxis));
+        float lightPdf = 0.f;
+        Color Le = prevDelta ? sc.env.eval(ray.d) : envRadianceAndPdf(sc, pp.envStrategy, ray.d, prevAxis, &lightPdf);
+        float w = prevDelta ? 1.f : powerHeuristic(1.f, prevPdf, 1.f, lightPdf);
         L += beta * Le * w;
       }
       break;

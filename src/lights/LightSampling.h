@@ -27,9 +27,12 @@ ENVGI_INLINE Vec3f envSamplingAxis(const SurfaceInteraction& si, Vec3f wo, const
 // already took the whole map as collapsed-map lights (a delta bounce still sees the map).
 ENVGI_INLINE bool envSeenByBsdfSampling(EnvStrategy s, bool prevDelta) { return prevDelta || s != EnvStrategy::Points; }
 
-ENVGI_INLINE float envLightPdf(const SceneView& sc, EnvStrategy s, Vec3f dir, Vec3f axis) {
-  if (!sc.hasEnvironment) return 0.f;
-  return sc.envSelectProb() * sc.env.pdf(s, dir, axis);
+// The map's radiance along an escaping BSDF-sampled direction and, through *lightPdf, the
+// density next-event estimation would have drawn it with (selection included).
+ENVGI_INLINE Color envRadianceAndPdf(const SceneView& sc, EnvStrategy s, Vec3f dir, Vec3f axis, float* lightPdf) {
+  Color Le = sc.env.evalWithPdf(s, dir, axis, lightPdf);
+  *lightPdf *= sc.envSelectProb();
+  return Le;
 }
 
 // Solid-angle density of reaching light primitive `light` at point lp (normal ln) from p.

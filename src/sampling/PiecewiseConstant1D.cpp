@@ -26,4 +26,15 @@ void PiecewiseConstant1D::build(const float* f, int n, float* funcOut, float* cd
   cdfOut[n] = 1.f;
 }
 
+void buildGuide(const float* cdf, int size, int G, int* guide) {
+  if (G <= 0 || (G & (G - 1)) != 0) throw std::invalid_argument("buildGuide: the guide size must be a power of two");
+  for (int g = 0; g <= G; ++g) guide[g] = findInterval(cdf, size, float(g) / float(G));
+}
+
+int guideSize(int n, int perEntry) {
+  int G = 1;
+  while (G * perEntry < n) G *= 2;
+  return G;
+}
+
 }  // namespace envgi

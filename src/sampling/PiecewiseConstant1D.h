@@ -19,6 +19,28 @@ ENVGI_INLINE int findInterval(const float* cdf, int size, float u) {
   return lo;
 }
 
+// findInterval narrowed by a guide table (Chen and Asau's cutpoints): guide[g] is the index for
+// u = g / G, g in [0, G], with G a power of two so that g / G and u * G are exact in float.
+// The index is non-decreasing in u, so the answer for u lies in [guide[g], guide[g + 1]] with
+// g = floor(u G): the same index as the plain search, from a few loads instead of log2(size).
+ENVGI_INLINE int findIntervalGuided(const float* cdf, float u, const int* guide, int G) {
+  int g = int(u * float(G));
+  g = g < 0 ? 0 : (g > G - 1 ? G - 1 : g);
+  int lo = guide[g], hi = guide[g + 1];
+  while (lo < hi) {
+    int mid = (lo + hi + 1) >> 1;
+    if (cdf[mid] <= u) lo = mid;
+    else hi = mid - 1;
+  }
+  return lo;
+}
+
+// Fills guide[0..G] for findIntervalGuided; G must be a power of two.
+void buildGuide(const float* cdf, int size, int G, int* guide);
+
+// The guide size for a cdf over n intervals: about one guide entry per `perEntry` intervals.
+int guideSize(int n, int perEntry);
+
 // Plain view over storage owned elsewhere (host vectors now, device buffers on the GPU).
 // A function that is zero everywhere degenerates to the uniform density, so sampling a
 // zero-power light never divides by zero.

@@ -63,6 +63,36 @@ TEST(PiecewiseConstant1D, NegativeAndNaNWeightsAreZero) {
   EXPECT_FLOAT_EQ(v.pdf(0.9f), 0.f);
 }
 
+// The guided search must pick exactly the interval binary search picks, for every u: on a
+// peaked function with runs of zeros (empty intervals), for guides coarser and finer than it,
+// and at the guide's own cut points and their float neighbours.
+TEST(PiecewiseConstant1D, GuidedSearchEqualsBinarySearch) {
+  std::vector<float> f(3001, 0.f);
+  Pcg32 rng(7);
+  for (size_t i = 0; i < f.size(); ++i) f[i] = (i % 17 < 5) ? 0.f : rng.nextFloat() * rng.nextFloat();
+  f[1234] = 5000.f;  // a sun: most of the mass in one interval
+  PiecewiseConstant1D d(f);
+  const float* cdf = d.view().cdf;
+  int size = d.size() + 1;
+  for (int G : {1, 2, 64, 1024, 8192}) {
+    std::vector<int> guide(size_t(G) + 1);
+    buildGuide(cdf, size, G, guide.data());
+    std::vector<float> us;
+    for (int i = 0; i < 100000; ++i) us.push_back(rng.nextFloat());
+    for (int g = 0; g < G; ++g) {
+      float c = float(g) / float(G);
+      us.insert(us.end(), {c, std::nextafter(c, 0.f), std::nextafter(c, 1.f)});
+    }
+    us.push_back(kOneMinusEpsilon);
+    for (float u : us) ASSERT_EQ(findIntervalGuided(cdf, u, guide.data(), G), findInterval(cdf, size, u)) << "G " << G << " u " << u;
+  }
+  std::vector<int> guide(4);
+  EXPECT_THROW(buildGuide(cdf, size, 3, guide.data()), std::invalid_argument);
+  EXPECT_EQ(guideSize(2048, 4), 512);
+  EXPECT_EQ(guideSize(2049, 4), 1024);
+  EXPECT_EQ(guideSize(1, 4), 1);
+}
+
 TEST(PiecewiseConstant2D, PdfIntegratesToOneAndMatchesSampling) {
   const int w = 7, h = 5;
   std::vector<float> f(w * h);
