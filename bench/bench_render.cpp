@@ -2,7 +2,8 @@
 // tracing the very same rays (recorded from the path tracer), on the buddha scene, with 1 and
 // 2 threads. The ratio is the share of time envgi spends outside Embree.
 // Run: build/bin/envgi_bench_render --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
-// ENVGI_BENCH_MESH=/path/to/mesh.ply swaps the Buddha for another mesh (e.g. the 871k dragon).
+// ENVGI_BENCH_MESH=/path/to/mesh.ply swaps the Buddha for another mesh (e.g. the 871k dragon),
+// ENVGI_BENCH_ENVMAP=/path/to/map.hdr Grace Cathedral for another map.
 #include <benchmark/benchmark.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -42,6 +43,7 @@ struct Fixture {
   Fixture() {
     std::map<std::string, std::string> defs = {{"res", "256"}, {"spp", "4"}};
     if (const char* m = std::getenv("ENVGI_BENCH_MESH")) defs["mesh"] = m;
+    if (const char* e = std::getenv("ENVGI_BENCH_ENVMAP")) defs["envmap"] = e;
     loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/buddha.xml", defs, scene);
     scene.integrator.type = IntegratorType::Path;
     scene.integrator.path.maxDepth = 4;
