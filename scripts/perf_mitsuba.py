@@ -10,6 +10,7 @@ prints the Markdown table that docs/performance.md holds.
 import argparse
 import os
 import re
+import statistics
 import subprocess
 import tempfile
 import time
@@ -49,6 +50,13 @@ def mitsuba_render(scene, spp, seed):
     return img, time.perf_counter() - t
 
 
+def timed(render, repeats):
+    """The image of one render and the median time of `repeats` (same seed, so the same image):
+    one render's time moves by 10-30% on a shared machine, enough to flip a ratio near 1."""
+    runs = [render() for _ in range(repeats)]
+    return runs[0][0], statistics.median(t for _, t in runs)
+
+
 def rmse(a, b):
     return float(np.sqrt(np.mean((a - b) ** 2)))
 
@@ -63,6 +71,7 @@ def main():
     ap.add_argument('--spp', default='16,64')
     ap.add_argument('--threads', type=int, default=os.cpu_count())
     ap.add_argument('--strategy', default='product', help="envgi's environment strategy (its default: product)")
+    ap.add_argument('--repeats', type=int, default=3, help='renders per timing; the median time is used')
     args = ap.parse_args()
     mi.set_variant(args.variant)
     tmp = tempfile.mkdtemp(prefix='envgi_perf_')
@@ -75,21 +84,24 @@ def main():
         mitsuba_render(scene, 4, 0)  # compiles its kernels
         mref, _ = mitsuba_render(scene, args.ref_spp, 1)
         for spp in (int(s) for s in args.spp.split(',')):
-            mimg, mt = mitsuba_render(scene, spp, 7)
-            eimg, et = envgi_render(args.envgi, xml, out, spp, 7, args.res, args.threads, args.strategy)
+            mimg, mt = timed(lambda: mitsuba_render(scene, spp, 7), args.repeats)
+            erender = lambda n: envgi_render(args.envgi, xml, out, n, 7, args.res, args.threads, args.strategy)
+            eimg, et = timed(lambda: erender(spp), args.repeats)
             espp = max(1, int(round(spp * mt / et)))
-            eimg2, et2 = envgi_render(args.envgi, xml, out, espp, 7, args.res, args.threads, args.strategy)
+            eimg2, et2 = timed(lambda: erender(espp), args.repeats)
             rm, re_, re2 = rmse(mimg, mref), rmse(eimg, eref), rmse(eimg2, eref)
-            rows.append((name, spp, mt, rm, et, re_, espp, et2, re2, (re2 * re2 * et2) / (rm * rm * mt)))
+            rows.append((name, spp, mt, rm, et, re_, espp, et2, re2, (re2 * re2 * et2) / (rm * rm * mt),
+                         (re_ * re_ * et) / (rm * rm * mt)))
             print(rows[-1], flush=True)
     print(f'\nMitsuba {mi.__version__} {args.variant} vs envgi path (strategy {args.strategy}), {args.res}^2, '
-          f'{args.threads} threads; RMSE against each renderer\'s own {args.ref_spp}-spp reference\n')
+          f'{args.threads} threads; RMSE against each renderer\'s own {args.ref_spp}-spp reference; times are '
+          f'medians of {args.repeats} renders\n')
     print('| scene | spp | Mitsuba s | Mitsuba RMSE | envgi s | envgi RMSE | envgi spp, same time | s | RMSE | '
-          'envgi RMSE² t / Mitsuba\'s |')
-    print('|---|---|---|---|---|---|---|---|---|---|')
+          'envgi RMSE² t / Mitsuba\'s, same time | same spp |')
+    print('|---|---|---|---|---|---|---|---|---|---|---|')
     for r in rows:
         print(f'| {r[0]} | {r[1]} | {r[2]:.2f} | {r[3]:.4f} | {r[4]:.2f} | {r[5]:.4f} | {r[6]} | {r[7]:.2f} | {r[8]:.4f} '
-              f'| {r[9]:.2f} |')
+              f'| {r[9]:.2f} | {r[10]:.2f} |')
 
 
 if __name__ == '__main__':

@@ -11,11 +11,15 @@ namespace envgi {
 enum class SamplerType : int { Independent = 0, Stratified = 1, Sobol = 2 };
 
 ENVGI_INLINE uint32_t reverseBits32(uint32_t v) {
+#if defined(__CUDA_ARCH__)
+  return __brev(v);
+#else
+  // A byte swap does the two widest steps of the five in one instruction.
+  v = __builtin_bswap32(v);
   v = ((v >> 1) & 0x55555555u) | ((v & 0x55555555u) << 1);
   v = ((v >> 2) & 0x33333333u) | ((v & 0x33333333u) << 2);
-  v = ((v >> 4) & 0x0F0F0F0Fu) | ((v & 0x0F0F0F0Fu) << 4);
-  v = ((v >> 8) & 0x00FF00FFu) | ((v & 0x00FF00FFu) << 8);
-  return (v >> 16) | (v << 16);
+  return ((v >> 4) & 0x0F0F0F0Fu) | ((v & 0x0F0F0F0Fu) << 4);
+#endif
 }
 
 // First two dimensions of Sobol': van der Corput and the Pascal-matrix dimension.
@@ -26,16 +30,34 @@ ENVGI_INLINE uint32_t sobolDim1(uint32_t i) {
     if (i & 1u) r ^= v;
   return r;
 }
+// The same two with their bits reversed, the form the scrambler works in: dimension 0 is then
+// the index itself, and dimension 1 builds its reversed generator columns directly.
+ENVGI_INLINE uint32_t sobolDim0Reversed(uint32_t i) { return i; }
+ENVGI_INLINE uint32_t sobolDim1Reversed(uint32_t i) {
+  uint32_t r = 0;
+  for (uint32_t v = 1u; i; i >>= 1, v ^= v << 1)
+    if (i & 1u) r ^= v;
+  return r;
+}
 
-// Nested uniform (Owen) scrambling through a hash on reversed bits (Laine-Karras style).
-ENVGI_INLINE uint32_t owenScramble(uint32_t v, uint32_t seed) {
-  v = reverseBits32(v);
+// Laine-Karras hash on bit-reversed values: each output bit depends only on the bits below it,
+// which, reversed, is nested uniform (Owen) scrambling.
+ENVGI_INLINE uint32_t laineKarrasPermutation(uint32_t v, uint32_t seed) {
   v += seed;
   v ^= v * 0x6c50b47cu;
   v ^= v * 0xb82f1e52u;
   v ^= v * 0xc7afe638u;
   v ^= v * 0x8d22f6e6u;
-  return reverseBits32(v);
+  return v;
+}
+
+// Nested uniform (Owen) scrambling of a value in natural bit order.
+ENVGI_INLINE uint32_t owenScramble(uint32_t v, uint32_t seed) {
+  return reverseBits32(laineKarrasPermutation(reverseBits32(v), seed));
+}
+// The same for a value handed over already reversed (sobolDim*Reversed): one reversal fewer.
+ENVGI_INLINE uint32_t owenScrambleReversed(uint32_t reversedV, uint32_t seed) {
+  return reverseBits32(laineKarrasPermutation(reversedV, seed));
 }
 
 // Kensler's hashed permutation: element i of a pseudo-random permutation of [0, n).
@@ -48,7 +70,9 @@ ENVGI_INLINE uint32_t permutationElement(uint32_t i, uint32_t l, uint32_t p) {
     i *= 0x74dcb303; i ^= (i & w) >> 2; i *= 0x9e501cc3; i ^= (i & w) >> 2; i *= 0xc860a3df;
     i &= w; i ^= i >> 5;
   } while (i >= l);
-  return (i + p) % l;
+  // A power of two (the usual sample count) needs no division, which would sit on every draw's
+  // critical path.
+  return (l & (l - 1)) == 0 ? (i + p) & (l - 1) : (i + p) % l;
 }
 
 // Salts that give each use of a pixel's hash its own stream.
@@ -64,6 +88,7 @@ struct Sampler {
   uint32_t seed = 0;
   uint64_t pixelHash = 0;
   uint32_t index = 0;
+  uint32_t indexInPixel = 0;  // index % spp, taken once a sample rather than once a draw
   uint32_t dim = 0;
   Pcg32 rng;
 
@@ -71,6 +96,7 @@ struct Sampler {
   ENVGI_HD void start(uint64_t pixel, uint32_t sampleIndex) {
     pixelHash = hashCombine(mixBits(pixel), seed);
     index = sampleIndex;
+    indexInPixel = sampleIndex % spp;
     dim = 0;
     rng.setSeed(pixelHash, uint64_t(sampleIndex) + 1u);
   }
@@ -80,13 +106,13 @@ struct Sampler {
     switch (type) {
       case SamplerType::Stratified: {
         uint32_t h = uint32_t(hashCombine(pixelHash, d));
-        uint32_t s = permutationElement(index % spp, spp, h);
+        uint32_t s = permutationElement(indexInPixel, spp, h);
         return (float(s) + rng.nextFloat()) / float(spp) * kOneMinusEpsilon;
       }
       case SamplerType::Sobol: {
         uint32_t h = uint32_t(hashCombine(pixelHash, d));
-        uint32_t i = permutationElement(index % spp, spp, h ^ kSobolShuffle1D);
-        return bitsToFloat01(owenScramble(sobolDim0(i), h));
+        uint32_t i = permutationElement(indexInPixel, spp, h ^ kSobolShuffle1D);
+        return bitsToFloat01(owenScrambleReversed(sobolDim0Reversed(i), h));
       }
       case SamplerType::Independent: break;
     }
@@ -112,9 +138,10 @@ struct Sampler {
       case SamplerType::Sobol: {
         // Independent shuffles per dimension pair decorrelate the pairs (Burley 2020).
         uint32_t h = uint32_t(hashCombine(pixelHash, d));
-        uint32_t i = permutationElement(index % spp, spp, h ^ kSobolShuffle2D);
+        uint32_t i = permutationElement(indexInPixel, spp, h ^ kSobolShuffle2D);
         uint32_t s0 = uint32_t(mixBits(h ^ kOwenSeedX)), s1 = uint32_t(mixBits(h ^ kOwenSeedY));
-        return {bitsToFloat01(owenScramble(sobolDim0(i), s0)), bitsToFloat01(owenScramble(sobolDim1(i), s1))};
+        return {bitsToFloat01(owenScrambleReversed(sobolDim0Reversed(i), s0)),
+                bitsToFloat01(owenScrambleReversed(sobolDim1Reversed(i), s1))};
       }
       case SamplerType::Independent: break;
     }

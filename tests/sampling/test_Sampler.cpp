@@ -73,3 +73,31 @@ TEST(Sampler, PermutationIsBijective) {
     EXPECT_LT(*seen.rbegin(), n);
   }
 }
+
+// The fast forms the Sobol sampler draws through must give the very values of the plain ones:
+// the byte-swap bit reversal, the dimensions built already reversed, the scrambler fed reversed
+// input. The permutation's power-of-two shortcut (a mask for the modulo) must stay a bijection.
+TEST(Sampler, FastFormsMatchThePlainOnes) {
+  auto naiveReverse = [](uint32_t v) {
+    uint32_t r = 0;
+    for (int b = 0; b < 32; ++b) r |= ((v >> b) & 1u) << (31 - b);
+    return r;
+  };
+  Pcg32 rng(11);
+  for (int k = 0; k < 20000; ++k) {
+    uint32_t v = rng.nextUInt(), seed = rng.nextUInt(), i = k < 4096 ? uint32_t(k) : v;
+    ASSERT_EQ(reverseBits32(v), naiveReverse(v));
+    ASSERT_EQ(sobolDim0Reversed(i), reverseBits32(sobolDim0(i)));
+    ASSERT_EQ(sobolDim1Reversed(i), reverseBits32(sobolDim1(i)));
+    ASSERT_EQ(owenScrambleReversed(reverseBits32(v), seed), owenScramble(v, seed));
+  }
+  for (uint32_t l : {1u, 2u, 64u, 1024u}) {
+    std::set<uint32_t> seen;
+    for (uint32_t i = 0; i < l; ++i) {
+      uint32_t e = permutationElement(i, l, 0xdeadbeefu);
+      seen.insert(e);
+      ASSERT_LT(e, l);
+    }
+    EXPECT_EQ(seen.size(), l);
+  }
+}
