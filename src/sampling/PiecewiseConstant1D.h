@@ -8,9 +8,8 @@
 
 namespace envgi {
 
-// Index i in [0, size-2] with cdf[i] <= u < cdf[i+1], for a non-decreasing cdf.
-ENVGI_INLINE int findInterval(const float* cdf, int size, float u) {
-  int lo = 0, hi = size - 2;
+// The largest i in [lo, hi] with cdf[i] <= u (lo if none), for a non-decreasing cdf.
+ENVGI_INLINE int findIntervalBetween(const float* cdf, int lo, int hi, float u) {
   while (lo < hi) {
     int mid = (lo + hi + 1) >> 1;
     if (cdf[mid] <= u) lo = mid;
@@ -19,6 +18,9 @@ ENVGI_INLINE int findInterval(const float* cdf, int size, float u) {
   return lo;
 }
 
+// Index i in [0, size-2] with cdf[i] <= u < cdf[i+1], for a non-decreasing cdf.
+ENVGI_INLINE int findInterval(const float* cdf, int size, float u) { return findIntervalBetween(cdf, 0, size - 2, u); }
+
 // findInterval narrowed by a guide table (Chen and Asau's cutpoints): guide[g] is the index for
 // u = g / G, g in [0, G], with G a power of two so that g / G and u * G are exact in float.
 // The index is non-decreasing in u, so the answer for u lies in [guide[g], guide[g + 1]] with
@@ -26,13 +28,7 @@ ENVGI_INLINE int findInterval(const float* cdf, int size, float u) {
 ENVGI_INLINE int findIntervalGuided(const float* cdf, float u, const int* guide, int G) {
   int g = int(u * float(G));
   g = g < 0 ? 0 : (g > G - 1 ? G - 1 : g);
-  int lo = guide[g], hi = guide[g + 1];
-  while (lo < hi) {
-    int mid = (lo + hi + 1) >> 1;
-    if (cdf[mid] <= u) lo = mid;
-    else hi = mid - 1;
-  }
-  return lo;
+  return findIntervalBetween(cdf, guide[g], guide[g + 1], u);
 }
 
 // Fills guide[0..G] for findIntervalGuided; G must be a power of two.

@@ -22,16 +22,9 @@ ENVGI_INLINE uint32_t reverseBits32(uint32_t v) {
 #endif
 }
 
-// First two dimensions of Sobol': van der Corput and the Pascal-matrix dimension.
-ENVGI_INLINE uint32_t sobolDim0(uint32_t i) { return reverseBits32(i); }
-ENVGI_INLINE uint32_t sobolDim1(uint32_t i) {
-  uint32_t r = 0;
-  for (uint32_t v = 1u << 31; i; i >>= 1, v ^= v >> 1)
-    if (i & 1u) r ^= v;
-  return r;
-}
-// The same two with their bits reversed, the form the scrambler works in: dimension 0 is then
-// the index itself, and dimension 1 builds its reversed generator columns directly.
+// The first two dimensions of Sobol' (van der Corput and the Pascal-matrix dimension) with
+// their bits reversed, the form the scrambler works in: dimension 0 is then the index itself,
+// and dimension 1 builds its reversed generator columns directly.
 ENVGI_INLINE uint32_t sobolDim0Reversed(uint32_t i) { return i; }
 ENVGI_INLINE uint32_t sobolDim1Reversed(uint32_t i) {
   uint32_t r = 0;
@@ -51,11 +44,8 @@ ENVGI_INLINE uint32_t laineKarrasPermutation(uint32_t v, uint32_t seed) {
   return v;
 }
 
-// Nested uniform (Owen) scrambling of a value in natural bit order.
-ENVGI_INLINE uint32_t owenScramble(uint32_t v, uint32_t seed) {
-  return reverseBits32(laineKarrasPermutation(reverseBits32(v), seed));
-}
-// The same for a value handed over already reversed (sobolDim*Reversed): one reversal fewer.
+// Nested uniform (Owen) scrambling of a value handed over with its bits reversed
+// (sobolDim*Reversed); the result is in natural bit order.
 ENVGI_INLINE uint32_t owenScrambleReversed(uint32_t reversedV, uint32_t seed) {
   return reverseBits32(laineKarrasPermutation(reversedV, seed));
 }
