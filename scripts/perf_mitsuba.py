@@ -73,6 +73,8 @@ def main():
     ap.add_argument('--strategy', default='product', help="envgi's environment strategy (its default: product)")
     ap.add_argument('--repeats', type=int, default=3, help='renders per timing; the median time is used')
     args = ap.parse_args()
+    if args.repeats < 1:
+        ap.error('--repeats must be at least 1')
     mi.set_variant(args.variant)
     tmp = tempfile.mkdtemp(prefix='envgi_perf_')
     out = os.path.join(tmp, 'e.exr')
