@@ -3,11 +3,13 @@
 // 2 threads. The ratio is the share of time envgi spends outside Embree.
 // Run: build/bin/envgi_bench_render --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 // ENVGI_BENCH_MESH=/path/to/mesh.ply swaps the Buddha for another mesh (e.g. the 871k dragon),
-// ENVGI_BENCH_ENVMAP=/path/to/map.hdr Grace Cathedral for another map.
+// ENVGI_BENCH_ENVMAP=/path/to/map.hdr Grace Cathedral for another map, ENVGI_BENCH_DEPTH=N the path
+// depth 4 for N (1: camera rays and the map seen directly, 2: one bounce; splits the cost by depth).
 #include <benchmark/benchmark.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cstdlib>
 
 #include "accel/EmbreeAccel.h"
@@ -36,6 +38,11 @@ struct RecordingTracer {
   }
 };
 
+int benchDepth() {
+  const char* d = std::getenv("ENVGI_BENCH_DEPTH");
+  return d ? std::max(1, std::atoi(d)) : 4;
+}
+
 struct Fixture {
   Scene scene;
   std::unique_ptr<EmbreeAccel> accel;
@@ -46,13 +53,13 @@ struct Fixture {
     if (const char* e = std::getenv("ENVGI_BENCH_ENVMAP")) defs["envmap"] = e;
     loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/buddha.xml", defs, scene);
     scene.integrator.type = IntegratorType::Path;
-    scene.integrator.path.maxDepth = 4;
+    scene.integrator.path.maxDepth = benchDepth();
     scene.finalize();
     accel = std::make_unique<EmbreeAccel>(scene);
     // Record the rays of one full render, in the order the path tracer makes them.
     RecordingTracer tr{accel.get(), &rec};
     PathParams pp;
-    pp.maxDepth = 4;
+    pp.maxDepth = benchDepth();
     const Camera& cam = scene.view().camera;
     Sampler smp;
     smp.type = SamplerType::Sobol;
