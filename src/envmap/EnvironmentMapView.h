@@ -7,6 +7,7 @@
 // rotates that frame into the scene.
 #pragma once
 
+#include "core/Atan2.h"
 #include "core/Frame.h"
 #include "core/Transform.h"
 #include "envmap/AdaptiveQuadtree.h"
@@ -62,11 +63,11 @@ struct EnvironmentMapView {
   int pointCount = 0;
 
   ENVGI_HD static Vec2f dirToUV(Vec3f d) {
-    float u = std::atan2(d.x, -d.z) * kInv2Pi;
+    float u = polyAtan2(d.x, -d.z) * kInv2Pi;
     if (u < 0.f) u += 1.f;
     if (!(u < 1.f)) u = 0.f;
     // atan2 rather than acos: acos loses half its digits near the poles.
-    float v = std::atan2(std::sqrt(d.x * d.x + d.z * d.z), d.y) * kInvPi;
+    float v = polyAtan2(std::sqrt(d.x * d.x + d.z * d.z), d.y) * kInvPi;
     return {u, v};
   }
   ENVGI_HD static Vec3f uvToDir(Vec2f uv) {
