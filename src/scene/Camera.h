@@ -19,12 +19,14 @@ struct Camera {
   ENVGI_HD Ray generateRay(float x, float y) const {
     float sx = 2.f * x / float(width) - 1.f, sy = 1.f - 2.f * y / float(height);
     // Camera-space +x is the image's left (lookat builds x = up x dir), so image right is -x.
-    Vec3f d = normalize(Vec3f(-sx * tanHalfX, sy * tanHalfY, 1.f));
+    // On the plane z = 1: its length is 1 / cos of the angle to the axis, which turns the
+    // near and far planes into distances along the ray without normalising twice.
+    Vec3f d(-sx * tanHalfX, sy * tanHalfY, 1.f);
+    float len = length(d);
     Ray r;
-    Vec3f dw = normalize(toWorld.vector(d));
-    r.o = toWorld.point(Vec3f(0.f)) + dw * (nearClip / d.z);
-    r.d = dw;
-    r.tMax = (farClip - nearClip) / d.z;
+    r.d = normalize(toWorld.vector(d));
+    r.o = toWorld.translation() + r.d * (nearClip * len);
+    r.tMax = (farClip - nearClip) * len;
     return r;
   }
 };
