@@ -49,6 +49,11 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
   v.cellsX = cellsX_;
   v.cellsY = cellsY_;
   const int cells = cellsX_ * cellsY_;
+  layout_.reserve(size_t(cellsX_ + 1 + cellsY_ + 1 + width + height));
+  for (int cx = 0; cx <= cellsX_; ++cx) layout_.push_back(v.cellX0(cx));
+  for (int cy = 0; cy <= cellsY_; ++cy) layout_.push_back(v.cellY0(cy));
+  for (int x = 0; x < width; ++x) layout_.push_back(v.cellOfPixel(x, 0));
+  for (int y = 0; y < height; ++y) layout_.push_back(v.cellOfPixel(0, y));
 
   // Per cell: the cdf of its pixels' weights and their sum; its bounding cap on the sphere.
   // Guides: about one entry per 4 pixels of the largest cell (64 at most) and per 4 cells.
@@ -128,6 +133,10 @@ CosineProductView CosineProduct::view() const {
   v.cellSum = cellSum_.data();
   v.bucketGuide = bucketGuide_.data();
   v.cellGuide = cellGuide_.data();
+  v.cellStartX = layout_.data();
+  v.cellStartY = v.cellStartX + cellsX_ + 1;
+  v.columnCell = v.cellStartY + cellsY_ + 1;
+  v.rowCell = v.columnCell + width_;
   v.bucketGuideSize = bucketGuideSize_;
   v.cellGuideSize = cellGuideSize_;
   v.width = width_;
@@ -141,7 +150,7 @@ CosineProductView CosineProduct::view() const {
 size_t CosineProduct::bytes() const {
   return sizeof(float) * (bucketFunc_.size() + bucketCdf_.size() + bucketInt_.size() + cellCdf_.size() +
                           cellSum_.size()) +
-         sizeof(int) * (cellCdfStart_.size() + bucketGuide_.size() + cellGuide_.size());
+         sizeof(int) * (cellCdfStart_.size() + bucketGuide_.size() + cellGuide_.size() + layout_.size());
 }
 
 }  // namespace envgi

@@ -28,6 +28,13 @@ EnvironmentMapView uploadEnvironment(DeviceArena& a, EnvironmentMapView v) {
     p.cellSum = a.upload(p.cellSum, cells, "cosine product tables");
     p.bucketGuide = a.upload(p.bucketGuide, buckets * (p.bucketGuideSize + 1), "cosine product tables");
     p.cellGuide = a.upload(p.cellGuide, cells * (p.cellGuideSize + 1), "cosine product tables");
+    // One block on the host (CosineProduct::layout_): upload it once and point into it.
+    size_t layout = size_t(p.cellsX + 1 + p.cellsY + 1 + p.width + p.height);
+    const int* start = a.upload(p.cellStartX, layout, "cosine product tables");
+    p.cellStartY = start + (p.cellStartY - p.cellStartX);
+    p.columnCell = start + (p.columnCell - p.cellStartX);
+    p.rowCell = start + (p.rowCell - p.cellStartX);
+    p.cellStartX = start;
   }
   return v;
 }
