@@ -62,6 +62,7 @@ struct CosineProductView {
 
   ENVGI_HD bool valid() const { return bucketsPerSide > 0; }
   ENVGI_HD int cells() const { return cellsX * cellsY; }
+  // nLocal of any length: the octahedral map divides by the sum of its components.
   ENVGI_HD int bucket(Vec3f nLocal) const {
     Vec2f o = octahedralEncode(nLocal);
     int bx = clampi(int(o.x * float(bucketsPerSide)), 0, bucketsPerSide - 1);

@@ -62,6 +62,7 @@ struct EnvironmentMapView {
   const DirectionalLight* points = nullptr;  // the collapsed map, when one was made
   int pointCount = 0;
 
+  // d need not be unit: both atan2 calls see its components scaled alike.
   ENVGI_HD static Vec2f dirToUV(Vec3f d) {
     float u = polyAtan2(d.x, -d.z) * kInv2Pi;
     if (u < 0.f) u += 1.f;
@@ -101,10 +102,13 @@ struct EnvironmentMapView {
   }
 
   ENVGI_HD Vec3f toLocal(Vec3f worldDir) const { return normalize(toWorld.inverseVector(worldDir)); }
+  // toLocal up to a positive factor, a square root and a division cheaper: enough for dirToUV
+  // and the product's normal buckets, which do not depend on the length.
+  ENVGI_HD Vec3f toLocalUnnormalized(Vec3f worldDir) const { return toWorld.inverseVector(worldDir); }
   ENVGI_HD Vec3f fromLocal(Vec3f localDir) const { return normalize(toWorld.vector(localDir)); }
 
   // Radiance arriving from world direction d.
-  ENVGI_HD Color eval(Vec3f d) const { return lookupUV(dirToUV(toLocal(d))); }
+  ENVGI_HD Color eval(Vec3f d) const { return lookupUV(dirToUV(toLocalUnnormalized(d))); }
 
   // Density in solid angle of the importance density at (u, v): p(u,v) / (2 pi^2 sin theta).
   // A pixel from an alias table over the map and a position inside it from the bits the choice
@@ -168,7 +172,7 @@ struct EnvironmentMapView {
         Vec3f w = f.toWorld(sampleCosineHemisphere(u));
         out.dir = normalize(w);
         out.pdf = cosineHemispherePdf(dot(out.dir, normal));
-        out.uv = dirToUV(toLocal(out.dir));
+        out.uv = dirToUV(toLocalUnnormalized(out.dir));
         out.radiance = out.pdf > 0.f ? lookupUV(out.uv) : Color(0.f);
         return out;
       }
@@ -193,7 +197,7 @@ struct EnvironmentMapView {
       }
       case EnvStrategy::Product: {
         float pdfUV;
-        if (!product.sample(u, toLocal(normal), dist.condFunc, &out.uv, &pdfUV)) return out;
+        if (!product.sample(u, toLocalUnnormalized(normal), dist.condFunc, &out.uv, &pdfUV)) return out;
         local = uvToDir(out.uv);
         out.pdf = solidAnglePdf(pdfUV, out.uv.y);
         break;
@@ -211,7 +215,7 @@ struct EnvironmentMapView {
         out.dir = points[i].dir;
         out.pdf = points[i].pmf;
         out.radiance = points[i].irradiance;
-        out.uv = dirToUV(toLocal(out.dir));
+        out.uv = dirToUV(toLocalUnnormalized(out.dir));
         out.delta = true;
         return out;
       }
@@ -224,14 +228,14 @@ struct EnvironmentMapView {
   ENVGI_HD float pdf(EnvStrategy s, Vec3f worldDir, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
     EnvStrategy t = strategyFor(s, normal);
     bool mapped = t != EnvStrategy::Uniform && t != EnvStrategy::Cosine && t != EnvStrategy::Points;
-    return pdfAt(t, worldDir, mapped ? dirToUV(toLocal(worldDir)) : Vec2f(0.f, 0.f), normal);
+    return pdfAt(t, worldDir, mapped ? dirToUV(toLocalUnnormalized(worldDir)) : Vec2f(0.f, 0.f), normal);
   }
 
   // Radiance from world direction d and, through *pdfOut, the density strategy s gives it about
   // `normal`: one mapping to (u, v) serves both, which is what a BSDF-sampled ray that escapes
   // needs (two atan2 calls and a rotation fewer than eval() and pdf() apart).
   ENVGI_HD Color evalWithPdf(EnvStrategy s, Vec3f worldDir, Vec3f normal, float* pdfOut) const {
-    Vec2f uv = dirToUV(toLocal(worldDir));
+    Vec2f uv = dirToUV(toLocalUnnormalized(worldDir));
     *pdfOut = pdfAt(strategyFor(s, normal), worldDir, uv, normal);
     return lookupUV(uv);
   }
@@ -246,7 +250,8 @@ struct EnvironmentMapView {
       case EnvStrategy::Alias: return importancePdfUV(uv);
       case EnvStrategy::Adaptive: return adaptive.pdf(uv);
       case EnvStrategy::Points: return 0.f;  // no direction drawn by BSDF sampling hits a point
-      case EnvStrategy::Product: return solidAnglePdf(product.pdf(uv, toLocal(normal), dist.condFunc), uv.y);
+      case EnvStrategy::Product:
+        return solidAnglePdf(product.pdf(uv, toLocalUnnormalized(normal), dist.condFunc), uv.y);
     }
     return 0.f;
   }
