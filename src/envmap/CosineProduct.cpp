@@ -53,7 +53,7 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
   for (int cx = 0; cx <= cellsX_; ++cx) layout_.push_back(v.cellX0(cx));
   for (int cy = 0; cy <= cellsY_; ++cy) layout_.push_back(v.cellY0(cy));
   for (int x = 0; x < width; ++x) layout_.push_back(v.cellOfPixel(x, 0));
-  for (int y = 0; y < height; ++y) layout_.push_back(v.cellOfPixel(0, y));
+  for (int y = 0; y < height; ++y) layout_.push_back(v.cellOfPixel(0, y) / cellsX_);
 
   // Per cell: the cdf of its pixels' weights and their sum; its bounding cap on the sphere.
   // Guides: about one entry per 4 pixels of the largest cell (64 at most) and per 4 cells.
@@ -63,7 +63,7 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
   cellGuide_.resize(size_t(cells) * (cellGuideSize_ + 1));
   bucketGuide_.resize(size_t(bucketsPerSide) * bucketsPerSide * (bucketGuideSize_ + 1));
   cellCdfStart_.resize(size_t(cells));
-  cellSum_.resize(size_t(cells));
+  std::vector<float> cellSum(static_cast<size_t>(cells));
   std::vector<Dir> cellCentre(static_cast<size_t>(cells));
   std::vector<double> cellRadius(static_cast<size_t>(cells));
   std::vector<float> f, func;  // one cell's pixel weights, and build()'s copy of them
@@ -84,7 +84,7 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
       float integral;
       PiecewiseConstant1D::build(f.data(), int(f.size()), func.data(), cellCdf_.data() + cellCdfStart_[size_t(c)],
                                  &integral);
-      cellSum_[size_t(c)] = float(sum);
+      cellSum[size_t(c)] = float(sum);
       buildGuide(cellCdf_.data() + cellCdfStart_[size_t(c)], int(f.size()) + 1, cellGuideSize_,
                  cellGuide_.data() + size_t(c) * (cellGuideSize_ + 1));
       double u0 = double(x0) / width, u1 = double(x1) / width, v0 = double(y0) / height, v1 = double(y1) / height;
@@ -96,7 +96,7 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
   // Per bucket of normals: cell power times the largest cosine any of its normals can have
   // with any direction in the cell (zero only where the whole cell is below every normal).
   const int buckets = buckets_ * buckets_;
-  bucketFunc_.resize(size_t(buckets) * cells);
+  func.resize(size_t(cells));  // build()'s copy of a bucket's weights: not kept, pdfUV reads the cdf
   bucketCdf_.resize(size_t(buckets) * (cells + 1));
   bucketInt_.resize(size_t(buckets));
   std::vector<float> weights(static_cast<size_t>(cells));
@@ -113,9 +113,9 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
       for (int c = 0; c < cells; ++c) {
         double gap = angleBetween(n, cellCentre[size_t(c)]) - cellRadius[size_t(c)] - delta;
         double g = gap <= 0.0 ? 1.0 : (gap < M_PI / 2 ? std::cos(gap) : 0.0);
-        weights[size_t(c)] = float(double(cellSum_[size_t(c)]) * g);
+        weights[size_t(c)] = float(double(cellSum[size_t(c)]) * g);
       }
-      PiecewiseConstant1D::build(weights.data(), cells, bucketFunc_.data() + size_t(k) * cells,
+      PiecewiseConstant1D::build(weights.data(), cells, func.data(),
                                  bucketCdf_.data() + size_t(k) * (cells + 1), &bucketInt_[size_t(k)]);
       buildGuide(bucketCdf_.data() + size_t(k) * (cells + 1), cells + 1, bucketGuideSize_,
                  bucketGuide_.data() + size_t(k) * (bucketGuideSize_ + 1));
@@ -125,12 +125,10 @@ CosineProduct::CosineProduct(const float* w, int width, int height, int cellsX, 
 CosineProductView CosineProduct::view() const {
   CosineProductView v;
   if (buckets_ == 0) return v;
-  v.bucketFunc = bucketFunc_.data();
   v.bucketCdf = bucketCdf_.data();
   v.bucketInt = bucketInt_.data();
   v.cellCdf = cellCdf_.data();
   v.cellCdfStart = cellCdfStart_.data();
-  v.cellSum = cellSum_.data();
   v.bucketGuide = bucketGuide_.data();
   v.cellGuide = cellGuide_.data();
   v.cellStartX = layout_.data();
@@ -148,8 +146,7 @@ CosineProductView CosineProduct::view() const {
 }
 
 size_t CosineProduct::bytes() const {
-  return sizeof(float) * (bucketFunc_.size() + bucketCdf_.size() + bucketInt_.size() + cellCdf_.size() +
-                          cellSum_.size()) +
+  return sizeof(float) * (bucketCdf_.size() + bucketInt_.size() + cellCdf_.size()) +
          sizeof(int) * (cellCdfStart_.size() + bucketGuide_.size() + cellGuide_.size() + layout_.size());
 }
 

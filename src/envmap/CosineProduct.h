@@ -38,20 +38,18 @@ ENVGI_INLINE Vec3f octahedralDecode(Vec2f uv) {
 }
 
 struct CosineProductView {
-  const float* bucketFunc = nullptr;  // buckets x cells: cell power times the cosine bound
-  const float* bucketCdf = nullptr;   // buckets x (cells + 1)
-  const float* bucketInt = nullptr;   // buckets: the mean of each bucket's row of bucketFunc
+  const float* bucketCdf = nullptr;   // buckets x (cells + 1), over cell power times the cosine bound
+  const float* bucketInt = nullptr;   // buckets: the mean cell power times the bound (0: no light)
   const float* cellCdf = nullptr;     // each cell's pixels (row-major inside the cell): pixels + 1 values
   const int* cellCdfStart = nullptr;  // cells: where a cell's cdf begins in cellCdf
-  const float* cellSum = nullptr;     // cells: the sum of the pixel weights inside each cell
   // Guide tables (findIntervalGuided) over bucketCdf, buckets x (bucketGuideSize + 1), and over
   // each cell's cdf, cells x (cellGuideSize + 1): the same draws as binary search, fewer loads.
   const int* bucketGuide = nullptr;
   const int* cellGuide = nullptr;
   int bucketGuideSize = 0, cellGuideSize = 0;
   // cellX0 and cellY0 of every cell column and row (cellsX + 1 and cellsY + 1 entries), and
-  // cellOfPixel split by column (the cell column) and row (cellsX times the cell row): the
-  // per-sample path reads them instead of making seven 64-bit divisions.
+  // the cell column of every pixel column and the cell row of every pixel row: the per-sample
+  // path reads them instead of making 64-bit divisions.
   const int* cellStartX = nullptr;
   const int* cellStartY = nullptr;
   const int* columnCell = nullptr;
@@ -78,18 +76,19 @@ struct CosineProductView {
     return cy * cellsX + cx;
   }
 
-  // Density in (u, v) of drawing pixel (px, py) of cell c for a normal in bucket k; pixelWeight
-  // is that pixel's entry in the map's weights.
-  ENVGI_HD float pdfUV(int k, int c, float pixelWeight) const {
-    int n = cells();
-    float total = bucketInt[k] * float(n), sum = cellSum[c];
-    if (!(total > 0.f) || !(sum > 0.f)) return 0.f;
-    return bucketFunc[size_t(k) * n + c] / total * (pixelWeight / sum) * float(width) * float(height);
+  // Density in (u, v) of pixel j (row-major inside cell c) for a normal in bucket k: the chance
+  // that the two searches pick it, read off the very cdfs they search (so sample() and pdf()
+  // agree to the bit, and a pixel too faint to own a float step of its cdf has no density, as
+  // it is never drawn), times the pixel count, since a pixel spans 1 / (width height) of (u, v).
+  ENVGI_HD float pdfUV(int k, int c, int j) const {
+    if (!(bucketInt[k] > 0.f)) return 0.f;
+    const float* cdf = bucketCdf + size_t(k) * (cells() + 1);
+    const float* pc = cellCdf + cellCdfStart[c];
+    return (cdf[c + 1] - cdf[c]) * (pc[j + 1] - pc[j]) * float(width) * float(height);
   }
 
   // Draws (u, v) for a normal in the map's frame; false where the bucket sees no light.
-  // pixelWeights: the map's per-pixel weights, width x height.
-  ENVGI_HD bool sample(Vec2f u, Vec3f nLocal, const float* pixelWeights, Vec2f* uv, float* pdfOut) const {
+  ENVGI_HD bool sample(Vec2f u, Vec3f nLocal, Vec2f* uv, float* pdfOut) const {
     int k = bucket(nLocal), n = cells();
     if (!(bucketInt[k] > 0.f)) return false;
     const float* cdf = bucketCdf + size_t(k) * (n + 1);
@@ -108,13 +107,15 @@ struct CosineProductView {
     r2 = r2 < kOneMinusEpsilon ? r2 : kOneMinusEpsilon;
     float fx = (float(px) + r1) / float(width), fy = (float(py) + r2) / float(height);
     *uv = {fx < kOneMinusEpsilon ? fx : kOneMinusEpsilon, fy < kOneMinusEpsilon ? fy : kOneMinusEpsilon};
-    *pdfOut = pdfUV(k, c, pixelWeights[size_t(py) * width + px]);
+    *pdfOut = w1 * w2 * float(width) * float(height);  // pdfUV(k, c, j), from the values at hand
     return *pdfOut > 0.f;
   }
 
-  ENVGI_HD float pdf(Vec2f uv, Vec3f nLocal, const float* pixelWeights) const {
+  ENVGI_HD float pdf(Vec2f uv, Vec3f nLocal) const {
     int px = clampi(int(uv.x * float(width)), 0, width - 1), py = clampi(int(uv.y * float(height)), 0, height - 1);
-    return pdfUV(bucket(nLocal), columnCell[px] + rowCell[py], pixelWeights[size_t(py) * width + px]);
+    int cx = columnCell[px], cy = rowCell[py];
+    int x0 = cellStartX[cx], cw = cellStartX[cx + 1] - x0;
+    return pdfUV(bucket(nLocal), cy * cellsX + cx, (py - cellStartY[cy]) * cw + (px - x0));
   }
 };
 
@@ -129,7 +130,7 @@ class CosineProduct {
   size_t bytes() const;
 
  private:
-  std::vector<float> bucketFunc_, bucketCdf_, bucketInt_, cellCdf_, cellSum_;
+  std::vector<float> bucketCdf_, bucketInt_, cellCdf_;
   std::vector<int> cellCdfStart_, bucketGuide_, cellGuide_;
   std::vector<int> layout_;  // cellStartX, cellStartY, columnCell, rowCell, one after the other
   int width_ = 0, height_ = 0, cellsX_ = 0, cellsY_ = 0, buckets_ = 0, bucketGuideSize_ = 0, cellGuideSize_ = 0;

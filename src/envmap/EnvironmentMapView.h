@@ -197,7 +197,7 @@ struct EnvironmentMapView {
       }
       case EnvStrategy::Product: {
         float pdfUV;
-        if (!product.sample(u, toLocalUnnormalized(normal), dist.condFunc, &out.uv, &pdfUV)) return out;
+        if (!product.sample(u, toLocalUnnormalized(normal), &out.uv, &pdfUV)) return out;
         local = uvToDir(out.uv);
         out.pdf = solidAnglePdf(pdfUV, out.uv.y);
         break;
@@ -251,7 +251,7 @@ struct EnvironmentMapView {
       case EnvStrategy::Adaptive: return adaptive.pdf(uv);
       case EnvStrategy::Points: return 0.f;  // no direction drawn by BSDF sampling hits a point
       case EnvStrategy::Product:
-        return solidAnglePdf(product.pdf(uv, toLocalUnnormalized(normal), dist.condFunc), uv.y);
+        return solidAnglePdf(product.pdf(uv, toLocalUnnormalized(normal)), uv.y);
     }
     return 0.f;
   }

@@ -20,12 +20,10 @@ EnvironmentMapView uploadEnvironment(DeviceArena& a, EnvironmentMapView v) {
   if (v.product.valid()) {
     CosineProductView& p = v.product;
     size_t cells = size_t(p.cells()), buckets = size_t(p.bucketsPerSide) * p.bucketsPerSide;
-    p.bucketFunc = a.upload(p.bucketFunc, buckets * cells, "cosine product tables");
     p.bucketCdf = a.upload(p.bucketCdf, buckets * (cells + 1), "cosine product tables");
     p.bucketInt = a.upload(p.bucketInt, buckets, "cosine product tables");
     p.cellCdf = a.upload(p.cellCdf, px + cells, "cosine product tables");
     p.cellCdfStart = a.upload(p.cellCdfStart, cells, "cosine product tables");
-    p.cellSum = a.upload(p.cellSum, cells, "cosine product tables");
     p.bucketGuide = a.upload(p.bucketGuide, buckets * (p.bucketGuideSize + 1), "cosine product tables");
     p.cellGuide = a.upload(p.cellGuide, cells * (p.cellGuideSize + 1), "cosine product tables");
     // One block on the host (CosineProduct::layout_): upload it once and point into it.
