@@ -4,8 +4,9 @@
 // Run: build/bin/envgi_bench_render --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 // BM_ShareOfPlainEmbree gives the ratio itself from back-to-back pairs, robust to drift.
 // ENVGI_BENCH_MESH=/path/to/mesh.ply swaps the Buddha for another mesh (e.g. the 871k dragon),
-// ENVGI_BENCH_ENVMAP=/path/to/map.hdr Grace Cathedral for another map, ENVGI_BENCH_DEPTH=N the path
-// depth 4 for N (1: camera rays and the map seen directly, 2: one bounce; splits the cost by depth).
+// ENVGI_BENCH_ENVMAP=/path/to/map.hdr Grace Cathedral for another map. ENVGI_BENCH_DEPTH=N cuts the
+// paths at depth N instead of 4 (1: camera rays and the map they see; 2: one shading point), which
+// splits the cost by depth.
 #include <benchmark/benchmark.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
