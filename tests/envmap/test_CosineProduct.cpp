@@ -65,7 +65,9 @@ TEST(CosineProduct, BoundIsAtLeastTheCosine) {
     const float* cdf = p.bucketCdf + size_t(k) * (p.cells() + 1);
     double g = double(cdf[c + 1] - cdf[c]) * p.bucketInt[k] * p.cells() / cellPower[size_t(c)];
     float cosine = dot(nl, w);
-    if (g < cosine - 1e-3) ++violations;  // the cdf's float steps carry ~1e-4 of g
+    // Read back through the cdf's float steps, g carries rounding: one of these 200000 pairs
+    // reads between 1e-5 and 2e-5 below its cosine. The stored weights were checked to 1e-5.
+    if (g < cosine - 5e-5) ++violations;
     if (cosine > 0.f && g < cosine + 0.5) ++tight;
     if (cosine > 0.f && !(p.pdf(uv, nl) > 0.f)) ++noDensity;
   }
