@@ -84,7 +84,11 @@ struct CosineProductView {
     if (!(bucketInt[k] > 0.f)) return 0.f;
     const float* cdf = bucketCdf + size_t(k) * (cells() + 1);
     const float* pc = cellCdf + cellCdfStart[c];
-    return (cdf[c + 1] - cdf[c]) * (pc[j + 1] - pc[j]) * float(width) * float(height);
+    return densityOfSteps(cdf[c + 1] - cdf[c], pc[j + 1] - pc[j]);
+  }
+  // The one expression sample() and pdfUV() share, so that they cannot drift apart.
+  ENVGI_HD float densityOfSteps(float cellStep, float pixelStep) const {
+    return cellStep * pixelStep * float(width) * float(height);
   }
 
   // Draws (u, v) for a normal in the map's frame; false where the bucket sees no light.
@@ -107,7 +111,7 @@ struct CosineProductView {
     r2 = r2 < kOneMinusEpsilon ? r2 : kOneMinusEpsilon;
     float fx = (float(px) + r1) / float(width), fy = (float(py) + r2) / float(height);
     *uv = {fx < kOneMinusEpsilon ? fx : kOneMinusEpsilon, fy < kOneMinusEpsilon ? fy : kOneMinusEpsilon};
-    *pdfOut = w1 * w2 * float(width) * float(height);  // pdfUV(k, c, j), from the values at hand
+    *pdfOut = densityOfSteps(w1, w2);  // pdfUV(k, c, j), from the values at hand
     return *pdfOut > 0.f;
   }
 
