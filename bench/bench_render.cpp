@@ -14,6 +14,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 
 #include "accel/EmbreeAccel.h"
@@ -42,9 +43,17 @@ struct RecordingTracer {
   }
 };
 
+// A depth that is not a positive integer ends the run with one line, not a silent depth 1.
 int benchDepth() {
   const char* d = std::getenv("ENVGI_BENCH_DEPTH");
-  return d ? std::max(1, std::atoi(d)) : 4;
+  if (!d) return 4;
+  char* end = nullptr;
+  long n = std::strtol(d, &end, 10);
+  if (end == d || *end != '\0' || n < 1 || n > 1000) {
+    std::fprintf(stderr, "error: ENVGI_BENCH_DEPTH must be a path depth from 1 to 1000, not '%s'\n", d);
+    std::exit(2);
+  }
+  return int(n);
 }
 
 struct Fixture {
