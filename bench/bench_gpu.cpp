@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     std::string a = argv[i];
     auto next = [&] { return i + 1 < argc ? std::string(argv[++i]) : std::string(); };
-    if (a == "--dragon") dragon = next();
+    if (a == "--dragon") dragon = std::filesystem::absolute(next()).string();  // the scene XML resolves relative to itself
     else if (a == "--res") res = std::atoi(next().c_str());
     else if (a == "--frames") frames = std::atoi(next().c_str());
     else if (a == "--spp") spp = std::atoi(next().c_str());

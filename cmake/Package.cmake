@@ -9,6 +9,9 @@ endif()
 if(TARGET envgi_bench_gpu)
   list(APPEND _envgi_programs envgi_bench_gpu)
 endif()
+if(TARGET envgi_cuda_check)
+  list(APPEND _envgi_programs envgi_cuda_check)
+endif()
 set_target_properties(${_envgi_programs} PROPERTIES INSTALL_RPATH "$ORIGIN/../lib" BUILD_WITH_INSTALL_RPATH OFF)
 # DT_RPATH rather than DT_RUNPATH: it also applies to the libraries' own dependencies
 # (OpenEXR's Imath, Iex, zlib), which have no RPATH of their own.

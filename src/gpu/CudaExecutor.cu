@@ -1,5 +1,9 @@
 #include "gpu/CudaExecutor.h"
 
+#include <spdlog/spdlog.h>
+
+#include <atomic>
+
 #include "gpu/CudaPassExecutor.cuh"
 
 namespace envgi::gpu {
@@ -25,6 +29,21 @@ std::string deviceName(int gpu) {
   return p.name;
 }
 
+std::pair<int, int> computeCapability(int gpu) {
+  cudaDeviceProp p;
+  if (cudaGetDeviceProperties(&p, gpu) != cudaSuccess) return {0, 0};
+  return {p.major, p.minor};
+}
+
+bool hasMachineCodeFor(int major, int minor) {
+  // nvcc's list of the virtual architectures compiled (e.g. 800,900); each comes with machine
+  // code here (CMake's "80-real 90"), which runs on later minor versions of the same major.
+  constexpr int archs[] = {__CUDA_ARCH_LIST__};
+  for (int a : archs)
+    if (a / 100 == major && a % 100 / 10 <= minor) return true;
+  return false;
+}
+
 void selectDevice(int gpu) {
   std::string why;
   int n = deviceCount(&why);
@@ -33,6 +52,13 @@ void selectDevice(int gpu) {
     throw std::runtime_error("--gpu " + std::to_string(gpu) + ": this machine has " + std::to_string(n) +
                              " CUDA device(s), numbered from 0");
   check(cudaSetDevice(gpu), "selecting the device");
+  cudaDeviceProp p;
+  check(cudaGetDeviceProperties(&p, gpu), "reading the device's properties");
+  static std::atomic<bool> warned{false};
+  if (!hasMachineCodeFor(p.major, p.minor) && !warned.exchange(true))
+    spdlog::warn("this envgi has no machine code for {} (sm_{}{}): the driver compiles its PTX at the first "
+                 "launch, which takes seconds; rebuild with -DCMAKE_CUDA_ARCHITECTURES={}{}",
+                 p.name, p.major, p.minor, p.major, p.minor);
 }
 
 std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene& scene, const Bvh& bvh, const KernelSettings& k, int gpu,

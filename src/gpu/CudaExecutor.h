@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "accel/Bvh.h"
 #include "integrators/Sppm.h"
@@ -19,8 +20,14 @@ namespace envgi::gpu {
 // or this build has no CUDA.
 int deviceCount(std::string* why);
 std::string deviceName(int gpu);
+// The compute capability (major, minor) of device `gpu`; (0, 0) when it does not exist.
+std::pair<int, int> computeCapability(int gpu);
 
-// Makes CUDA device `gpu` current; throws when it does not exist.
+// Whether this build holds machine code for a GPU of compute capability major.minor (else the
+// driver JIT-compiles PTX at start-up).
+bool hasMachineCodeFor(int major, int minor);
+
+// Makes CUDA device `gpu` current, warning once when it needs PTX JIT; throws when it does not exist.
 void selectDevice(int gpu);
 
 // Uploads the scene and its BVH to GPU `gpu` and runs path/direct passes there; *deviceBytes

@@ -12,6 +12,10 @@ int deviceCount(std::string* why) {
 
 std::string deviceName(int) { return "none"; }
 
+std::pair<int, int> computeCapability(int) { return {0, 0}; }
+
+bool hasMachineCodeFor(int, int) { return false; }
+
 void selectDevice(int) { throw std::runtime_error("no CUDA device: this envgi was built without CUDA"); }
 
 std::unique_ptr<PassExecutor> makeCudaSppmExecutor(const Scene&, const Bvh&, const SppmParams&, const PhotonEmitter&, int,

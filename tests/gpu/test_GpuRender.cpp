@@ -209,6 +209,14 @@ TEST(GpuRender, GridMatchesTheCpu) {
   }
 }
 
+// Without machine code for the device, every program start spends seconds in the driver's
+// PTX JIT (a build for sm_75 took 7-10 s a start on an H200).
+TEST(GpuRender, BuildHasMachineCodeForTheDevice) {
+  auto [major, minor] = gpu::computeCapability(0);
+  EXPECT_TRUE(gpu::hasMachineCodeFor(major, minor)) << "sm_" << major << minor;
+  EXPECT_FALSE(gpu::hasMachineCodeFor(7, 5));
+}
+
 TEST(GpuRender, BadDeviceIndexIsAnError) {
   Scene s;
   loadScene(test::bundledScenesDir() + "/cornell-box.xml", {}, s);

@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# The GPU checks, run from the relocatable package on a machine with an NVIDIA GPU (and nothing
+# else installed): the kernel check, a CLI render per integrator on the device, the GPU test
+# suite and the GPU benchmark. Each step has its own time limit, so one hang cannot eat the
+# machine's time. A summary line per step goes to stdout; into LOGDIR go device-check.log (every
+# step's whole log) and device-check-images.tar (the renders).
+#   bash scripts/device-check.sh build-package/envgi-*-cuda.tar.gz [DRAGON.ply]
+# LOGDIR defaults to $OUT (the device tool's folder) or out/device-check. STEPS picks steps by
+# name (default: "check render tests bench"); a failed step is followed by a compute-sanitizer
+# run of a tiny render when `compute-sanitizer` is on the PATH.
+set -uo pipefail
+pkg=${1:?usage: device-check.sh PACKAGE.tar.gz [DRAGON.ply]}
+dragon=${2:-}
+logdir=${LOGDIR:-${OUT:-out/device-check}}
+steps=${STEPS:-check render tests bench}
+mkdir -p "$logdir"
+rm -f "$logdir/device-check.log"
+work=$(mktemp -d)
+logs=$work/logs
+mkdir -p "$logs"
+tar xf "$pkg" -C "$work" || { echo "device-check: cannot unpack $pkg"; exit 1; }
+root=$(echo "$work"/envgi-*)
+bin=$root/bin
+scenes=$root/share/envgi/scenes
+failed=0
+
+# step NAME LIMIT_S COMMAND...: runs COMMAND with a time limit, its output to logs/NAME.log.
+step() {
+  local name=$1 limit=$2
+  shift 2
+  local t0=$SECONDS
+  timeout --kill-after=5 "$limit" "$@" >"$logs/$name.log" 2>&1
+  local rc=$?
+  local verdict=ok
+  if [ $rc -eq 124 ] || [ $rc -eq 137 ]; then verdict="TIMED OUT after ${limit}s"; failed=1
+  elif [ $rc -eq 77 ]; then verdict="skipped (no device)"
+  elif [ $rc -ne 0 ]; then verdict="FAILED (exit $rc)"; failed=1; fi
+  printf '%-24s %-22s %4ds\n' "$name" "$verdict" $((SECONDS - t0))
+  # Appended as each step ends, so that what finished survives a caller's own time limit.
+  { echo "=== $name: $verdict"; cat "$logs/$name.log"; } >>"$logdir/device-check.log"
+}
+
+command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
+for s in $steps; do
+  case $s in
+    check) step cuda_check 60 "$bin/envgi_cuda_check" ;;
+    render)
+      for integ in path direct sppm grid photon; do
+        step "render_$integ" 60 "$bin/envgi" render "$scenes/buddha.xml" --device cuda --integrator "$integ" \
+          -D res=256 --spp 64 -o "$logs/buddha_$integ.png"
+      done ;;
+    tests) step gpu_tests 240 "$bin/envgi_gpu_tests" ;;
+    bench)
+      if [ -n "$dragon" ]; then step bench_gpu 180 "$bin/envgi_bench_gpu" --dragon "$dragon"
+      else step bench_gpu 180 "$bin/envgi_bench_gpu"; fi ;;
+    *) echo "device-check: unknown step $s"; exit 2 ;;
+  esac
+done
+if [ $failed -ne 0 ] && command -v compute-sanitizer >/dev/null; then
+  step sanitizer_path 120 compute-sanitizer --tool memcheck --print-limit 20 "$bin/envgi" render "$scenes/buddha.xml" \
+    --device cuda --integrator path -D res=32 --spp 2 -o "$logs/sanitizer.png"
+fi
+(cd "$logs" && tar cf "$logdir/device-check-images.tar" --ignore-failed-read ./*.png 2>/dev/null)
+# The end of each log, so that a caller who sees only stdout still sees the figures.
+for f in "$logs"/*.log; do echo "=== $(basename "$f")"; tail -n 25 "$f"; done
+rm -rf "$work"
+exit $failed
