@@ -7,7 +7,8 @@
 // and photons traced and splatted a second, with --sppm-photons a pass. And the photon-map pass
 // (1M global photons stored, no caustic map): photons emitted a second, tracing only. And the
 // grid integrator on the buddha scene (its own settings): ms a 1-spp frame once the grid is
-// built, and what building it took.
+// built, and what building it took. And the viewer orbiting the buddha (bench/ViewOrbit.h): the
+// median time from a camera message to the first frame from that camera, path and grid.
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -27,6 +28,7 @@
 #include "render/SppmExecutor.h"
 #include "scene/SceneLoader.h"
 #include "support/FrameMesh.h"
+#include "ViewOrbit.h"
 
 using namespace envgi;
 
@@ -130,6 +132,11 @@ int main(int argc, char** argv) {
   std::vector<Row> rows;
   std::vector<SppmRow> sppmRows;
   std::vector<std::pair<std::string, double>> mapRows;  // device, M photons emitted a second
+  struct ViewRow {
+    std::string device, integrator;
+    double ms, jpegKB;
+  };
+  std::vector<ViewRow> viewRows;
   try {
     for (auto& [name, mesh] : scenes) {
       Scene s;
@@ -227,6 +234,19 @@ int main(int argc, char** argv) {
       shootPhotons(s, accel, ps, &g, &c, &st);
       mapRows.push_back({st.device, double(st.emittedGlobal) / st.traceSeconds / 1e6});
     }
+    // The viewer orbiting the bundled buddha: camera message to the first frame from it.
+    for (int dev = gpus > 0 ? 0 : 1; dev < (cpu ? 2 : 1); ++dev)
+      for (const char* integ : {"path", "grid"}) {
+        ViewOptions vo;
+        vo.maxSpp = 1;
+        if (dev == 0) vo.prepare = gpu::cudaPreparer(0);
+        bench::ViewOrbit orbit(test::bundledScenesDir() + "/buddha.xml", res, integ, vo);
+        std::vector<double> t;
+        for (int i = 0; i < (dev == 0 ? 4 * frames : frames); ++i) t.push_back(orbit.moveAndWait());
+        std::sort(t.begin(), t.end());
+        viewRows.push_back({dev == 0 ? "cuda:0 (" + gpu::deviceName(0) + ")" : "cpu", integ, t[t.size() / 2],
+                            double(orbit.lastJpegBytes()) / 1e3});
+      }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "envgi_bench_gpu: error: %s\n", e.what());
     return 1;
@@ -243,5 +263,9 @@ int main(int argc, char** argv) {
     std::printf("| %s | %.1f | %d | %.2f |\n", r.device.c_str(), r.passMs, r.passes, r.photonsPerSec / 1e6);
   std::printf("\nphoton-map pass on buddha, 1M global photons stored\n| device | M photons emitted/s |\n|---|---|\n");
   for (auto& [dev, rate] : mapRows) std::printf("| %s | %.2f |\n", dev.c_str(), rate);
+  std::printf("\nviewer orbiting buddha at %dx%d, 1 spp a camera: camera message to its first frame (render, "
+              "tone map, JPEG), median\n| device | integrator | ms | JPEG kB |\n|---|---|---|---|\n", res, res);
+  for (const ViewRow& r : viewRows)
+    std::printf("| %s | %s | %.1f | %.1f |\n", r.device.c_str(), r.integrator.c_str(), r.ms, r.jpegKB);
   return 0;
 }

@@ -6,13 +6,13 @@
 # step's whole log) and device-check-images.tar (the renders).
 #   bash scripts/device-check.sh build-package/envgi-*-cuda.tar.gz [DRAGON.ply]
 # LOGDIR defaults to $OUT (the device tool's folder) or out/device-check. STEPS picks steps by
-# name (default: "check render tests bench"); a failed step is followed by a compute-sanitizer
+# name (default: "check render view tests bench"); a failed step is followed by a compute-sanitizer
 # run of a tiny render when `compute-sanitizer` is on the PATH.
 set -uo pipefail
 pkg=${1:?usage: device-check.sh PACKAGE.tar.gz [DRAGON.ply]}
 dragon=${2:-}
 logdir=${LOGDIR:-${OUT:-out/device-check}}
-steps=${STEPS:-check render tests bench}
+steps=${STEPS:-check render view tests bench}
 mkdir -p "$logdir"
 rm -f "$logdir/device-check.log"
 work=$(mktemp -d)
@@ -40,6 +40,22 @@ step() {
   { echo "=== $name: $verdict"; cat "$logs/$name.log"; } >>"$logdir/device-check.log"
 }
 
+# `envgi view --device cuda` from the command line: the server starts on the GPU, serves the
+# page, and Ctrl-C (SIGINT) stops it with exit code 0.
+view_smoke() {
+  "$1/envgi" view "$2/buddha.xml" --device cuda --port 18734 &
+  local pid=$! ok=1
+  for _ in $(seq 50); do
+    if python3 -c "import urllib.request as u; assert u.urlopen('http://127.0.0.1:18734/', timeout=1).status == 200" \
+      2>/dev/null; then ok=0; break; fi
+    sleep 0.2
+  done
+  kill -INT $pid
+  wait $pid || return 1
+  [ $ok -eq 0 ] || { echo "view_smoke: the page was not served"; return 1; }
+  echo "view_smoke: page served, server stopped cleanly"
+}
+
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
 for s in $steps; do
   case $s in
@@ -50,6 +66,7 @@ for s in $steps; do
           -D res=256 --spp 64 -o "$logs/buddha_$integ.png"
       done ;;
     tests) step gpu_tests 240 "$bin/envgi_gpu_tests" ;;
+    view) step view_server 60 bash -c "$(declare -f view_smoke); view_smoke '$bin' '$scenes'" ;;
     bench)
       if [ -n "$dragon" ]; then step bench_gpu 180 "$bin/envgi_bench_gpu" --dragon "$dragon"
       else step bench_gpu 180 "$bin/envgi_bench_gpu"; fi ;;

@@ -36,14 +36,8 @@ void runView(const ViewArgs& a) {
   vo.threads = a.threads;
   vo.maxSpp = a.maxSpp;
   if (chooseCuda(a.device)) {
-    // The GPU's BVH is built once, on first use: the viewer never changes the geometry.
-    auto bvh = std::make_shared<std::unique_ptr<Bvh>>();
-    int gpu = a.gpu;
-    vo.prepare = [bvh, gpu](const Scene& s, const EmbreeAccel& accel, const RenderOptions& ro) {
-      if (!*bvh) *bvh = std::make_unique<Bvh>(s);
-      return gpu::prepareCudaRender(s, **bvh, &accel, ro, gpu);
-    };
-    spdlog::info("view: rendering on {}", gpu::deviceName(gpu));
+    vo.prepare = gpu::cudaPreparer(a.gpu);
+    spdlog::info("view: rendering on {}", gpu::deviceName(a.gpu));
   }
   ViewSession session(std::move(scene), a.scene, vo);
   ViewServerOptions so;

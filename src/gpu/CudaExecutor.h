@@ -2,6 +2,7 @@
 // compile without nvcc. In a build without CUDA these report that no device exists.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -54,5 +55,9 @@ std::unique_ptr<PassExecutor> makeCudaGridExecutor(const Scene& scene, const Bvh
 // and grid wholly there; photon traces its maps there and needs accel for the rest.
 PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const EmbreeAccel* accel, RenderOptions opts,
                                  int gpu, size_t* deviceBytes = nullptr);
+
+// prepareCudaRender for a scene whose geometry never changes (the viewer): the BVH is built on
+// the first call and kept.
+std::function<PreparedRender(const Scene&, const EmbreeAccel&, const RenderOptions&)> cudaPreparer(int gpu);
 
 }  // namespace envgi::gpu

@@ -43,4 +43,12 @@ PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const Embre
   return pr;
 }
 
+std::function<PreparedRender(const Scene&, const EmbreeAccel&, const RenderOptions&)> cudaPreparer(int gpu) {
+  auto bvh = std::make_shared<std::unique_ptr<Bvh>>();
+  return [bvh, gpu](const Scene& s, const EmbreeAccel& accel, const RenderOptions& ro) {
+    if (!*bvh) *bvh = std::make_unique<Bvh>(s);
+    return prepareCudaRender(s, **bvh, &accel, ro, gpu);
+  };
+}
+
 }  // namespace envgi::gpu

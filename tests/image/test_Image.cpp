@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <filesystem>
 #include <fstream>
 
@@ -40,6 +42,39 @@ TEST(Image, FloatFormatsRoundTrip) {
           EXPECT_NEAR(back.at(x, y)[k], img.at(x, y)[k], tol * std::max(1.f, img.at(x, y)[k])) << ext;
   }
   fs::remove_all(d);
+}
+
+// toneMapImage finds the 8-bit code among the curve's steps; it must agree with rounding the
+// channel curve, but for values within float rounding of a step.
+TEST(Image, ToneMapImageMatchesTheRoundedChannelCurve) {
+  Image img;
+  img.width = 1000;
+  img.height = 1000;
+  img.rgb.resize(size_t(3) * img.width * img.height);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> e(-14.f, 6.f);
+  for (float& v : img.rgb) v = std::exp2(e(rng));
+  img.rgb[0] = NAN;
+  img.rgb[1] = -1.f;
+  img.rgb[2] = INFINITY;
+  for (ToneMap curve : {ToneMap::Clamp, ToneMap::Aces})
+    for (float exposure : {0.f, -1.5f, 2.f}) {
+      SaveOptions o;
+      o.toneMap = curve;
+      o.exposure = exposure;
+      std::vector<unsigned char> ldr = toneMapImage(img, o);
+      size_t off = 0, far = 0;
+      for (size_t i = 0; i < ldr.size(); ++i) {
+        long want = std::lround(toneMapChannel(img.rgb[i], o) * 255.f);
+        off += ldr[i] != want;
+        far += std::abs(long(ldr[i]) - want) > 1;
+      }
+      EXPECT_EQ(far, 0u);
+      EXPECT_LT(off, ldr.size() / 100000) << "exposure " << exposure;
+      EXPECT_EQ(ldr[0], 0);
+      EXPECT_EQ(ldr[1], 0);
+      EXPECT_EQ(ldr[2], 255);
+    }
 }
 
 TEST(Image, PngIsSrgbAfterExposure) {
