@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "image/Image.h"
+#include <stb/stb_image.h>
 
 using namespace envgi;
 namespace fs = std::filesystem;
@@ -75,6 +76,40 @@ TEST(Image, ToneMapImageMatchesTheRoundedChannelCurve) {
       EXPECT_EQ(ldr[1], 0);
       EXPECT_EQ(ldr[2], 255);
     }
+}
+
+// The viewer's frames: a JPEG that decodes (stb_image, an independent decoder) to the image
+// given, within JPEG's loss on a smooth picture; a buffer too short for the size is an error.
+TEST(Image, JpegDecodesBackToTheImage) {
+  const int w = 67, h = 41;
+  std::vector<unsigned char> rgb(size_t(w) * h * 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      unsigned char* p = &rgb[3 * (size_t(y) * w + x)];
+      p[0] = (unsigned char)(255 * x / (w - 1));
+      p[1] = (unsigned char)(255 * y / (h - 1));
+      p[2] = 128;
+    }
+  std::string jpg = encodeJpeg(w, h, rgb, 90);
+  int bw = 0, bh = 0, n = 0;
+  unsigned char* back = stbi_load_from_memory(reinterpret_cast<const unsigned char*>(jpg.data()), int(jpg.size()),
+                                              &bw, &bh, &n, 3);
+  ASSERT_NE(back, nullptr);
+  EXPECT_EQ(bw, w);
+  EXPECT_EQ(bh, h);
+  double sq = 0.0;
+  int worst = 0;
+  for (size_t i = 0; i < rgb.size(); ++i) {
+    int d = std::abs(int(back[i]) - int(rgb[i]));
+    sq += double(d) * d;
+    worst = std::max(worst, d);
+  }
+  stbi_image_free(back);
+  EXPECT_LT(std::sqrt(sq / double(rgb.size())), 2.0);
+  EXPECT_LT(worst, 16);
+  rgb.resize(rgb.size() - 1);
+  EXPECT_THROW(encodeJpeg(w, h, rgb, 90), std::runtime_error);
+  EXPECT_THROW(encodeJpeg(0, h, rgb, 90), std::runtime_error);
 }
 
 TEST(Image, PngIsSrgbAfterExposure) {
