@@ -1,18 +1,19 @@
 #!/usr/bin/env bash
 # The GPU checks, run from the relocatable package on a machine with an NVIDIA GPU (and nothing
-# else installed): the kernel check, a CLI render per integrator on the device, the GPU test
-# suite and the GPU benchmark. Each step has its own time limit, so one hang cannot eat the
+# else installed): the kernel check, a CLI render per integrator on the device, the viewer's
+# server, the GPU test suite, the GPU benchmark, and the study on the GPU against the CPU. Each step has its own time limit, so one hang cannot eat the
 # machine's time. A summary line per step goes to stdout; into LOGDIR go device-check.log (every
 # step's whole log) and device-check-images.tar (the renders).
 #   bash scripts/device-check.sh build-package/envgi-*-cuda.tar.gz [DRAGON.ply]
 # LOGDIR defaults to $OUT (the device tool's folder) or out/device-check. STEPS picks steps by
-# name (default: "check render view tests bench"); a failed step is followed by a compute-sanitizer
+# name (default: "check render view interrupt tests bench study"); a failed step is followed by a compute-sanitizer
 # run of a tiny render when `compute-sanitizer` is on the PATH.
 set -uo pipefail
+here=$(cd "$(dirname "$0")" && pwd)
 pkg=${1:?usage: device-check.sh PACKAGE.tar.gz [DRAGON.ply]}
 dragon=${2:-}
 logdir=${LOGDIR:-${OUT:-out/device-check}}
-steps=${STEPS:-check render view tests bench}
+steps=${STEPS:-check render view interrupt tests bench study}
 mkdir -p "$logdir"
 rm -f "$logdir/device-check.log"
 work=$(mktemp -d)
@@ -56,6 +57,35 @@ view_smoke() {
   echo "view_smoke: page served, server stopped cleanly"
 }
 
+# The paper's study (docs/study.md's command) on the GPU and on the CPU: the wall time of each,
+# and their RMSE tables compared (scripts/compare_study.py).
+study_both() {
+  local args=(study "$2/buddha.xml" -D res=128 --reference-spp 2048 --seeds 2 --time 0.5,2)
+  local t0=$SECONDS
+  "$1/envgi" -q "${args[@]}" -o "$3/study-cuda" --device cuda || return 1
+  echo "study on the GPU: $((SECONDS - t0)) s"
+  t0=$SECONDS
+  "$1/envgi" -q "${args[@]}" -o "$3/study-cpu" --device cpu || return 1
+  echo "study on the CPU ($(nproc) cores): $((SECONDS - t0)) s"
+  cat "$3/study-cuda/results.csv"
+  python3 "$4" "$3/study-cuda/results.csv" "$3/study-cpu/results.csv"
+}
+
+# Ctrl-C during a long GPU render: the finished passes are written, the exit is clean, and how
+# long after the signal it came (a pass runs to its end first).
+interrupt_check() {
+  "$1/envgi" render "$2/buddha.xml" --device cuda -D res=1024 --spp 1000000 -o "$3/long.exr" --no-progress &
+  local pid=$!
+  sleep 5
+  local t0
+  t0=$(date +%s.%N)
+  kill -INT $pid
+  wait $pid
+  local rc=$?
+  echo "exit $rc, $(python3 -c "print(f'{$(date +%s.%N) - $t0:.2f}')") s after SIGINT"
+  [ $rc -eq 0 ] && [ -s "$3/long.exr" ]
+}
+
 command -v nvidia-smi >/dev/null && nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv,noheader
 for s in $steps; do
   case $s in
@@ -66,6 +96,8 @@ for s in $steps; do
           -D res=256 --spp 64 -o "$logs/buddha_$integ.png"
       done ;;
     tests) step gpu_tests 240 "$bin/envgi_gpu_tests" ;;
+    interrupt) step interrupt 60 bash -c "$(declare -f interrupt_check); interrupt_check '$bin' '$scenes' '$work'" ;;
+    study) step study 240 bash -c "$(declare -f study_both); study_both '$bin' '$scenes' '$work' '$here/compare_study.py'" ;;
     view) step view_server 60 bash -c "$(declare -f view_smoke); view_smoke '$bin' '$scenes'" ;;
     bench)
       if [ -n "$dragon" ]; then step bench_gpu 180 "$bin/envgi_bench_gpu" --dragon "$dragon"

@@ -14,9 +14,11 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "accel/Bvh.h"
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
 #include "core/Files.h"
+#include "gpu/CudaExecutor.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
 #include "scene/NameTables.h"
@@ -33,7 +35,8 @@ struct StudyArgs {
   std::string scene, out, reference, strategies = "uniform,cosine,bsdf,adaptive,importance,mis,product,points-64",
                                      spp = "1,4,16,64,256", times, integrator = "direct";
   std::vector<std::string> defines;
-  int seeds = 2, referenceSpp = 4096, threads = 0;
+  int seeds = 2, referenceSpp = 4096, threads = 0, gpu = 0;
+  std::string device = "auto";
 };
 
 std::vector<std::string> splitList(const std::string& s) {
@@ -86,9 +89,18 @@ struct Rendered {
   double seconds = 0.0;
 };
 
-// One run on the study's scene: loaded and traced by Embree once, re-finalised per run for
-// its strategy and seed (finalize keeps the vertex buffers Embree reads in place).
-Rendered renderOnce(const StudyArgs& a, Scene& scene, const EmbreeAccel& accel, const std::string& strategy, int spp,
+// What renders the study's runs: Embree on the CPU, or the CUDA executor over one BVH. The
+// geometry is the same for every run (only strategy and seed change), so both are built once.
+struct StudyDevice {
+  const EmbreeAccel* accel = nullptr;
+  std::unique_ptr<Bvh> bvh;  // set when rendering on the GPU
+  int gpu = 0;
+};
+
+// One run on the study's scene, re-finalised per run for its strategy and seed (finalize keeps
+// the vertex buffers Embree reads in place). Its seconds are the render's alone, without the
+// GPU's scene upload, so that equal-time budgets compare sampling, not start-up.
+Rendered renderOnce(const StudyArgs& a, Scene& scene, const StudyDevice& dev, const std::string& strategy, int spp,
                     uint32_t seed) {
   applyStrategy(strategy, scene);
   scene.sampler.seed = seed;
@@ -99,7 +111,12 @@ Rendered renderOnce(const StudyArgs& a, Scene& scene, const EmbreeAccel& accel, 
   o.threads = a.threads;
   RenderStats st;
   Rendered r;
-  r.image = render(scene, accel, o, &st);
+  if (dev.bvh) {
+    PreparedRender pr = gpu::prepareCudaRender(scene, *dev.bvh, dev.accel, o, dev.gpu);
+    r.image = renderPasses(*pr.executor, scene.camera.width, scene.camera.height, pr.spp, o, &st);
+  } else {
+    r.image = render(scene, *dev.accel, o, &st);
+  }
   r.seconds = st.seconds;
   return r;
 }
@@ -148,7 +165,15 @@ void runStudy(const StudyArgs& a) {
   scene.integrator.type = integrator;
   for (const std::string& s : strategies) applyStrategy(s, scene);  // names checked before any work
   scene.finalize();
+  bool cuda = chooseCuda(a.device);
   EmbreeAccel accel(scene);
+  StudyDevice dev;
+  dev.accel = &accel;
+  dev.gpu = a.gpu;
+  if (cuda) {
+    dev.bvh = std::make_unique<Bvh>(scene);
+    spdlog::info("study: rendering on cuda:{} ({})", a.gpu, gpu::deviceName(a.gpu));
+  }
   fs::create_directories(a.out + "/runs");
   std::string probe = a.out + "/.write_test";
   writeFileAtomically(probe, "ok");  // an unwritable folder fails here, before any rendering
@@ -162,7 +187,7 @@ void runStudy(const StudyArgs& a) {
     spdlog::info("study: reference {}", refPath);
   } else {
     spdlog::info("study: rendering the reference, mis at {} spp", a.referenceSpp);
-    Rendered r = renderOnce(a, scene, accel, "mis", a.referenceSpp, 1000003u);
+    Rendered r = renderOnce(a, scene, dev, "mis", a.referenceSpp, 1000003u);
     ref = r.image;
     saveImage(ref, refPath);
     spdlog::info("study: reference done in {:.1f} s", r.seconds);
@@ -202,7 +227,7 @@ void runStudy(const StudyArgs& a) {
       spdlog::info("study: [{}/{}] {} {} seed {}", done, plan.size(), r.strategy,
                    r.timeBudget > 0 ? fmt::format("{} s ({} spp)", r.timeBudget, r.spp) : fmt::format("{} spp", r.spp),
                    r.seed);
-      Rendered img = renderOnce(a, scene, accel, r.strategy, r.spp, uint32_t(17 + 7919 * r.seed));
+      Rendered img = renderOnce(a, scene, dev, r.strategy, r.spp, uint32_t(17 + 7919 * r.seed));
       ImageError e = imageError(img.image, ref);
       r.seconds = img.seconds;
       r.rmse = e.rmse;
@@ -252,6 +277,8 @@ void addStudyCommand(CLI::App& app) {
   c->add_option("--integrator", a->integrator, "direct (default) or path");
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
   c->add_option("--threads", a->threads, "Worker threads (default: all cores)");
+  c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
+  c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(CLI::NonNegativeNumber);
   c->callback([a] { runStudy(*a); });
 }
 

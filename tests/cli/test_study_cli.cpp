@@ -72,3 +72,30 @@ TEST(StudyCli, BadInputIsOneErrorLine) {
   CliResult unwritable = runCli("study " + buddha() + " -o /proc/envgi_study -D res=16");
   EXPECT_EQ(unwritable.code, 1) << unwritable.output;
 }
+
+// --device as `render` takes it: auto falls back to the CPU where there is no GPU; cuda there is
+// one error line before any work; an unknown device is an error. (With a GPU, the study on it
+// is checked against the CPU's by scripts/device-check.sh.)
+TEST(StudyCli, DeviceChoice) {
+  TempDir d;
+  std::string base = "study " + buddha() + " -D res=12 --spp 1 --seeds 1 --reference-spp 4 --strategies importance -o ";
+  CliResult bad = runCli(base + d.file("bad") + " --device tpu");
+  EXPECT_EQ(bad.code, 1);
+  EXPECT_NE(bad.output.find("unknown device 'tpu'"), std::string::npos) << bad.output;
+  EXPECT_FALSE(fs::exists(d.file("bad") + "/reference.exr"));
+  CliResult cpu = runCli(base + d.file("cpu") + " --device cpu");
+  ASSERT_EQ(cpu.code, 0) << cpu.output;
+  EXPECT_TRUE(fs::exists(d.file("cpu") + "/results.csv"));
+  bool gpu = runCli("render " + buddha() + " -D res=4 --spp 1 --no-progress --device cuda -o " + d.file("p.exr")).code == 0;
+  CliResult cuda = runCli(base + d.file("cuda") + " --device cuda");
+  if (gpu) {
+    EXPECT_EQ(cuda.code, 0) << cuda.output;
+  } else {
+    EXPECT_EQ(cuda.code, 1);
+    EXPECT_NE(cuda.output.find("envgi: error: --device cuda: no CUDA device"), std::string::npos) << cuda.output;
+    EXPECT_FALSE(fs::exists(d.file("cuda") + "/reference.exr"));
+    CliResult autoDev = runCli(base + d.file("auto") + " --device auto");
+    EXPECT_EQ(autoDev.code, 0) << autoDev.output;
+    EXPECT_NE(autoDev.output.find("device: CPU"), std::string::npos) << autoDev.output;
+  }
+}
