@@ -1,5 +1,5 @@
-// Relaxed atomic adds that compile for both host and device: SPPM's photon splats add into
-// per-pixel sums from many threads, on the CPU (oneTBB) and in CUDA kernels alike.
+// Relaxed atomic adds that compile for both host and device: SPPM's photon splats and the GPU's
+// regenerated paths add into per-pixel sums from many threads, on the CPU and in CUDA kernels.
 #pragma once
 
 #include <cstdint>
@@ -15,6 +15,18 @@ ENVGI_INLINE void atomicAddRelaxed(float* p, float v) {
   // GCC/Clang's generic builtins work on float in C++17 too (nvcc's host pass), unlike
   // std::atomic_ref.
   float expected, desired;
+  __atomic_load(p, &expected, __ATOMIC_RELAXED);
+  desired = expected + v;
+  while (!__atomic_compare_exchange(p, &expected, &desired, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
+    desired = expected + v;
+#endif
+}
+
+ENVGI_INLINE void atomicAddRelaxed(double* p, double v) {
+#if defined(__CUDA_ARCH__)
+  atomicAdd(p, v);
+#else
+  double expected, desired;
   __atomic_load(p, &expected, __ATOMIC_RELAXED);
   desired = expected + v;
   while (!__atomic_compare_exchange(p, &expected, &desired, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED))

@@ -18,62 +18,85 @@ struct PathParams {
   EnvStrategy envStrategy = EnvStrategy::Product;
 };
 
+// A path between bounces: what pathStep carries from one bounce to the next. Plain data, so a
+// GPU thread can hold one, end it, and start another (path regeneration).
+struct PathState {
+  Ray ray;
+  Color L, beta;
+  float etaScale;  // product of eta^2 over refractions, for Russian roulette
+  float prevPdf;
+  bool prevDelta;
+  Vec3f prevP, prevAxis;
+  int depth;
+};
+
+ENVGI_HD inline PathState pathBegin(const Ray& ray) {
+  return {ray, Color(0.f), Color(1.f), 1.f, 0.f, true, ray.o, Vec3f(0.f, 0.f, 1.f), 1};
+}
+
+// One bounce of the path: trace st->ray, add what it sees and next-event estimation to st->L,
+// sample the BSDF for the next ray. Returns false once the path has ended.
+template <class Tracer>
+ENVGI_HD bool pathStep(const SceneView& sc, const Tracer& tracer, PathState* st, Sampler& smp, const PathParams& pp,
+                       uint64_t* rayCount) {
+  const int depth = st->depth;
+  const Ray& ray = st->ray;
+  Hit h;
+  ++*rayCount;
+  if (!tracer.intersect(ray, &h)) {
+    if (sc.hasEnvironment && !(depth == 1 && pp.hideEmitters) && envSeenByBsdfSampling(pp.envStrategy, st->prevDelta)) {
+      float lightPdf = 0.f;
+      Color Le = st->prevDelta ? sc.env.eval(ray.d)
+                               : envRadianceAndPdf(sc, pp.envStrategy, ray.d, st->prevAxis, &lightPdf);
+      float w = st->prevDelta ? 1.f : powerHeuristic(1.f, st->prevPdf, 1.f, lightPdf);
+      st->L += st->beta * Le * w;
+    }
+    return false;
+  }
+  SurfaceInteraction si = sc.interaction(ray, h);
+  Vec3f wo = -ray.d;
+  if (si.light >= 0 && !(depth == 1 && pp.hideEmitters)) {
+    Color Le = sc.emitted(si, wo);
+    if (!isBlack(Le)) {
+      float w = st->prevDelta ? 1.f
+                              : powerHeuristic(1.f, st->prevPdf, 1.f, areaLightPdf(sc, si.light, st->prevP, si.p, si.ng));
+      st->L += st->beta * Le * w;
+    }
+  }
+  if (pp.maxDepth >= 0 && depth >= pp.maxDepth) return false;
+  const Bsdf& bsdf = sc.bsdfs[si.bsdf];
+  Vec3f woLocal = si.shading.toLocal(wo);
+  Vec3f axis = envSamplingAxis(si, wo, bsdf);
+
+  // Next-event estimation, weighted against this bounce's BSDF sample.
+  st->L += st->beta * sampleLd(sc, tracer, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, rayCount);
+
+  BsdfSample bs;
+  float uc = smp.get1D();
+  Vec2f ub = smp.get2D();
+  if (!bsdfSample(bsdf, woLocal, uc, ub, &bs)) return false;
+  Vec3f wi = si.shading.toWorld(bs.wi);
+  st->beta *= bs.weight;
+  st->etaScale *= bsdfEtaSquared(bsdf, woLocal, bs.wi);
+  if (isBlack(st->beta)) return false;
+  st->prevPdf = bs.pdf;
+  st->prevDelta = bs.delta;
+  st->prevP = si.p;
+  st->prevAxis = axis;
+  st->ray.o = offsetRayOrigin(si.p, si.ng, wi, si.t);
+  st->ray.d = wi;
+  st->ray.tMax = INFINITY;
+  st->depth = depth + 1;
+  return depth < pp.rrDepth || russianRoulette(&st->beta, smp.get1D(), kRouletteMaxSurvival, st->etaScale);
+}
+
 template <class Tracer>
 ENVGI_HD Color pathTrace(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& smp, const PathParams& pp,
                          uint64_t* rayCount) {
-  Color L(0.f), beta(1.f);
-  float etaScale = 1.f;  // product of eta^2 over refractions, for Russian roulette
-  float prevPdf = 0.f;
-  bool prevDelta = true;
-  Vec3f prevP = ray.o, prevAxis(0.f, 0.f, 1.f);
-  for (int depth = 1;; ++depth) {
-    Hit h;
-    ++*rayCount;
-    if (!tracer.intersect(ray, &h)) {
-      if (sc.hasEnvironment && !(depth == 1 && pp.hideEmitters) && envSeenByBsdfSampling(pp.envStrategy, prevDelta)) {
-        float lightPdf = 0.f;
-        Color Le = prevDelta ? sc.env.eval(ray.d) : envRadianceAndPdf(sc, pp.envStrategy, ray.d, prevAxis, &lightPdf);
-        float w = prevDelta ? 1.f : powerHeuristic(1.f, prevPdf, 1.f, lightPdf);
-        L += beta * Le * w;
-      }
-      break;
-    }
-    SurfaceInteraction si = sc.interaction(ray, h);
-    Vec3f wo = -ray.d;
-    if (si.light >= 0 && !(depth == 1 && pp.hideEmitters)) {
-      Color Le = sc.emitted(si, wo);
-      if (!isBlack(Le)) {
-        float w = prevDelta ? 1.f : powerHeuristic(1.f, prevPdf, 1.f, areaLightPdf(sc, si.light, prevP, si.p, si.ng));
-        L += beta * Le * w;
-      }
-    }
-    if (pp.maxDepth >= 0 && depth >= pp.maxDepth) break;
-    const Bsdf& bsdf = sc.bsdfs[si.bsdf];
-    Vec3f woLocal = si.shading.toLocal(wo);
-    Vec3f axis = envSamplingAxis(si, wo, bsdf);
-
-    // Next-event estimation, weighted against this bounce's BSDF sample.
-    L += beta * sampleLd(sc, tracer, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, rayCount);
-
-    BsdfSample bs;
-    float uc = smp.get1D();
-    Vec2f ub = smp.get2D();
-    if (!bsdfSample(bsdf, woLocal, uc, ub, &bs)) break;
-    Vec3f wi = si.shading.toWorld(bs.wi);
-    beta *= bs.weight;
-    etaScale *= bsdfEtaSquared(bsdf, woLocal, bs.wi);
-    if (isBlack(beta)) break;
-    prevPdf = bs.pdf;
-    prevDelta = bs.delta;
-    prevP = si.p;
-    prevAxis = axis;
-    ray.o = offsetRayOrigin(si.p, si.ng, wi, si.t);
-    ray.d = wi;
-    ray.tMax = INFINITY;
-
-    if (depth >= pp.rrDepth && !russianRoulette(&beta, smp.get1D(), kRouletteMaxSurvival, etaScale)) break;
+  PathState st = pathBegin(ray);
+  while (pathStep(sc, tracer, &st, smp, pp, rayCount)) {
   }
-  return L;
+  return st.L;
 }
 
 }  // namespace envgi

@@ -2,6 +2,7 @@
 // a pixel's samples [s0, s1) traced by an integrator and added to the film. Plain data only.
 #pragma once
 
+#include "core/Atomic.h"
 #include "integrators/DirectIntegrator.h"
 #include "integrators/PathIntegrator.h"
 #include "sampling/Sampler.h"
@@ -30,6 +31,26 @@ struct SampleIntegrator {
     return type == SampleIntegratorType::Direct ? directTrace(*scene, tracer, ray, smp, direct, rays)
                                                 : pathTrace(*scene, tracer, ray, smp, path, rays);
   }
+  // The same sample one bounce a call (regeneratePaths): begin, then step until it returns
+  // false; the radiance is then in the state's L. direct is one step.
+  ENVGI_HD PathState begin(const Ray& ray) const { return pathBegin(ray); }
+  ENVGI_HD bool step(PathState* st, Sampler& smp, uint64_t* rays) const {
+    if (type == SampleIntegratorType::Direct) {
+      st->L = directTrace(*scene, tracer, st->ray, smp, direct, rays);
+      return false;
+    }
+    return pathStep(*scene, tracer, st, smp, path, rays);
+  }
+};
+
+// Integrators that run one bounce a call, so regeneratePaths can drive them.
+template <class T>
+struct RunsByBounce {
+  static constexpr bool value = false;
+};
+template <class Tracer>
+struct RunsByBounce<SampleIntegrator<Tracer>> {
+  static constexpr bool value = true;
 };
 
 // What the path and direct kernels run with (Renderer's kernelSettings() fills it from a scene).
@@ -54,7 +75,23 @@ struct PixelCounters {
   uint64_t dropped = 0;  // NaN, infinite or negative samples, left out of the sums
 };
 
-// Samples [s0, s1) of pixel (x, y). The same (pixel, sample) gives the same sample on any device.
+// Starts sample s of pixel (x, y): the sampler at its first dimension, the filter offset, the
+// camera ray. The same (pixel, sample) gives the same sample on any device.
+ENVGI_HD inline Ray startCameraSample(const Camera& cam, Sampler& smp, int x, int y, int s) {
+  smp.start(uint64_t(y) * uint64_t(cam.width) + uint64_t(x), uint32_t(s));
+  Vec2f off = sampleFilter(cam.filter, smp.get2D());
+  return cam.generateRay(float(x) + 0.5f + off.x, float(y) + 0.5f + off.y);
+}
+
+// Whether a sample's radiance goes into the film; NaN, infinite or negative ones are counted
+// as dropped instead.
+ENVGI_HD inline bool acceptedSample(const Color& L, PixelCounters* counters) {
+  if (isFiniteVec(L) && L.x >= 0.f && L.y >= 0.f && L.z >= 0.f) return true;
+  ++counters->dropped;
+  return false;
+}
+
+// Samples [s0, s1) of pixel (x, y).
 template <class Integrator>
 ENVGI_HD void renderPixel(const Camera& cam, const SampleSequence& seq, const Integrator& integrate, int x, int y,
                           int s0, int s1, FilmView film, PixelCounters* counters) {
@@ -66,19 +103,48 @@ ENVGI_HD void renderPixel(const Camera& cam, const SampleSequence& seq, const In
   double accSq = 0.0;
   size_t pixel = size_t(y) * size_t(cam.width) + size_t(x);
   for (int s = s0; s < s1; ++s) {
-    smp.start(uint64_t(pixel), uint32_t(s));
-    Vec2f off = sampleFilter(cam.filter, smp.get2D());
-    Ray ray = cam.generateRay(float(x) + 0.5f + off.x, float(y) + 0.5f + off.y);
-    Color L = integrate(ray, smp, &counters->rays);
-    if (!isFiniteVec(L) || L.x < 0.f || L.y < 0.f || L.z < 0.f) {
-      ++counters->dropped;
-      continue;
-    }
+    Color L = integrate(startCameraSample(cam, smp, x, y, s), smp, &counters->rays);
+    if (!acceptedSample(L, counters)) continue;
     acc += L;
     accSq += double(luminance(L)) * double(luminance(L));
   }
   film.sum[pixel] += acc;
   if (film.sumSqLum) film.sumSqLum[pixel] += accSq;
+}
+
+// Samples [s0, s1) of every pixel by path regeneration (Novak et al. 2010), for a GPU thread:
+// whenever its path ends, the thread takes the next (pixel, sample) from fetch() (items numbered
+// sample-major, so a warp's fresh items are neighbouring pixels) instead of idling while its
+// warp's longest path finishes. Any thread may finish any pixel's sample, so the film sums are
+// added atomically. With one thread and a counting fetch it adds each pixel's samples in the
+// order renderPixel does, so a fresh film gets the same sums bit for bit.
+template <class Integrator, class Fetch>
+ENVGI_HD void regeneratePaths(const Camera& cam, const SampleSequence& seq, const Integrator& integ, int s0, int s1,
+                              FilmView film, Fetch fetch, PixelCounters* counters) {
+  const uint64_t npix = uint64_t(cam.width) * uint64_t(cam.height), total = npix * uint64_t(s1 - s0);
+  Sampler smp;
+  smp.type = seq.type;
+  smp.spp = seq.spp;
+  smp.seed = seq.seed;
+  PathState st = integ.begin(Ray{});
+  uint64_t pixel = 0;
+  bool active = false;
+  for (;;) {
+    if (!active) {
+      uint64_t item = fetch();
+      if (item >= total) break;
+      pixel = item % npix;
+      int x = int(pixel % uint64_t(cam.width)), y = int(pixel / uint64_t(cam.width));
+      st = integ.begin(startCameraSample(cam, smp, x, y, s0 + int(item / npix)));
+    }
+    active = integ.step(&st, smp, &counters->rays);
+    if (!active && acceptedSample(st.L, counters)) {
+      atomicAddRelaxed(&film.sum[pixel].x, st.L.x);
+      atomicAddRelaxed(&film.sum[pixel].y, st.L.y);
+      atomicAddRelaxed(&film.sum[pixel].z, st.L.z);
+      if (film.sumSqLum) atomicAddRelaxed(&film.sumSqLum[pixel], double(luminance(st.L)) * double(luminance(st.L)));
+    }
+  }
 }
 
 }  // namespace envgi
