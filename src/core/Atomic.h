@@ -8,17 +8,24 @@
 
 namespace envgi {
 
-ENVGI_INLINE void atomicAddRelaxed(float* p, float v) {
-#if defined(__CUDA_ARCH__)
-  atomicAdd(p, v);
-#else
-  // GCC/Clang's generic builtins work on float in C++17 too (nvcc's host pass), unlike
-  // std::atomic_ref.
-  float expected, desired;
+#if !defined(__CUDA_ARCH__)
+// GCC/Clang's generic builtins work on float and double in C++17 too (nvcc's host pass),
+// unlike std::atomic_ref.
+template <class T>
+inline void atomicAddByCas(T* p, T v) {
+  T expected, desired;
   __atomic_load(p, &expected, __ATOMIC_RELAXED);
   desired = expected + v;
   while (!__atomic_compare_exchange(p, &expected, &desired, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
     desired = expected + v;
+}
+#endif
+
+ENVGI_INLINE void atomicAddRelaxed(float* p, float v) {
+#if defined(__CUDA_ARCH__)
+  atomicAdd(p, v);
+#else
+  atomicAddByCas(p, v);
 #endif
 }
 
@@ -26,11 +33,7 @@ ENVGI_INLINE void atomicAddRelaxed(double* p, double v) {
 #if defined(__CUDA_ARCH__)
   atomicAdd(p, v);
 #else
-  double expected, desired;
-  __atomic_load(p, &expected, __ATOMIC_RELAXED);
-  desired = expected + v;
-  while (!__atomic_compare_exchange(p, &expected, &desired, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED))
-    desired = expected + v;
+  atomicAddByCas(p, v);
 #endif
 }
 
