@@ -6,7 +6,8 @@
 # step's whole log) and device-check-images.tar (the renders).
 #   bash scripts/device-check.sh build-package/envgi-*-cuda.tar.gz [DRAGON.ply]
 # LOGDIR defaults to $OUT (the device tool's folder) or out/device-check. STEPS picks steps by
-# name (default: "check render view interrupt tests bench study"); a failed step is followed by a compute-sanitizer
+# name (default: "check render view interrupt tests bench study"; also bench_perpixel, the path
+# kernel without path regeneration); a failed step is followed by a compute-sanitizer
 # run of a tiny render when `compute-sanitizer` is on the PATH.
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
@@ -102,6 +103,8 @@ for s in $steps; do
     bench)
       if [ -n "$dragon" ]; then step bench_gpu 180 "$bin/envgi_bench_gpu" --dragon "$dragon"
       else step bench_gpu 180 "$bin/envgi_bench_gpu"; fi ;;
+    bench_perpixel)  # the path kernel without path regeneration, for an A/B with "bench"
+      ENVGI_GPU_REGEN=0 step bench_perpixel 120 "$bin/envgi_bench_gpu" --no-cpu ${dragon:+--dragon "$dragon"} ;;
     *) echo "device-check: unknown step $s"; exit 2 ;;
   esac
 done

@@ -1,7 +1,8 @@
-// The render loop's passes on a CUDA GPU for any per-sample integrator (path/direct, the grid
-// integrator's camera samples): one thread a pixel runs renderPixel, the CPU executor's body,
-// over its samples of the pass. The device scene and whatever else the integrator reads live
-// in the DeviceScene's arena, which this executor owns. CUDA-only.
+// The render loop's passes on a CUDA GPU for any per-sample integrator: path and direct by
+// path regeneration (regeneratePaths), others (the grid integrator's camera samples) one thread
+// a pixel running renderPixel, the CPU executor's body, over its samples of the pass. The
+// device scene and whatever else the integrator reads live in the DeviceScene's arena, which
+// this executor owns. CUDA-only.
 #pragma once
 
 #include <cooperative_groups.h>
