@@ -12,21 +12,20 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <csetjmp>
-#include <cstdlib>
-// jpeglib.h needs FILE and size_t declared first.
-#include <cstdio>
-#include <jpeglib.h>
-
 #include <algorithm>
 #include <cmath>
+#include <csetjmp>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
+
+// After <cstdio>: jpeglib.h needs FILE and size_t declared first.
+#include <jpeglib.h>
 
 namespace envgi {
 
