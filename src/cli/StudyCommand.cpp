@@ -87,6 +87,7 @@ void applyStrategy(const std::string& name, Scene& scene) {
 struct Rendered {
   Image image;
   double seconds = 0.0;
+  std::string device;
 };
 
 // What renders the study's runs: Embree on the CPU, or the CUDA executor over one BVH. The
@@ -114,8 +115,10 @@ Rendered renderOnce(const StudyArgs& a, Scene& scene, const StudyDevice& dev, co
   if (dev.bvh) {
     PreparedRender pr = gpu::prepareCudaRender(scene, *dev.bvh, dev.accel, o, dev.gpu);
     r.image = renderPasses(*pr.executor, scene.camera.width, scene.camera.height, pr.spp, o, &st);
+    r.device = pr.executor->deviceName();
   } else {
     r.image = render(scene, *dev.accel, o, &st);
+    r.device = "cpu";
   }
   r.seconds = st.seconds;
   return r;
@@ -129,7 +132,7 @@ std::string runKey(const StudyRun& r) {
 nlohmann::json toJson(const StudyRun& r) {
   return {{"strategy", r.strategy}, {"spp", r.spp},          {"time_budget", r.timeBudget}, {"seed", r.seed},
           {"seconds", r.seconds},   {"rmse", r.rmse},        {"relmse", r.relMse},
-          {"worst_region_rmse", r.worstRegionRmse}};
+          {"worst_region_rmse", r.worstRegionRmse}, {"device", r.device}};
 }
 
 StudyRun fromJson(const nlohmann::json& j) {
@@ -142,6 +145,7 @@ StudyRun fromJson(const nlohmann::json& j) {
   r.rmse = j.at("rmse");
   r.relMse = j.at("relmse");
   r.worstRegionRmse = j.value("worst_region_rmse", 0.0);
+  r.device = j.value("device", std::string());
   return r;
 }
 
@@ -230,6 +234,7 @@ void runStudy(const StudyArgs& a) {
       Rendered img = renderOnce(a, scene, dev, r.strategy, r.spp, uint32_t(17 + 7919 * r.seed));
       ImageError e = imageError(img.image, ref);
       r.seconds = img.seconds;
+      r.device = img.device;
       r.rmse = e.rmse;
       r.relMse = e.relMse;
       r.worstRegionRmse = e.worstRegionRmse;
@@ -245,11 +250,11 @@ void runStudy(const StudyArgs& a) {
     }
     runs.push_back(r);
   }
-  std::string csv = "strategy,spp,time_budget,seed,seconds,rmse,relmse,worst_region_rmse\n";
+  std::string csv = "strategy,spp,time_budget,seed,seconds,rmse,relmse,worst_region_rmse,device\n";
   nlohmann::json all = nlohmann::json::array();
   for (const StudyRun& r : runs) {
-    csv += fmt::format("{},{},{},{},{:.6f},{:.8g},{:.8g},{:.8g}\n", r.strategy, r.spp, r.timeBudget, r.seed, r.seconds,
-                       r.rmse, r.relMse, r.worstRegionRmse);
+    csv += fmt::format("{},{},{},{},{:.6f},{:.8g},{:.8g},{:.8g},\"{}\"\n", r.strategy, r.spp, r.timeBudget, r.seed,
+                       r.seconds, r.rmse, r.relMse, r.worstRegionRmse, r.device);
     all.push_back(toJson(r));
   }
   writeFileAtomically(a.out + "/results.csv", csv);

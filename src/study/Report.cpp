@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <set>
 
 #include "study/ErrorMetrics.h"
 
@@ -147,6 +148,12 @@ std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun
                   "td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}figure{display:inline-block;margin:6px}"
                   "figcaption{font-size:12px;text-align:center}img{image-rendering:pixelated;width:192px}</style></head><body>";
   h += "<h1>Strategies compared: " + escape(scene) + "</h1>";
+  // Times (and so the equal-time runs) are the device's: say which rendered the runs.
+  std::set<std::string> devices;
+  for (const StudyRun& r : runs) devices.insert(r.device.empty() ? "not recorded" : r.device);
+  std::string deviceList;
+  for (const std::string& d : devices) deviceList += (deviceList.empty() ? "" : "; ") + escape(d);
+  h += "<p>Rendered on: " + deviceList + ".</p>";
   h += "<p>RMSE against the reference, median over seeds. Lower is better; a slope of -1/2 on the "
        "samples plot is an unbiased estimator's Monte Carlo rate, a flattening curve is bias (the "
        "collapsed map, <code>points-N</code>).</p>";

@@ -26,6 +26,9 @@ TEST(StudyCli, WritesResultsAndResumes) {
     EXPECT_TRUE(fs::exists(out + "/" + f)) << f;
   std::string csv = slurp(out + "/results.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 3 * 2 + 3);  // header, spp runs, time runs
+  // Each run says what rendered it: times, and so equal-time results, are the device's.
+  EXPECT_EQ(csv.substr(0, csv.find('\n')), "strategy,spp,time_budget,seed,seconds,rmse,relmse,worst_region_rmse,device");
+  EXPECT_NE(csv.find(",\"cpu\"\n"), std::string::npos) << csv;
   // The unbiased strategies converge: importance at 16 spp beats importance at 1.
   auto rmseOf = [&](const std::string& prefix) {
     size_t p = csv.find(prefix);
@@ -38,6 +41,7 @@ TEST(StudyCli, WritesResultsAndResumes) {
   EXPECT_LT(rmseOf("importance,16,"), rmseOf("importance,1,"));
   std::string html = slurp(out + "/report.html");
   EXPECT_NE(html.find("<svg"), std::string::npos);
+  EXPECT_NE(html.find("Rendered on: cpu."), std::string::npos);
   EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
   // Re-run: every run is found done.
   CliResult again = runCli(args);
