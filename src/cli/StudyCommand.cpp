@@ -9,12 +9,12 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
 
-#include "accel/Bvh.h"
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
 #include "core/Files.h"
@@ -90,19 +90,15 @@ struct Rendered {
   std::string device;
 };
 
-// What renders the study's runs: Embree on the CPU, or the CUDA executor over one BVH. The
-// geometry is the same for every run (only strategy and seed change), so both are built once.
-struct StudyDevice {
-  const EmbreeAccel* accel = nullptr;
-  std::unique_ptr<Bvh> bvh;  // set when rendering on the GPU
-  int gpu = 0;
-};
+// What renders the study's runs on the GPU: gpu::cudaPreparer, which builds the BVH on the first
+// run and keeps it (only strategy and seed change between runs); unset, the CPU's prepareRender.
+using Preparer = std::function<PreparedRender(const Scene&, const EmbreeAccel&, const RenderOptions&)>;
 
 // One run on the study's scene, re-finalised per run for its strategy and seed (finalize keeps
 // the vertex buffers Embree reads in place). Its seconds are the render's alone, without the
 // GPU's scene upload, so that equal-time budgets compare sampling, not start-up.
-Rendered renderOnce(const StudyArgs& a, Scene& scene, const StudyDevice& dev, const std::string& strategy, int spp,
-                    uint32_t seed) {
+Rendered renderOnce(const StudyArgs& a, Scene& scene, const EmbreeAccel& accel, const Preparer& prepare,
+                    const std::string& strategy, int spp, uint32_t seed) {
   applyStrategy(strategy, scene);
   scene.sampler.seed = seed;
   scene.finalize();
@@ -112,14 +108,9 @@ Rendered renderOnce(const StudyArgs& a, Scene& scene, const StudyDevice& dev, co
   o.threads = a.threads;
   RenderStats st;
   Rendered r;
-  if (dev.bvh) {
-    PreparedRender pr = gpu::prepareCudaRender(scene, *dev.bvh, dev.accel, o, dev.gpu);
-    r.image = renderPasses(*pr.executor, scene.camera.width, scene.camera.height, pr.spp, o, &st);
-    r.device = pr.executor->deviceName();
-  } else {
-    r.image = render(scene, *dev.accel, o, &st);
-    r.device = "cpu";
-  }
+  PreparedRender pr = prepare ? prepare(scene, accel, o) : prepareRender(scene, accel, o);
+  r.image = renderPasses(*pr.executor, scene.camera.width, scene.camera.height, pr.spp, o, &st);
+  r.device = pr.executor->deviceName();
   r.seconds = st.seconds;
   return r;
 }
@@ -171,11 +162,9 @@ void runStudy(const StudyArgs& a) {
   scene.finalize();
   bool cuda = chooseCuda(a.device);
   EmbreeAccel accel(scene);
-  StudyDevice dev;
-  dev.accel = &accel;
-  dev.gpu = a.gpu;
+  Preparer prepare;
   if (cuda) {
-    dev.bvh = std::make_unique<Bvh>(scene);
+    prepare = gpu::cudaPreparer(a.gpu);
     spdlog::info("study: rendering on cuda:{} ({})", a.gpu, gpu::deviceName(a.gpu));
   }
   fs::create_directories(a.out + "/runs");
@@ -191,7 +180,7 @@ void runStudy(const StudyArgs& a) {
     spdlog::info("study: reference {}", refPath);
   } else {
     spdlog::info("study: rendering the reference, mis at {} spp", a.referenceSpp);
-    Rendered r = renderOnce(a, scene, dev, "mis", a.referenceSpp, 1000003u);
+    Rendered r = renderOnce(a, scene, accel, prepare, "mis", a.referenceSpp, 1000003u);
     ref = r.image;
     saveImage(ref, refPath);
     spdlog::info("study: reference done in {:.1f} s", r.seconds);
@@ -231,7 +220,7 @@ void runStudy(const StudyArgs& a) {
       spdlog::info("study: [{}/{}] {} {} seed {}", done, plan.size(), r.strategy,
                    r.timeBudget > 0 ? fmt::format("{} s ({} spp)", r.timeBudget, r.spp) : fmt::format("{} spp", r.spp),
                    r.seed);
-      Rendered img = renderOnce(a, scene, dev, r.strategy, r.spp, uint32_t(17 + 7919 * r.seed));
+      Rendered img = renderOnce(a, scene, accel, prepare, r.strategy, r.spp, uint32_t(17 + 7919 * r.seed));
       ImageError e = imageError(img.image, ref);
       r.seconds = img.seconds;
       r.device = img.device;

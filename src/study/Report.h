@@ -15,7 +15,7 @@ struct StudyRun {
   double timeBudget = 0.0;  // 0: an equal-samples run
   int seed = 0;
   double seconds = 0.0, rmse = 0.0, relMse = 0.0, worstRegionRmse = 0.0;
-  std::string device;  // what rendered it ("cpu", "cuda:0 (NVIDIA H200, regeneration)"): times depend on it
+  std::string device{};  // what rendered it ("cpu", "cuda:0 (NVIDIA H200, regeneration)"): times depend on it
 };
 
 struct StudyImage {
