@@ -75,6 +75,15 @@ struct PixelCounters {
   uint64_t dropped = 0;  // NaN, infinite or negative samples, left out of the sums
 };
 
+// A sampler over the pass's sequence, to be started per sample.
+ENVGI_HD inline Sampler sequenceSampler(const SampleSequence& seq) {
+  Sampler smp;
+  smp.type = seq.type;
+  smp.spp = seq.spp;
+  smp.seed = seq.seed;
+  return smp;
+}
+
 // Starts sample s of pixel (x, y): the sampler at its first dimension, the filter offset, the
 // camera ray. The same (pixel, sample) gives the same sample on any device.
 ENVGI_HD inline Ray startCameraSample(const Camera& cam, Sampler& smp, int x, int y, int s) {
@@ -95,10 +104,7 @@ ENVGI_HD inline bool acceptedSample(const Color& L, PixelCounters* counters) {
 template <class Integrator>
 ENVGI_HD void renderPixel(const Camera& cam, const SampleSequence& seq, const Integrator& integrate, int x, int y,
                           int s0, int s1, FilmView film, PixelCounters* counters) {
-  Sampler smp;
-  smp.type = seq.type;
-  smp.spp = seq.spp;
-  smp.seed = seq.seed;
+  Sampler smp = sequenceSampler(seq);
   Color acc(0.f);
   double accSq = 0.0;
   size_t pixel = size_t(y) * size_t(cam.width) + size_t(x);
@@ -122,10 +128,7 @@ template <class Integrator, class Fetch>
 ENVGI_HD void regeneratePaths(const Camera& cam, const SampleSequence& seq, const Integrator& integ, int s0, int s1,
                               FilmView film, Fetch fetch, PixelCounters* counters) {
   const uint64_t npix = uint64_t(cam.width) * uint64_t(cam.height), total = npix * uint64_t(s1 - s0);
-  Sampler smp;
-  smp.type = seq.type;
-  smp.spp = seq.spp;
-  smp.seed = seq.seed;
+  Sampler smp = sequenceSampler(seq);
   PathState st = integ.begin(Ray{});
   uint64_t pixel = 0;
   bool active = false;
