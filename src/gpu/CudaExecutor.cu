@@ -52,13 +52,12 @@ void selectDevice(int gpu) {
     throw std::runtime_error("--gpu " + std::to_string(gpu) + ": this machine has " + std::to_string(n) +
                              " CUDA device(s), numbered from 0");
   check(cudaSetDevice(gpu), "selecting the device");
-  cudaDeviceProp p;
-  check(cudaGetDeviceProperties(&p, gpu), "reading the device's properties");
+  auto [major, minor] = computeCapability(gpu);
   static std::atomic<bool> warned{false};
-  if (!hasMachineCodeFor(p.major, p.minor) && !warned.exchange(true))
+  if (!hasMachineCodeFor(major, minor) && !warned.exchange(true))
     spdlog::warn("this envgi has no machine code for {} (sm_{}{}): the driver compiles its PTX at the first "
                  "launch, which takes seconds; rebuild with -DCMAKE_CUDA_ARCHITECTURES={}{}",
-                 p.name, p.major, p.minor, p.major, p.minor);
+                 deviceName(gpu), major, minor, major, minor);
 }
 
 std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene& scene, const Bvh& bvh, const KernelSettings& k, int gpu,
