@@ -34,16 +34,16 @@ ENVGI_HD inline PathState pathBegin(const Ray& ray) {
   return {ray, Color(0.f), Color(1.f), 1.f, 0.f, true, ray.o, Vec3f(0.f, 0.f, 1.f), 1};
 }
 
-// One bounce of the path: trace st->ray, add what it sees and next-event estimation to st->L,
-// sample the BSDF for the next ray. Returns false once the path has ended.
+// One bounce of the path after st->ray has been traced (found: whether it hit, h: where): add
+// what it sees and next-event estimation to st->L, sample the BSDF for the next ray. Returns
+// false once the path has ended. Apart from pathStep, so that an executor can trace many
+// paths' rays together (ray packets) and then shade them.
 template <class Tracer>
-ENVGI_HD bool pathStep(const SceneView& sc, const Tracer& tracer, PathState* st, Sampler& smp, const PathParams& pp,
-                       uint64_t* rayCount) {
+ENVGI_HD bool pathShade(const SceneView& sc, const Tracer& tracer, PathState* st, bool found, const Hit& h, Sampler& smp,
+                        const PathParams& pp, uint64_t* rayCount) {
   const int depth = st->depth;
   const Ray& ray = st->ray;
-  Hit h;
-  ++*rayCount;
-  if (!tracer.intersect(ray, &h)) {
+  if (!found) {
     if (sc.hasEnvironment && !(depth == 1 && pp.hideEmitters) && envSeenByBsdfSampling(pp.envStrategy, st->prevDelta)) {
       float lightPdf = 0.f;
       Color Le = st->prevDelta ? sc.env.eval(ray.d)
@@ -88,6 +88,16 @@ ENVGI_HD bool pathStep(const SceneView& sc, const Tracer& tracer, PathState* st,
   st->ray.tMax = INFINITY;
   st->depth = depth + 1;
   return depth < pp.rrDepth || russianRoulette(&st->beta, smp.get1D(), kRouletteMaxSurvival, st->etaScale);
+}
+
+// One bounce of the path: trace st->ray, then pathShade.
+template <class Tracer>
+ENVGI_HD bool pathStep(const SceneView& sc, const Tracer& tracer, PathState* st, Sampler& smp, const PathParams& pp,
+                       uint64_t* rayCount) {
+  Hit h;
+  ++*rayCount;
+  bool found = tracer.intersect(st->ray, &h);
+  return pathShade(sc, tracer, st, found, h, smp, pp, rayCount);
 }
 
 template <class Tracer>

@@ -1,13 +1,18 @@
-// Runs render passes on the CPU: oneTBB over image tiles, each pixel through renderPixel, the
-// same body the CUDA kernel runs. Deterministic whatever the thread count (no shared sums).
+// Runs render passes on the CPU: oneTBB over image tiles, each tile a bounce at a time
+// (renderTileByBounce) for the path tracer, each pixel through renderPixel for the others; both
+// run the integrator bodies the CUDA kernels run. Deterministic whatever the thread count (no
+// shared sums), and the same sums either way.
 #pragma once
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cstdlib>
+#include <cstring>
 
 #include "render/PassExecutor.h"
 #include "render/PixelKernel.h"
@@ -24,9 +29,15 @@ class CpuExecutor final : public PassExecutor {
         tile_(tileSize) {
     film_.sum.assign(size_t(cam.width) * cam.height, Color(0.f));
     if (keepVariance) film_.sumSqLum.assign(film_.sum.size(), 0.0);
+    if constexpr (RunsByBounce<Integrator>::value) {
+      // A bounce at a time unless ENVGI_CPU_BY_BOUNCE=0 asks for renderPixel (for A/B timings:
+      // docs/performance.md); the film is the same to the bit either way.
+      const char* e = std::getenv("ENVGI_CPU_BY_BOUNCE");
+      byBounce_ = integrate_.shadesAfterTrace() && !(e && std::strcmp(e, "0") == 0);
+    }
   }
 
-  std::string deviceName() const override { return name_; }
+  std::string deviceName() const override { return byBounce_ ? name_ + " (by bounce)" : name_; }
 
   void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
     int W = cam_.width, H = cam_.height;
@@ -39,6 +50,13 @@ class CpuExecutor final : public PassExecutor {
         for (int t = r.begin(); t < r.end(); ++t) {
           int x0 = (t % tilesX) * tile_, y0 = (t / tilesX) * tile_;
           int x1 = std::min(W, x0 + tile_), y1 = std::min(H, y0 + tile_);
+          if constexpr (RunsByBounce<Integrator>::value) {
+            if (byBounce_) {
+              renderTileByBounce(cam_, seq_, integrate_, x0, y0, x1, y1, s0, s1, fv, &batch_.local(), &pc);
+              progress.add(size_t(x1 - x0) * size_t(y1 - y0) * size_t(s1 - s0));
+              continue;
+            }
+          }
           for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) renderPixel(cam_, seq_, integrate_, x, y, s0, s1, fv, &pc);
           progress.add(size_t(x1 - x0) * size_t(y1 - y0) * size_t(s1 - s0));
@@ -67,7 +85,9 @@ class CpuExecutor final : public PassExecutor {
   tbb::task_arena arena_;
   std::string name_;
   int tile_;
+  bool byBounce_ = false;
   FilmSums film_;
+  tbb::enumerable_thread_specific<TileBatch> batch_;  // renderTileByBounce's room, one per thread
 };
 
 }  // namespace envgi
