@@ -10,26 +10,53 @@
 
 namespace envgi {
 
-// Returns f * L * w / (pdf * nE) for one light sample, zero if it is blocked or the BSDF is a
-// pure delta. Its three sample dimensions are drawn whatever happens, so sequences stay
-// aligned across pixels.
+// One light sample before its shadow ray: f * L * w / (pdf * nE), which counts only if the ray
+// from o along d (to tMax) is unblocked; no ray (and nothing) for a sample below the surface, a
+// black one or a pure delta BSDF.
+struct LightSampleLd {
+  Color value;
+  Vec3f o, d;
+  float tMax = 0.f;
+  bool needsRay = false;
+};
+
+// Its three sample dimensions are drawn whatever happens, so sequences stay aligned across
+// pixels.
+ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
+                                        Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
+                                        Sampler& smp) {
+  LightSampleLd out;
+  float uSel = smp.get1D();
+  Vec2f uL = smp.get2D(), uL2 = smp.get2D();
+  LightSample ls;
+  if (bsdfIsDelta(bsdf) || !sampleLight(sc, si, axis, strategy, uSel, uL, uL2, &ls)) return out;
+  Vec3f wiLocal = si.shading.toLocal(ls.dir);
+  Color f = bsdfEval(bsdf, woLocal, wiLocal);
+  if (isBlack(f) || isBlack(ls.radiance)) return out;
+  out.o = offsetRayOrigin(si.p, si.ng, ls.dir, si.t);
+  out.d = ls.dir;
+  out.tMax = ls.environment ? INFINITY : ls.dist * (1.f - 1e-4f) - length(out.o - si.p);
+  float w = nB > 0.f && !ls.delta ? powerHeuristic(nE, ls.pdf, nB, bsdfPdf(bsdf, woLocal, wiLocal)) : 1.f;
+  out.value = f * ls.radiance * (w / (ls.pdf * nE));
+  out.needsRay = true;
+  return out;
+}
+
+// The sample's contribution once its shadow ray's answer is known.
+ENVGI_HD inline Color resolvedLd(const LightSampleLd& ld, bool occluded) {
+  return ld.needsRay && !occluded ? ld.value : Color(0.f);
+}
+
+// prepareLd with its shadow ray traced now: f * L * w / (pdf * nE) for one light sample, zero if
+// it is blocked.
 template <class Tracer>
 ENVGI_HD Color sampleLd(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& si, const Bsdf& bsdf,
                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB, Sampler& smp,
                         uint64_t* rayCount) {
-  float uSel = smp.get1D();
-  Vec2f uL = smp.get2D(), uL2 = smp.get2D();
-  LightSample ls;
-  if (bsdfIsDelta(bsdf) || !sampleLight(sc, si, axis, strategy, uSel, uL, uL2, &ls)) return Color(0.f);
-  Vec3f wiLocal = si.shading.toLocal(ls.dir);
-  Color f = bsdfEval(bsdf, woLocal, wiLocal);
-  if (isBlack(f) || isBlack(ls.radiance)) return Color(0.f);
-  Vec3f o = offsetRayOrigin(si.p, si.ng, ls.dir, si.t);
-  float tMax = ls.environment ? INFINITY : ls.dist * (1.f - 1e-4f) - length(o - si.p);
+  LightSampleLd ld = prepareLd(sc, si, bsdf, woLocal, axis, strategy, nE, nB, smp);
+  if (!ld.needsRay) return Color(0.f);
   ++*rayCount;
-  if (tracer.occluded(o, ls.dir, tMax)) return Color(0.f);
-  float w = nB > 0.f && !ls.delta ? powerHeuristic(nE, ls.pdf, nB, bsdfPdf(bsdf, woLocal, wiLocal)) : 1.f;
-  return f * ls.radiance * (w / (ls.pdf * nE));
+  return resolvedLd(ld, tracer.occluded(ld.o, ld.d, ld.tMax));
 }
 
 }  // namespace envgi

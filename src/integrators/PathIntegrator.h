@@ -34,13 +34,30 @@ ENVGI_HD inline PathState pathBegin(const Ray& ray) {
   return {ray, Color(0.f), Color(1.f), 1.f, 0.f, true, ray.o, Vec3f(0.f, 0.f, 1.f), 1};
 }
 
-// One bounce of the path after st->ray has been traced (found: whether it hit, h: where): add
-// what it sees and next-event estimation to st->L, sample the BSDF for the next ray. Returns
-// false once the path has ended. Apart from pathStep, so that an executor can trace many
-// paths' rays together (ray packets) and then shade them.
+// Next-event estimation's shadow ray traced at once, its contribution added to the path
+// (pathStep's way; an executor that traces many paths' shadow rays together keeps ld and the
+// path's beta instead, and adds beta * resolvedLd(ld, blocked) before the path goes on).
 template <class Tracer>
-ENVGI_HD bool pathShade(const SceneView& sc, const Tracer& tracer, PathState* st, bool found, const Hit& h, Sampler& smp,
-                        const PathParams& pp, uint64_t* rayCount) {
+struct ShadowRayNow {
+  const Tracer& tracer;
+  uint64_t* rayCount;
+  ENVGI_HD void operator()(const LightSampleLd& ld, PathState* st) const {
+    Color Ld(0.f);
+    if (ld.needsRay) {
+      ++*rayCount;
+      Ld = resolvedLd(ld, tracer.occluded(ld.o, ld.d, ld.tMax));
+    }
+    st->L += st->beta * Ld;
+  }
+};
+
+// One bounce of the path after st->ray has been traced (found: whether it hit, h: where): add
+// what it sees to st->L, hand next-event estimation's sample to shadow (ShadowRayNow or an
+// executor's batch), sample the BSDF for the next ray. Returns false once the path has ended.
+// Apart from pathStep, so that an executor can trace many paths' rays together, then shade them.
+template <class Shadow>
+ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hit& h, Sampler& smp,
+                        const PathParams& pp, const Shadow& shadow) {
   const int depth = st->depth;
   const Ray& ray = st->ray;
   if (!found) {
@@ -69,7 +86,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, const Tracer& tracer, PathState* st
   Vec3f axis = envSamplingAxis(si, wo, bsdf);
 
   // Next-event estimation, weighted against this bounce's BSDF sample.
-  st->L += st->beta * sampleLd(sc, tracer, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, rayCount);
+  shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp), st);
 
   BsdfSample bs;
   float uc = smp.get1D();
@@ -97,7 +114,7 @@ ENVGI_HD bool pathStep(const SceneView& sc, const Tracer& tracer, PathState* st,
   Hit h;
   ++*rayCount;
   bool found = tracer.intersect(st->ray, &h);
-  return pathShade(sc, tracer, st, found, h, smp, pp, rayCount);
+  return pathShade(sc, st, found, h, smp, pp, ShadowRayNow<Tracer>{tracer, rayCount});
 }
 
 template <class Tracer>

@@ -46,8 +46,9 @@ struct SampleIntegrator {
   // step() with the trace taken out, for an executor that traces many paths' rays together
   // (renderTileByBounce): only path runs this way, since direct traces inside its one step.
   ENVGI_HD bool shadesAfterTrace() const { return type == SampleIntegratorType::Path; }
-  ENVGI_HD bool shade(PathState* st, bool found, const Hit& h, Sampler& smp, uint64_t* rays) const {
-    return pathShade(*scene, tracer, st, found, h, smp, path, rays);
+  template <class Shadow>
+  ENVGI_HD bool shade(PathState* st, bool found, const Hit& h, Sampler& smp, const Shadow& shadow) const {
+    return pathShade(*scene, st, found, h, smp, path, shadow);
   }
 };
 
@@ -164,13 +165,28 @@ struct TileBatch {
   std::vector<PathState> state;
   std::vector<Sampler> sampler;
   std::vector<Hit> hit;
-  std::vector<unsigned char> found;
+  std::vector<unsigned char> found, going, nee, blocked;
   std::vector<int> active;
+  std::vector<LightSampleLd> ld;  // each path's next-event sample of this round
+  std::vector<Color> ldBeta;      // and the path's beta when it was drawn
   std::vector<Color> acc;
   std::vector<double> accSq;
   void resize(size_t n) {
     if (state.size() >= n) return;
-    state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), active.resize(n), acc.resize(n), accSq.resize(n);
+    state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), nee.resize(n);
+    blocked.resize(n), active.resize(n);
+    ld.resize(n), ldBeta.resize(n), acc.resize(n), accSq.resize(n);
+  }
+};
+
+// Keeps a path's next-event sample for the round's shadow rays (renderTileByBounce).
+struct ShadowRayLater {
+  TileBatch* b;
+  ENVGI_HD void operator()(const LightSampleLd& ld, PathState* st) const {
+    size_t k = size_t(st - b->state.data());
+    b->ld[k] = ld;
+    b->ldBeta[k] = st->beta;
+    b->nee[k] = 1;
   }
 };
 
@@ -199,10 +215,26 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         b->found[k] = integ.tracer.intersect(b->state[k].ray, &b->hit[k]);
       }
       counters->rays += uint64_t(live);
+      // Shade, then trace the round's shadow rays back to back, then add what got through, each
+      // before anything later in its path, as pathStep adds it.
+      for (int i = 0; i < live; ++i) {
+        int k = b->active[i];
+        b->nee[k] = 0;
+        b->going[k] = integ.shade(&b->state[k], b->found[k] != 0, b->hit[k], b->sampler[k], ShadowRayLater{b});
+      }
       int next = 0;
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];
-        if (integ.shade(&b->state[k], b->found[k] != 0, b->hit[k], b->sampler[k], &counters->rays)) {
+        b->blocked[k] = 0;
+        if (b->nee[k] && b->ld[k].needsRay) {
+          ++counters->rays;
+          b->blocked[k] = integ.tracer.occluded(b->ld[k].o, b->ld[k].d, b->ld[k].tMax);
+        }
+      }
+      for (int i = 0; i < live; ++i) {
+        int k = b->active[i];
+        if (b->nee[k]) b->state[k].L += b->ldBeta[k] * resolvedLd(b->ld[k], b->blocked[k] != 0);
+        if (b->going[k]) {
           b->active[next++] = k;
         } else if (acceptedSample(b->state[k].L, counters)) {
           const Color& L = b->state[k].L;
