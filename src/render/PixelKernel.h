@@ -179,10 +179,11 @@ struct TileBatch {
   }
 };
 
-// Keeps a path's next-event sample for the round's shadow rays (renderTileByBounce).
+// Keeps a path's next-event sample for the round's shadow rays (renderTileByBounce; CPU only).
+// st is one of b->state, whose index names the path's slots.
 struct ShadowRayLater {
   TileBatch* b;
-  ENVGI_HD void operator()(const LightSampleLd& ld, PathState* st) const {
+  void operator()(const LightSampleLd& ld, PathState* st) const {
     size_t k = size_t(st - b->state.data());
     b->ld[k] = ld;
     b->ldBeta[k] = st->beta;
@@ -193,8 +194,8 @@ struct ShadowRayLater {
 // Samples [s0, s1) of the tile [x0, x1) x [y0, y1) a bounce at a time (CPU): sample s of every
 // pixel starts together, then each round traces all live paths' rays back to back and shades
 // them back to back, instead of alternating one ray's traversal with its shading. That keeps
-// the BVH, then the map's tables, in cache across a round (renderPixel: 8% slower on the
-// buddha bench). Each pixel adds its samples in renderPixel's order, so the film's sums are the
+// the BVH, then the map's tables, in cache across a round (renderPixel took 4-8% longer on the
+// buddha bench: docs/performance.md). Each pixel adds its samples in renderPixel's order, so the film's sums are the
 // same to the bit.
 template <class Integrator>
 void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Integrator& integ, int x0, int y0, int x1,
@@ -222,7 +223,6 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         b->nee[k] = 0;
         b->going[k] = integ.shade(&b->state[k], b->found[k] != 0, b->hit[k], b->sampler[k], ShadowRayLater{b});
       }
-      int next = 0;
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];
         b->blocked[k] = 0;
@@ -231,6 +231,7 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
           b->blocked[k] = integ.tracer.occluded(b->ld[k].o, b->ld[k].d, b->ld[k].tMax);
         }
       }
+      int next = 0;
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];
         if (b->nee[k]) b->state[k].L += b->ldBeta[k] * resolvedLd(b->ld[k], b->blocked[k] != 0);
