@@ -47,6 +47,14 @@ ENVGI_HD inline Color resolvedLd(const LightSampleLd& ld, bool occluded) {
   return ld.needsRay && !occluded ? ld.value : Color(0.f);
 }
 
+// Traces the sample's shadow ray, if it has one (counted in *rayCount): whether it is blocked.
+template <class Tracer>
+ENVGI_HD bool shadowRayBlocked(const Tracer& tracer, const LightSampleLd& ld, uint64_t* rayCount) {
+  if (!ld.needsRay) return false;
+  ++*rayCount;
+  return tracer.occluded(ld.o, ld.d, ld.tMax);
+}
+
 // prepareLd with its shadow ray traced now: f * L * w / (pdf * nE) for one light sample, zero if
 // it is blocked.
 template <class Tracer>
@@ -54,9 +62,7 @@ ENVGI_HD Color sampleLd(const SceneView& sc, const Tracer& tracer, const Surface
                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB, Sampler& smp,
                         uint64_t* rayCount) {
   LightSampleLd ld = prepareLd(sc, si, bsdf, woLocal, axis, strategy, nE, nB, smp);
-  if (!ld.needsRay) return Color(0.f);
-  ++*rayCount;
-  return resolvedLd(ld, tracer.occluded(ld.o, ld.d, ld.tMax));
+  return resolvedLd(ld, shadowRayBlocked(tracer, ld, rayCount));
 }
 
 }  // namespace envgi

@@ -42,12 +42,7 @@ struct ShadowRayNow {
   const Tracer& tracer;
   uint64_t* rayCount;
   ENVGI_HD void operator()(const LightSampleLd& ld, PathState* st) const {
-    Color Ld(0.f);
-    if (ld.needsRay) {
-      ++*rayCount;
-      Ld = resolvedLd(ld, tracer.occluded(ld.o, ld.d, ld.tMax));
-    }
-    st->L += st->beta * Ld;
+    st->L += st->beta * resolvedLd(ld, shadowRayBlocked(tracer, ld, rayCount));
   }
 };
 

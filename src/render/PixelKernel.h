@@ -52,7 +52,8 @@ struct SampleIntegrator {
   }
 };
 
-// Integrators that run one bounce a call, so regeneratePaths can drive them.
+// Integrators that run one bounce a call, so regeneratePaths and renderTileByBounce can drive
+// them.
 template <class T>
 struct RunsByBounce {
   static constexpr bool value = false;
@@ -165,7 +166,7 @@ struct TileBatch {
   std::vector<PathState> state;
   std::vector<Sampler> sampler;
   std::vector<Hit> hit;
-  std::vector<unsigned char> found, going, nee, blocked;
+  std::vector<unsigned char> found, going;
   std::vector<int> active;
   std::vector<LightSampleLd> ld;  // each path's next-event sample of this round
   std::vector<Color> ldBeta;      // and the path's beta when it was drawn
@@ -173,21 +174,21 @@ struct TileBatch {
   std::vector<double> accSq;
   void resize(size_t n) {
     if (state.size() >= n) return;
-    state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), nee.resize(n);
-    blocked.resize(n), active.resize(n);
+    state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), active.resize(n);
     ld.resize(n), ldBeta.resize(n), acc.resize(n), accSq.resize(n);
   }
 };
 
 // Keeps a path's next-event sample for the round's shadow rays (renderTileByBounce; CPU only).
-// st is one of b->state, whose index names the path's slots.
+// st is one of b->state, whose index names the path's slots. A sample without a ray adds its
+// zero now, as ShadowRayNow would.
 struct ShadowRayLater {
   TileBatch* b;
   void operator()(const LightSampleLd& ld, PathState* st) const {
     size_t k = size_t(st - b->state.data());
     b->ld[k] = ld;
     b->ldBeta[k] = st->beta;
-    b->nee[k] = 1;
+    if (!ld.needsRay) st->L += st->beta * resolvedLd(ld, false);
   }
 };
 
@@ -195,8 +196,8 @@ struct ShadowRayLater {
 // pixel starts together, then each round traces all live paths' rays back to back and shades
 // them back to back, instead of alternating one ray's traversal with its shading. That keeps
 // the BVH, then the map's tables, in cache across a round (renderPixel took 4-8% longer on the
-// buddha bench: docs/performance.md). Each pixel adds its samples in renderPixel's order, so the film's sums are the
-// same to the bit.
+// buddha bench: docs/performance.md). Each pixel adds its samples in renderPixel's order, so
+// the film's sums are the same to the bit.
 template <class Integrator>
 void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Integrator& integ, int x0, int y0, int x1,
                         int y1, int s0, int s1, FilmView film, TileBatch* b, PixelCounters* counters) {
@@ -216,25 +217,19 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         b->found[k] = integ.tracer.intersect(b->state[k].ray, &b->hit[k]);
       }
       counters->rays += uint64_t(live);
-      // Shade, then trace the round's shadow rays back to back, then add what got through, each
+      // Shade, then trace the round's shadow rays back to back, each adding what got through
       // before anything later in its path, as pathStep adds it.
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];
-        b->nee[k] = 0;
+        b->ld[k].needsRay = false;
         b->going[k] = integ.shade(&b->state[k], b->found[k] != 0, b->hit[k], b->sampler[k], ShadowRayLater{b});
-      }
-      for (int i = 0; i < live; ++i) {
-        int k = b->active[i];
-        b->blocked[k] = 0;
-        if (b->nee[k] && b->ld[k].needsRay) {
-          ++counters->rays;
-          b->blocked[k] = integ.tracer.occluded(b->ld[k].o, b->ld[k].d, b->ld[k].tMax);
-        }
       }
       int next = 0;
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];
-        if (b->nee[k]) b->state[k].L += b->ldBeta[k] * resolvedLd(b->ld[k], b->blocked[k] != 0);
+        const LightSampleLd& ld = b->ld[k];
+        if (ld.needsRay)
+          b->state[k].L += b->ldBeta[k] * resolvedLd(ld, shadowRayBlocked(integ.tracer, ld, &counters->rays));
         if (b->going[k]) {
           b->active[next++] = k;
         } else if (acceptedSample(b->state[k].L, counters)) {
