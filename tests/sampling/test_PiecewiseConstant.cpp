@@ -86,6 +86,13 @@ TEST(PiecewiseConstant1D, GuidedSearchEqualsBinarySearch) {
     us.push_back(kOneMinusEpsilon);
     for (float u : us) ASSERT_EQ(findIntervalGuided(cdf, u, guide.data(), G), findInterval(cdf, size, u)) << "G " << G << " u " << u;
   }
+  // The branch-free search the guide hands its range to, on any range, an empty one and NaN.
+  for (int i = 0; i < 20000; ++i) {
+    int lo = int(rng.nextUInt() % uint32_t(size)), hi = lo + int(rng.nextUInt() % 40u) - 5;
+    hi = hi < size - 1 ? hi : size - 1;
+    float u = i % 1000 == 0 ? std::nanf("") : rng.nextFloat();
+    ASSERT_EQ(findIntervalBetweenNoBranch(cdf, lo, hi, u), findIntervalBetween(cdf, lo, hi, u)) << lo << " " << hi;
+  }
   std::vector<int> guide(4);
   EXPECT_THROW(buildGuide(cdf, size, 3, guide.data()), std::invalid_argument);
   EXPECT_EQ(guideSize(2048, 4), 512);
