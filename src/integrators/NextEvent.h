@@ -31,12 +31,13 @@ ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceIntera
   LightSample ls;
   if (bsdfIsDelta(bsdf) || !sampleLight(sc, si, axis, strategy, uSel, uL, uL2, &ls)) return out;
   Vec3f wiLocal = si.shading.toLocal(ls.dir);
-  Color f = bsdfEval(bsdf, woLocal, wiLocal);
+  float bsdfPdfOfLight;
+  Color f = bsdfEvalPdf(bsdf, woLocal, wiLocal, &bsdfPdfOfLight);
   if (isBlack(f) || isBlack(ls.radiance)) return out;
   out.o = offsetRayOrigin(si.p, si.ng, ls.dir, si.t);
   out.d = ls.dir;
   out.tMax = ls.environment ? INFINITY : ls.dist * (1.f - 1e-4f) - length(out.o - si.p);
-  float w = nB > 0.f && !ls.delta ? powerHeuristic(nE, ls.pdf, nB, bsdfPdf(bsdf, woLocal, wiLocal)) : 1.f;
+  float w = nB > 0.f && !ls.delta ? powerHeuristic(nE, ls.pdf, nB, bsdfPdfOfLight) : 1.f;
   out.value = f * ls.radiance * (w / (ls.pdf * nE));
   out.needsRay = true;
   return out;

@@ -68,10 +68,14 @@ ENVGI_INLINE float plasticSpecularProb(const Bsdf& b, float fo) {
   return ps + pd > 0.f ? ps / (ps + pd) : 0.f;
 }
 
-// Diffuse base under a coating (Mitsuba's plastic, linear mode).
-ENVGI_INLINE Color plasticDiffuse(const Bsdf& b, Vec3f wo, Vec3f wi) {
-  float ti = 1.f - fresnelDielectric(wi.z, b.ior), to = 1.f - fresnelDielectric(wo.z, b.ior);
+// Diffuse base under a coating (Mitsuba's plastic, linear mode); fo is the Fresnel
+// reflectance at wo, which the plastics' pdfs need too.
+ENVGI_INLINE Color plasticDiffuse(const Bsdf& b, float fo, Vec3f wi) {
+  float ti = 1.f - fresnelDielectric(wi.z, b.ior), to = 1.f - fo;
   return b.reflectance * (kInvPi * wi.z * ti * to / ((1.f - b.fdrInt) * b.ior * b.ior));
+}
+ENVGI_INLINE Color plasticDiffuse(const Bsdf& b, Vec3f wo, Vec3f wi) {
+  return plasticDiffuse(b, fresnelDielectric(wo.z, b.ior), wi);
 }
 
 // Rough dielectric: generalised half vector and the relative index along wo.
@@ -185,12 +189,40 @@ ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
   return 0.f;
 }
 
+// bsdfEval and bsdfPdf of one pair of directions, with the very values of the two calls apart.
+// Next-event estimation and BSDF sampling both want both (Mitsuba's eval_pdf); rough plastic,
+// the example scenes' glossy BSDF, then computes its half vector, D, wo's Smith lambda and
+// wo's Fresnel term once instead of twice.
+ENVGI_INLINE Color bsdfEvalPdf(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
+  if (b.type != BsdfType::RoughPlastic) {
+    *pdf = bsdfPdf(b, wo, wi);
+    return bsdfEval(b, wo, wi);
+  }
+  detail::toFrontSide(b, &wo, &wi);
+  if (wo.z <= 0.f || wi.z <= 0.f) {
+    *pdf = 0.f;
+    return Color(0.f);
+  }
+  Vec3f m = normalize(wo + wi);
+  GGX d{b.alpha};
+  float D = d.D(m), lambdaO = d.lambda(wo), fo = fresnelDielectric(wo.z, b.ior);
+  // bsdfEval's expressions, in its order.
+  float F = fresnelDielectric(dot(wi, m), b.ior);
+  float G = 1.f / (1.f + lambdaO + d.lambda(wi));
+  Color spec = b.specularReflectance * (F * D * G / (4.f * wo.z));
+  // bsdfPdf's: GGX::visiblePdf(wo, m) with G1(wo) = 1 / (1 + lambda(wo)).
+  float ps = detail::plasticSpecularProb(b, fo);
+  float visible = 1.f / (1.f + lambdaO) * std::fabs(dot(wo, m)) * D / std::fabs(wo.z);
+  *pdf = ps * (visible / (4.f * std::fabs(dot(wo, m)))) + (1.f - ps) * cosineHemispherePdf(wi.z);
+  return spec + detail::plasticDiffuse(b, fo, wi);
+}
+
 namespace detail {
 // Non-delta lobes: the pdf of the sampled direction over all lobes, and weight = eval / pdf.
 ENVGI_INLINE bool finishSample(const Bsdf& b, Vec3f wo, BsdfSample* s) {
-  s->pdf = bsdfPdf(b, wo, s->wi);
+  Color f = bsdfEvalPdf(b, wo, s->wi, &s->pdf);
   if (!(s->pdf > 0.f)) return false;
-  s->weight = bsdfEval(b, wo, s->wi) / s->pdf;
+  s->weight = f / s->pdf;
   return true;
 }
 }  // namespace detail

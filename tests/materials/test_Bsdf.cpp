@@ -105,6 +105,29 @@ TEST(Bsdf, NonNegativeAndReciprocal) {
   }
 }
 
+// bsdfEvalPdf gives bsdfEval's and bsdfPdf's values to the bit, for every type and for
+// directions on either side (two-sided rough plastic seen from behind included).
+TEST(Bsdf, EvalPdfTogetherEqualsApart) {
+  Pcg32 rng(23);
+  for (const BsdfCase& c : cases()) {
+    for (bool twoSided : {false, true}) {
+      Bsdf b = c.bsdf;
+      b.twoSided = twoSided;
+      for (int i = 0; i < 4000; ++i) {
+        Vec3f wo = sampleUniformSphere({rng.nextFloat(), rng.nextFloat()});
+        Vec3f wi = sampleUniformSphere({rng.nextFloat(), rng.nextFloat()});
+        if (i % 4 == 0) wi = Vec3f(-wo.x, -wo.y, wo.z);  // the mirror direction: the specular peak
+        float pdf = -1.f;
+        Color f = bsdfEvalPdf(b, wo, wi, &pdf), fe = bsdfEval(b, wo, wi);
+        ASSERT_EQ(pdf, bsdfPdf(b, wo, wi)) << c.name;
+        ASSERT_EQ(f.x, fe.x) << c.name;
+        ASSERT_EQ(f.y, fe.y) << c.name;
+        ASSERT_EQ(f.z, fe.z) << c.name;
+      }
+    }
+  }
+}
+
 // Integral of eval() over the sphere by quadrature (independent of the sampling code).
 double hemisphereIntegral(const Bsdf& b, Vec3f wo) {
   const int n = 600;
