@@ -102,6 +102,35 @@ ENVGI_INLINE void toFrontSide(const Bsdf& b, Vec3f* wo, Vec3f* wi) {
   }
 }
 
+// What rough plastic's eval and pdf share for one pair of directions (both above the surface):
+// the half vector, D there, wo's Smith lambda and wo's Fresnel reflectance. bsdfEvalPdf
+// computes them once for both.
+struct RoughPlasticShared {
+  Vec3f m;
+  float D, lambdaO, fo;
+};
+ENVGI_INLINE RoughPlasticShared roughPlasticShared(const Bsdf& b, Vec3f wo, Vec3f wi) {
+  RoughPlasticShared r;
+  r.m = normalize(wo + wi);
+  GGX d{b.alpha};
+  r.D = d.D(r.m);
+  r.lambdaO = d.lambda(wo);
+  r.fo = fresnelDielectric(wo.z, b.ior);
+  return r;
+}
+ENVGI_INLINE Color roughPlasticEval(const Bsdf& b, const RoughPlasticShared& r, Vec3f wo, Vec3f wi) {
+  float F = fresnelDielectric(dot(wi, r.m), b.ior);
+  float G = 1.f / (1.f + r.lambdaO + GGX{b.alpha}.lambda(wi));  // height-correlated, GGX::G
+  Color spec = b.specularReflectance * (F * r.D * G / (4.f * wo.z));
+  return spec + plasticDiffuse(b, r.fo, wi);
+}
+ENVGI_INLINE float roughPlasticPdf(const Bsdf& b, const RoughPlasticShared& r, Vec3f wo, Vec3f wi) {
+  float ps = plasticSpecularProb(b, r.fo);
+  // GGX::visiblePdf(wo, m), with G1(wo) = 1 / (1 + lambda(wo)); wo.z > 0 here.
+  float visible = 1.f / (1.f + r.lambdaO) * std::fabs(dot(wo, r.m)) * r.D / std::fabs(wo.z);
+  return ps * (visible / (4.f * std::fabs(dot(wo, r.m)))) + (1.f - ps) * cosineHemispherePdf(wi.z);
+}
+
 }  // namespace detail
 
 ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
@@ -132,14 +161,9 @@ ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
     case BsdfType::Plastic:
       if (wo.z <= 0.f || wi.z <= 0.f) return Color(0.f);
       return detail::plasticDiffuse(b, wo, wi);
-    case BsdfType::RoughPlastic: {
+    case BsdfType::RoughPlastic:
       if (wo.z <= 0.f || wi.z <= 0.f) return Color(0.f);
-      Vec3f m = normalize(wo + wi);
-      GGX d{b.alpha};
-      float F = fresnelDielectric(dot(wi, m), b.ior);
-      Color spec = b.specularReflectance * (F * d.D(m) * d.G(wo, wi) / (4.f * wo.z));
-      return spec + detail::plasticDiffuse(b, wo, wi);
-    }
+      return detail::roughPlasticEval(b, detail::roughPlasticShared(b, wo, wi), wo, wi);
     case BsdfType::Conductor:
     case BsdfType::Dielectric:
     case BsdfType::ThinDielectric:
@@ -174,13 +198,9 @@ ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
       float ps = detail::plasticSpecularProb(b, fresnelDielectric(wo.z, b.ior));
       return (1.f - ps) * cosineHemispherePdf(wi.z);
     }
-    case BsdfType::RoughPlastic: {
+    case BsdfType::RoughPlastic:
       if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
-      float ps = detail::plasticSpecularProb(b, fresnelDielectric(wo.z, b.ior));
-      Vec3f m = normalize(wo + wi);
-      float spec = GGX{b.alpha}.visiblePdf(wo, m) / (4.f * std::fabs(dot(wo, m)));
-      return ps * spec + (1.f - ps) * cosineHemispherePdf(wi.z);
-    }
+      return detail::roughPlasticPdf(b, detail::roughPlasticShared(b, wo, wi), wo, wi);
     case BsdfType::Conductor:
     case BsdfType::Dielectric:
     case BsdfType::ThinDielectric:
@@ -191,8 +211,7 @@ ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
 
 // bsdfEval and bsdfPdf of one pair of directions, with the very values of the two calls apart.
 // Next-event estimation and BSDF sampling both want both (Mitsuba's eval_pdf); rough plastic,
-// the example scenes' glossy BSDF, then computes its half vector, D, wo's Smith lambda and
-// wo's Fresnel term once instead of twice.
+// the example scenes' glossy BSDF, then computes what the two share once instead of twice.
 ENVGI_INLINE Color bsdfEvalPdf(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
   if (b.type != BsdfType::RoughPlastic) {
     *pdf = bsdfPdf(b, wo, wi);
@@ -203,18 +222,9 @@ ENVGI_INLINE Color bsdfEvalPdf(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
     *pdf = 0.f;
     return Color(0.f);
   }
-  Vec3f m = normalize(wo + wi);
-  GGX d{b.alpha};
-  float D = d.D(m), lambdaO = d.lambda(wo), fo = fresnelDielectric(wo.z, b.ior);
-  // bsdfEval's expressions, in its order.
-  float F = fresnelDielectric(dot(wi, m), b.ior);
-  float G = 1.f / (1.f + lambdaO + d.lambda(wi));
-  Color spec = b.specularReflectance * (F * D * G / (4.f * wo.z));
-  // bsdfPdf's: GGX::visiblePdf(wo, m) with G1(wo) = 1 / (1 + lambda(wo)).
-  float ps = detail::plasticSpecularProb(b, fo);
-  float visible = 1.f / (1.f + lambdaO) * std::fabs(dot(wo, m)) * D / std::fabs(wo.z);
-  *pdf = ps * (visible / (4.f * std::fabs(dot(wo, m)))) + (1.f - ps) * cosineHemispherePdf(wi.z);
-  return spec + detail::plasticDiffuse(b, fo, wi);
+  detail::RoughPlasticShared r = detail::roughPlasticShared(b, wo, wi);
+  *pdf = detail::roughPlasticPdf(b, r, wo, wi);
+  return detail::roughPlasticEval(b, r, wo, wi);
 }
 
 namespace detail {
