@@ -126,9 +126,11 @@ ENVGI_INLINE Color roughPlasticEval(const Bsdf& b, const RoughPlasticShared& r, 
 }
 ENVGI_INLINE float roughPlasticPdf(const Bsdf& b, const RoughPlasticShared& r, Vec3f wo, Vec3f wi) {
   float ps = plasticSpecularProb(b, r.fo);
-  // GGX::visiblePdf(wo, m), with G1(wo) = 1 / (1 + lambda(wo)); wo.z > 0 here.
-  float visible = 1.f / (1.f + r.lambdaO) * std::fabs(dot(wo, r.m)) * r.D / std::fabs(wo.z);
-  return ps * (visible / (4.f * std::fabs(dot(wo, r.m)))) + (1.f - ps) * cosineHemispherePdf(wi.z);
+  // GGX::visiblePdf(wo, m), with G1(wo) = 1 / (1 + lambda(wo)), over the half vector's Jacobian
+  // 4 |wo.m|; wo.z > 0 here, so |wo.z| is wo.z.
+  float cosOM = std::fabs(dot(wo, r.m));
+  float visible = 1.f / (1.f + r.lambdaO) * cosOM * r.D / wo.z;
+  return ps * (visible / (4.f * cosOM)) + (1.f - ps) * cosineHemispherePdf(wi.z);
 }
 
 }  // namespace detail
