@@ -115,39 +115,6 @@ struct CosineProductView {
     return *pdfOut > 0.f;
   }
 
-  // sample()'s loads for (u, nLocal), asked for ahead one level of its chain at a time (CPU
-  // only). An executor drawing a batch calls level 0 for every draw, then level 1, and so on:
-  // each level reads only what the previous one fetched, so the batch's misses overlap instead
-  // of following one another. Levels: 0 the bucket's guide entry, 1 the cell cdf's range, 2 the
-  // cell's guide entry, 3 the pixel cdf's range.
-  void prefetchDraw(int level, Vec2f u, Vec3f nLocal) const {
-    int k = bucket(nLocal), n = cells();
-    const int* bg = bucketGuide + size_t(k) * (bucketGuideSize + 1);
-    int g = guideEntry(u.x, bucketGuideSize);
-    if (level == 0) {
-      __builtin_prefetch(bucketInt + k);
-      __builtin_prefetch(bg + g);
-      return;
-    }
-    const float* cdf = bucketCdf + size_t(k) * (n + 1);
-    if (level == 1) {
-      __builtin_prefetch(cdf + bg[g]);
-      __builtin_prefetch(cdf + bg[g + 1] + 1);
-      return;
-    }
-    int c = findIntervalBetweenNoBranch(cdf, bg[g], bg[g + 1], u.x);
-    const int* cg = cellGuide + size_t(c) * (cellGuideSize + 1);
-    int g2 = guideEntry(u.y, cellGuideSize);
-    if (level == 2) {
-      __builtin_prefetch(cellCdfStart + c);
-      __builtin_prefetch(cg + g2);
-      return;
-    }
-    const float* pc = cellCdf + cellCdfStart[c];
-    __builtin_prefetch(pc + cg[g2]);
-    __builtin_prefetch(pc + cg[g2 + 1] + 1);
-  }
-
   ENVGI_HD float pdf(Vec2f uv, Vec3f nLocal) const {
     int px = clampi(int(uv.x * float(width)), 0, width - 1), py = clampi(int(uv.y * float(height)), 0, height - 1);
     int cx = columnCell[px], cy = rowCell[py];

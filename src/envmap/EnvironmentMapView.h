@@ -225,13 +225,6 @@ struct EnvironmentMapView {
     return out;
   }
 
-  // sample()'s table loads asked for ahead, a level at a time (CosineProductView::prefetchDraw);
-  // only `product` has a chain long enough to gain (CPU only).
-  void prefetchSample(int level, EnvStrategy s, Vec2f u, Vec3f normal) const {
-    if (strategyFor(s, normal) == EnvStrategy::Product) product.prefetchDraw(level, u, toLocalUnnormalized(normal));
-  }
-  static constexpr int kPrefetchLevels = 4;
-
   ENVGI_HD float pdf(EnvStrategy s, Vec3f worldDir, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
     EnvStrategy t = strategyFor(s, normal);
     bool mapped = t != EnvStrategy::Uniform && t != EnvStrategy::Cosine && t != EnvStrategy::Points;

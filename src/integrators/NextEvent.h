@@ -20,36 +20,16 @@ struct LightSampleLd {
   bool needsRay = false;
 };
 
-// prepareLd's first half, the light sample itself; false for none (a pure delta BSDF, a light
-// facing away, a bucket that sees no light). Its three sample dimensions are drawn whatever
-// happens, so sequences stay aligned across pixels. Apart, so that an executor can draw a
-// round's light samples in one loop, where their chains of loads through the map's tables
-// overlap (renderTileByBounce).
-struct LightDims {
-  float uSel;     // the map or an area light
-  Vec2f uL, uL2;  // the direction on the map, or the point and the triangle on an area light
-};
-ENVGI_HD inline LightDims drawLightDims(Sampler& smp) {
-  LightDims d;
-  d.uSel = smp.get1D();
-  d.uL = smp.get2D();
-  d.uL2 = smp.get2D();
-  return d;
-}
-ENVGI_HD inline bool drawLightSample(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf, Vec3f axis,
-                                     EnvStrategy strategy, const LightDims& d, LightSample* ls) {
-  return !bsdfIsDelta(bsdf) && sampleLight(sc, si, axis, strategy, d.uSel, d.uL, d.uL2, ls);
-}
-// The map's tables that drawLightSample with d will read, asked for ahead (CPU only; a level
-// at a time, EnvironmentMapView::prefetchSample).
-inline void prefetchLightSample(const SceneView& sc, Vec3f axis, EnvStrategy strategy, const LightDims& d, int level) {
-  if (d.uSel < sc.envSelectProb()) sc.env.prefetchSample(level, strategy, d.uL, axis);
-}
-
-// Its second half: the BSDF and the MIS weight at the drawn sample, and the shadow ray's span.
-ENVGI_HD inline LightSampleLd finishLd(const SurfaceInteraction& si, const Bsdf& bsdf, Vec3f woLocal,
-                                       const LightSample& ls, float nE, float nB) {
+// Its three sample dimensions are drawn whatever happens, so sequences stay aligned across
+// pixels.
+ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
+                                        Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
+                                        Sampler& smp) {
   LightSampleLd out;
+  float uSel = smp.get1D();
+  Vec2f uL = smp.get2D(), uL2 = smp.get2D();
+  LightSample ls;
+  if (bsdfIsDelta(bsdf) || !sampleLight(sc, si, axis, strategy, uSel, uL, uL2, &ls)) return out;
   Vec3f wiLocal = si.shading.toLocal(ls.dir);
   float bsdfPdfOfLight;
   Color f = bsdfEvalPdf(bsdf, woLocal, wiLocal, &bsdfPdfOfLight);
@@ -61,14 +41,6 @@ ENVGI_HD inline LightSampleLd finishLd(const SurfaceInteraction& si, const Bsdf&
   out.value = f * ls.radiance * (w / (ls.pdf * nE));
   out.needsRay = true;
   return out;
-}
-
-ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
-                                        Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
-                                        Sampler& smp) {
-  LightSample ls;
-  if (!drawLightSample(sc, si, bsdf, axis, strategy, drawLightDims(smp), &ls)) return LightSampleLd{};
-  return finishLd(si, bsdf, woLocal, ls, nE, nB);
 }
 
 // The sample's contribution once its shadow ray's answer is known.

@@ -46,19 +46,13 @@ struct ShadowRayNow {
   }
 };
 
-// A surface point where the path scatters, as pathArrive leaves it for the rest of the bounce.
-struct PathVertex {
-  SurfaceInteraction si;
-  Vec3f woLocal;  // towards the previous vertex, in the shading frame
-  Vec3f axis;     // about which the map is sampled (envSamplingAxis)
-};
-
-// The first part of a bounce, after st->ray has been traced (found: whether it hit, h: where).
-// A ray that escaped adds the map, MIS-weighted against its BSDF sample, and ends the path. A
-// hit adds any emission, then returns true with *v filled if the path scatters there (below
-// max_depth).
-ENVGI_HD inline bool pathArrive(const SceneView& sc, PathState* st, bool found, const Hit& h, const PathParams& pp,
-                                PathVertex* v) {
+// One bounce of the path after st->ray has been traced (found: whether it hit, h: where): add
+// what it sees to st->L, hand next-event estimation's sample to shadow (ShadowRayNow or an
+// executor's batch), sample the BSDF for the next ray. Returns false once the path has ended.
+// Apart from pathStep, so that an executor can trace many paths' rays together, then shade them.
+template <class Shadow>
+ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hit& h, Sampler& smp,
+                        const PathParams& pp, const Shadow& shadow) {
   const int depth = st->depth;
   const Ray& ray = st->ray;
   if (!found) {
@@ -71,8 +65,7 @@ ENVGI_HD inline bool pathArrive(const SceneView& sc, PathState* st, bool found, 
     }
     return false;
   }
-  v->si = sc.interaction(ray, h);
-  const SurfaceInteraction& si = v->si;
+  SurfaceInteraction si = sc.interaction(ray, h);
   Vec3f wo = -ray.d;
   if (si.light >= 0 && !(depth == 1 && pp.hideEmitters)) {
     Color Le = sc.emitted(si, wo);
@@ -84,60 +77,29 @@ ENVGI_HD inline bool pathArrive(const SceneView& sc, PathState* st, bool found, 
   }
   if (pp.maxDepth >= 0 && depth >= pp.maxDepth) return false;
   const Bsdf& bsdf = sc.bsdfs[si.bsdf];
-  v->woLocal = si.shading.toLocal(wo);
-  v->axis = envSamplingAxis(si, wo, bsdf);
-  return true;
-}
+  Vec3f woLocal = si.shading.toLocal(wo);
+  Vec3f axis = envSamplingAxis(si, wo, bsdf);
 
-// The second part: next-event estimation's light sample at v from its dimensions d
-// (drawLightDims), *ls set where it returns true.
-ENVGI_HD inline bool pathDrawLight(const SceneView& sc, const PathVertex& v, const LightDims& d, const PathParams& pp,
-                                   LightSample* ls) {
-  return drawLightSample(sc, v.si, sc.bsdfs[v.si.bsdf], v.axis, pp.envStrategy, d, ls);
-}
-
-// The last part: the light sample (lit: whether there is one) weighted against this bounce's
-// BSDF sample and handed to shadow (ShadowRayNow or an executor's batch), then the BSDF
-// sampled for the next ray, and Russian roulette. Returns false once the path has ended.
-template <class Shadow>
-ENVGI_HD bool pathScatter(const SceneView& sc, PathState* st, const PathVertex& v, bool lit, const LightSample& ls,
-                          Sampler& smp, const PathParams& pp, const Shadow& shadow) {
-  const int depth = st->depth;
-  const SurfaceInteraction& si = v.si;
-  const Bsdf& bsdf = sc.bsdfs[si.bsdf];
-  shadow(lit ? finishLd(si, bsdf, v.woLocal, ls, 1.f, 1.f) : LightSampleLd{}, st);
+  // Next-event estimation, weighted against this bounce's BSDF sample.
+  shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp), st);
 
   BsdfSample bs;
   float uc = smp.get1D();
   Vec2f ub = smp.get2D();
-  if (!bsdfSample(bsdf, v.woLocal, uc, ub, &bs)) return false;
+  if (!bsdfSample(bsdf, woLocal, uc, ub, &bs)) return false;
   Vec3f wi = si.shading.toWorld(bs.wi);
   st->beta *= bs.weight;
-  st->etaScale *= bsdfEtaSquared(bsdf, v.woLocal, bs.wi);
+  st->etaScale *= bsdfEtaSquared(bsdf, woLocal, bs.wi);
   if (isBlack(st->beta)) return false;
   st->prevPdf = bs.pdf;
   st->prevDelta = bs.delta;
   st->prevP = si.p;
-  st->prevAxis = v.axis;
+  st->prevAxis = axis;
   st->ray.o = offsetRayOrigin(si.p, si.ng, wi, si.t);
   st->ray.d = wi;
   st->ray.tMax = INFINITY;
   st->depth = depth + 1;
   return depth < pp.rrDepth || russianRoulette(&st->beta, smp.get1D(), kRouletteMaxSurvival, st->etaScale);
-}
-
-// One bounce of the path after st->ray has been traced: pathArrive, pathDrawLight and
-// pathScatter in a row. Returns false once the path has ended. Apart from pathStep, so that an
-// executor can trace many paths' rays together, then shade them; renderTileByBounce also runs
-// the three parts as three loops over a round's paths.
-template <class Shadow>
-ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hit& h, Sampler& smp,
-                        const PathParams& pp, const Shadow& shadow) {
-  PathVertex v;
-  if (!pathArrive(sc, st, found, h, pp, &v)) return false;
-  LightSample ls;
-  bool lit = pathDrawLight(sc, v, drawLightDims(smp), pp, &ls);
-  return pathScatter(sc, st, v, lit, ls, smp, pp, shadow);
 }
 
 // One bounce of the path: trace st->ray, then pathShade.

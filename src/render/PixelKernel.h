@@ -46,20 +46,9 @@ struct SampleIntegrator {
   // step() with the trace taken out, for an executor that traces many paths' rays together
   // (renderTileByBounce): only path runs this way, since direct traces inside its one step.
   ENVGI_HD bool shadesAfterTrace() const { return type == SampleIntegratorType::Path; }
-  // pathShade's three parts (PathIntegrator.h), which renderTileByBounce runs as three loops.
-  ENVGI_HD bool arrive(PathState* st, bool found, const Hit& h, PathVertex* v) const {
-    return pathArrive(*scene, st, found, h, path, v);
-  }
-  ENVGI_HD bool drawLight(const PathVertex& v, const LightDims& d, LightSample* ls) const {
-    return pathDrawLight(*scene, v, d, path, ls);
-  }
-  void prefetchLight(const PathVertex& v, const LightDims& d, int level) const {
-    prefetchLightSample(*scene, v.axis, path.envStrategy, d, level);
-  }
   template <class Shadow>
-  ENVGI_HD bool scatter(PathState* st, const PathVertex& v, bool lit, const LightSample& ls, Sampler& smp,
-                        const Shadow& shadow) const {
-    return pathScatter(*scene, st, v, lit, ls, smp, path, shadow);
+  ENVGI_HD bool shade(PathState* st, bool found, const Hit& h, Sampler& smp, const Shadow& shadow) const {
+    return pathShade(*scene, st, found, h, smp, path, shadow);
   }
 };
 
@@ -177,19 +166,15 @@ struct TileBatch {
   std::vector<PathState> state;
   std::vector<Sampler> sampler;
   std::vector<Hit> hit;
-  std::vector<unsigned char> found, going, lit;
-  std::vector<int> active, scattering;
-  std::vector<PathVertex> vertex;  // where each path scatters this round
-  std::vector<LightDims> dims;     // its light sample's dimensions
-  std::vector<LightSample> light;  // and its light sample there
+  std::vector<unsigned char> found, going;
+  std::vector<int> active;
   std::vector<LightSampleLd> ld;  // each path's next-event sample of this round
   std::vector<Color> ldBeta;      // and the path's beta when it was drawn
   std::vector<Color> acc;
   std::vector<double> accSq;
   void resize(size_t n) {
     if (state.size() >= n) return;
-    state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), lit.resize(n);
-    active.resize(n), scattering.resize(n), vertex.resize(n), dims.resize(n), light.resize(n);
+    state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), active.resize(n);
     ld.resize(n), ldBeta.resize(n), acc.resize(n), accSq.resize(n);
   }
 };
@@ -232,12 +217,10 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         b->found[k] = integ.tracer.intersect(b->state[k].ray, &b->hit[k]);
       }
       counters->rays += uint64_t(live);
-      // Shade in loops over the round, one per part of pathShade, after prefetch loops that ask
-      // for the hit triangles, then the map's tables for the light samples, a level of their
-      // chain of loads at a time: the paths' misses overlap instead of following one another
-      // (docs/performance.md). Then trace the round's shadow rays back to back, each adding what
-      // got through before anything later in its path, as pathStep adds it.
-      int scattering = 0;
+      // Ask for the hit triangles' indices, then their vertices, for the whole round before
+      // shading it, so that interaction()'s misses overlap instead of following one another.
+      // Then shade, then trace the round's shadow rays back to back, each adding what got
+      // through before anything later in its path, as pathStep adds it.
       for (int i = 0; i < live; ++i)
         if (b->found[b->active[i]]) integ.scene->prefetchTriangle(b->hit[b->active[i]]);
       for (int i = 0; i < live; ++i)
@@ -245,23 +228,7 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];
         b->ld[k].needsRay = false;
-        b->going[k] = 0;
-        if (integ.arrive(&b->state[k], b->found[k] != 0, b->hit[k], &b->vertex[k])) b->scattering[scattering++] = k;
-      }
-      for (int i = 0; i < scattering; ++i) {
-        int k = b->scattering[i];
-        b->dims[k] = drawLightDims(b->sampler[k]);
-      }
-      for (int level = 0; level < EnvironmentMapView::kPrefetchLevels; ++level)
-        for (int i = 0; i < scattering; ++i) integ.prefetchLight(b->vertex[b->scattering[i]], b->dims[b->scattering[i]], level);
-      for (int i = 0; i < scattering; ++i) {
-        int k = b->scattering[i];
-        b->lit[k] = integ.drawLight(b->vertex[k], b->dims[k], &b->light[k]);
-      }
-      for (int i = 0; i < scattering; ++i) {
-        int k = b->scattering[i];
-        b->going[k] = integ.scatter(&b->state[k], b->vertex[k], b->lit[k] != 0, b->light[k], b->sampler[k],
-                                    ShadowRayLater{b});
+        b->going[k] = integ.shade(&b->state[k], b->found[k] != 0, b->hit[k], b->sampler[k], ShadowRayLater{b});
       }
       int next = 0;
       for (int i = 0; i < live; ++i) {
