@@ -72,6 +72,8 @@ def main():
     ap.add_argument('--threads', type=int, default=os.cpu_count())
     ap.add_argument('--strategy', default='product', help="envgi's environment strategy (its default: product)")
     ap.add_argument('--repeats', type=int, default=3, help='renders per timing; the median time is used')
+    ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass',
+                    help='comma-separated scene files (without .xml) in --scenes to compare on')
     args = ap.parse_args()
     if args.repeats < 1:
         ap.error('--repeats must be at least 1')
@@ -79,7 +81,11 @@ def main():
     tmp = tempfile.mkdtemp(prefix='envgi_perf_')
     out = os.path.join(tmp, 'e.exr')
     rows = []
-    for name in ('buddha', 'cornell-box', 'teapot-glass'):
+    names = [n for n in args.scene_names.split(',') if n]
+    for name in names:
+        if not os.path.isfile(os.path.join(args.scenes, name + '.xml')):
+            ap.error(f'no scene {name}.xml in {args.scenes}')
+    for name in names:
         xml = os.path.join(args.scenes, name + '.xml')
         eref, _ = envgi_render(args.envgi, xml, out, args.ref_spp, 1, args.res, args.threads, args.strategy)
         scene = mitsuba_scene(xml, args.res)
