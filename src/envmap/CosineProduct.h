@@ -37,6 +37,17 @@ ENVGI_INLINE Vec3f octahedralDecode(Vec2f uv) {
   return normalize(Vec3f(p.x, p.y, z));
 }
 
+// (p + r) / n for r in [0, 1], as a coordinate that pdf() maps back to pixel p (int(f n) == p):
+// near r = 1 the sum, the division or pdf()'s product may round onto the next pixel's edge,
+// which would give a draw the neighbour's density.
+ENVGI_INLINE float insidePixel(int p, float r, int n) {
+  float f = (float(p) + (r < kOneMinusEpsilon ? r : kOneMinusEpsilon)) / float(n);
+  f = f < kOneMinusEpsilon ? f : kOneMinusEpsilon;
+  while (int(f * float(n)) > p) f = nextafterf(f, 0.f);
+  while (int(f * float(n)) < p) f = nextafterf(f, 1.f);
+  return f;
+}
+
 struct CosineProductView {
   const float* bucketCdf = nullptr;   // buckets x (cells + 1), over cell power times the cosine bound
   const float* bucketInt = nullptr;   // buckets: the mean cell power times the bound (0: no light)
@@ -107,10 +118,7 @@ struct CosineProductView {
     float w2 = pc[j + 1] - pc[j];
     float r2 = w2 > 0.f ? (u.y - pc[j]) / w2 : 0.5f;
     int jy = j / cw, px = x0 + (j - jy * cw), py = y0 + jy;
-    r1 = r1 < kOneMinusEpsilon ? r1 : kOneMinusEpsilon;
-    r2 = r2 < kOneMinusEpsilon ? r2 : kOneMinusEpsilon;
-    float fx = (float(px) + r1) / float(width), fy = (float(py) + r2) / float(height);
-    *uv = {fx < kOneMinusEpsilon ? fx : kOneMinusEpsilon, fy < kOneMinusEpsilon ? fy : kOneMinusEpsilon};
+    *uv = {insidePixel(px, r1, width), insidePixel(py, r2, height)};
     *pdfOut = densityOfSteps(w1, w2);  // pdfUV(k, c, j), from the values at hand
     return *pdfOut > 0.f;
   }

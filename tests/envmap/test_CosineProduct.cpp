@@ -96,6 +96,38 @@ TEST(CosineProduct, PdfOfADrawEqualsItsDensity) {
   EXPECT_GT(drawn, 19000);
 }
 
+// Draws at the very top of a cell's and a pixel's cdf steps, where (px + r) / width rounds
+// onto the next pixel's edge unless kept inside: pdf() still finds the drawn pixel, with the
+// drawn density to the bit (a map width that is not a power of two included).
+TEST(CosineProduct, DrawsAtTheTopOfAStepStayInTheirPixel) {
+  for (int width : {96, 101}) {
+    EnvironmentMap env(skyWithSun(width, 48), {});
+    const CosineProductView& p = env.view().product;
+    ASSERT_TRUE(p.valid());
+    Pcg32 rng(29);
+    int checked = 0;
+    for (int i = 0; i < 20000; ++i) {
+      Vec3f nl = sampleUniformSphere(Vec2f(rng.nextFloat(), rng.nextFloat()));
+      int k = p.bucket(nl);
+      if (!(p.bucketInt[k] > 0.f)) continue;
+      const float* cdf = p.bucketCdf + size_t(k) * (p.cells() + 1);
+      int c = findIntervalGuided(cdf, rng.nextFloat(), p.bucketGuide + size_t(k) * (p.bucketGuideSize + 1),
+                                 p.bucketGuideSize);
+      int cx = c % p.cellsX, cy = c / p.cellsX;
+      int pixels = (p.cellX0(cx + 1) - p.cellX0(cx)) * (p.cellY0(cy + 1) - p.cellY0(cy));
+      const float* pc = p.cellCdf + p.cellCdfStart[c];
+      int j = int(rng.nextFloat() * float(pixels));
+      if (!(cdf[c + 1] > cdf[c]) || !(pc[j + 1] > pc[j])) continue;
+      Vec2f u(std::nextafter(cdf[c + 1], 0.f), std::nextafter(pc[j + 1], 0.f)), uv;
+      float pdf;
+      if (!p.sample(u, nl, &uv, &pdf)) continue;
+      ++checked;
+      ASSERT_EQ(p.pdf(uv, nl), pdf) << "width " << width << " draw " << i << " uv " << uv.x * width << "," << uv.y * 48;
+    }
+    EXPECT_GT(checked, 10000);
+  }
+}
+
 // Each cell's pixel cdf ends at 1, and cellOfPixel inverts the cells' pixel ranges, also for a
 // map whose size is not a multiple of the cell grid; the tables the draws read agree with both.
 TEST(CosineProduct, CellsPartitionAnOddSizedMap) {
