@@ -72,7 +72,7 @@ def main():
     ap.add_argument('--threads', type=int, default=os.cpu_count())
     ap.add_argument('--strategy', default='product', help="envgi's environment strategy (its default: product)")
     ap.add_argument('--repeats', type=int, default=3, help='renders per timing; the median time is used')
-    ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass',
+    ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,bunny-sunrise',
                     help='comma-separated scene files (without .xml) in --scenes to compare on')
     args = ap.parse_args()
     if args.repeats < 1:

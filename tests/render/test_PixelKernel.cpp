@@ -1,7 +1,7 @@
 // The GPU's path regeneration (regeneratePaths) against the per-pixel body (renderPixel), run
 // on the CPU with the GPU's BVH: the same samples, so with one thread taking the items in order
 // a fresh film gets the same sums to the bit, for path and direct on glass, a mirror-ish glossy
-// object and an area-lit box.
+// object, an area-lit box and a rough conductor under a low sun.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -47,7 +47,7 @@ struct SmallScene {
 }  // namespace
 
 TEST(PixelKernel, RegeneratedPathsAddTheSameSamplesAsRenderPixel) {
-  for (std::string name : {"teapot-glass", "buddha", "cornell-box"})
+  for (std::string name : {"teapot-glass", "buddha", "cornell-box", "bunny-sunrise"})
     for (IntegratorType type : {IntegratorType::Path, IntegratorType::Direct}) {
       SmallScene small(name, type);
       const KernelSettings& k = small.k;
@@ -80,7 +80,7 @@ TEST(PixelKernel, RegeneratedPathsAddTheSameSamplesAsRenderPixel) {
 // adds the same samples in the same order, so the sums agree to the bit, over whole and partial
 // tiles (24 pixels in tiles of 16) and over two passes.
 TEST(PixelKernel, TileByBounceAddsTheSameSamplesAsRenderPixel) {
-  for (std::string name : {"teapot-glass", "buddha", "cornell-box"}) {
+  for (std::string name : {"teapot-glass", "buddha", "cornell-box", "bunny-sunrise"}) {
     SmallScene small(name, IntegratorType::Path);
     const KernelSettings& k = small.k;
     SampleIntegrator<BvhTracer> integ = small.integrator();
