@@ -10,12 +10,6 @@ namespace envgi {
 
 namespace {
 
-// The mean of f^2 over the unit square for the bilinear f with corner values a (0,0), b (1,0),
-// c (0,1) and d (1,1): the tensor product of the 1D mass matrix [1/3 1/6; 1/6 1/3].
-double bilinearPatchMeanSquare(double a, double b, double c, double d) {
-  return (a * a + b * b + c * c + d * d + a * b + c * d + a * c + b * d) / 9.0 + (a * d + b * c) / 18.0;
-}
-
 float rowSinTheta(int y, int height) { return std::sin(kPi * (float(y) + 0.5f) / float(height)); }
 
 // Exact solid angle of one pixel of row y: (2 pi / width) (cos theta0 - cos theta1).
@@ -48,26 +42,23 @@ std::vector<float> EnvironmentMap::samplingWeights(const Image& img, bool biline
   for (size_t i = 0; i < lum.size(); ++i) lum[i] = luminance(img.rgb[i * 3], img.rgb[i * 3 + 1], img.rgb[i * 3 + 2]);
   std::vector<float> weight(lum.size());
   if (bilinear) {
-    // The root mean square of the bilinear lookup's luminance over each pixel: among densities
-    // constant over pixels, the one that minimises the variance of L / p (Lagrange: p_i
-    // proportional to the square root of the integral of L^2 over pixel i). The pixel's average
-    // (the [1/8, 3/4, 1/8] filter used before) undersamples where the lookup bleeds out of a
-    // bright pixel into dim ones: 1/64 of a one-pixel sun's weight goes to each diagonal
-    // neighbour, where the lookup reaches 1/4 of the sun's radiance. Sunrise map, 64 spp: RMSE
-    // 15% lower (docs/performance.md). Over one pixel the lookup is four bilinear patches, whose
-    // corners are the pixel's value, its means with the edge neighbours and with the corner ones.
-    auto L = [&](int x, int y) { return double(lum[size_t(y) * w + x]); };
-    for (int y = 0; y < h; ++y) {
-      int yn[2] = {std::max(y - 1, 0), std::min(y + 1, h - 1)};
+    // The average of the bilinear lookup over each pixel: the separable [1/8, 3/4, 1/8] filter
+    // of the pixels (wrapping in u, clamped in v), the pixel's share of the lookup's integral.
+    // Sampling then places the point inside the pixel by the lookup itself
+    // (EnvironmentMapView::warpInPixel), so that the density is proportional to what eval()
+    // returns, and positive wherever it is.
+    std::vector<float> tmp(lum.size());
+    for (int y = 0; y < h; ++y)
       for (int x = 0; x < w; ++x) {
-        int xn[2] = {(x + w - 1) % w, (x + 1) % w};
-        double c = L(x, y), sq = 0.0;
-        for (int i = 0; i < 2; ++i)
-          for (int j = 0; j < 2; ++j)
-            sq += bilinearPatchMeanSquare(c, 0.5 * (c + L(xn[i], y)), 0.5 * (c + L(x, yn[j])),
-                                          0.25 * (c + L(xn[i], y) + L(x, yn[j]) + L(xn[i], yn[j])));
-        weight[size_t(y) * w + x] = float(std::sqrt(0.25 * sq));
+        int xl = (x + w - 1) % w, xr = (x + 1) % w;
+        const float* row = &lum[size_t(y) * w];
+        tmp[size_t(y) * w + x] = 0.125f * row[xl] + 0.75f * row[x] + 0.125f * row[xr];
       }
+    for (int y = 0; y < h; ++y) {
+      int yu = std::max(y - 1, 0), yd = std::min(y + 1, h - 1);
+      for (int x = 0; x < w; ++x)
+        weight[size_t(y) * w + x] =
+            0.125f * tmp[size_t(yu) * w + x] + 0.75f * tmp[size_t(y) * w + x] + 0.125f * tmp[size_t(yd) * w + x];
     }
   } else {
     weight = lum;

@@ -101,6 +101,70 @@ struct EnvironmentMapView {
     return c * scale;
   }
 
+  // The bilinear lookup's luminance over pixel (px, py) is four bilinear patches meeting on a
+  // 3 x 3 lattice: v[j][i] at x = i / 2, y = j / 2 across the pixel (its corners, the midpoints
+  // of its edges, its centre), each the mean of the pixels around that point, wrapping in u and
+  // clamping at the poles as lookupUV does.
+  ENVGI_HD void pixelLattice(int px, int py, float v[3][3]) const {
+    int xs[3] = {px > 0 ? px - 1 : width - 1, px, px + 1 < width ? px + 1 : 0};
+    int ys[3] = {py > 0 ? py - 1 : 0, py, py + 1 < height ? py + 1 : height - 1};
+    float l[3][3];
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) l[j][i] = luminance(texel(xs[i], ys[j]));
+    for (int j = 0; j < 3; ++j)
+      for (int i = 0; i < 3; ++i) {
+        // The pixels around lattice point (i, j): the centre one, and the neighbour on the
+        // point's side across and down where the point lies on an edge or a corner.
+        float s = l[1][1] + (i != 1 ? l[1][i] : 0.f) + (j != 1 ? l[j][1] : 0.f) + (i != 1 && j != 1 ? l[j][i] : 0.f);
+        v[j][i] = s / float((i != 1 ? 2 : 1) * (j != 1 ? 2 : 1));
+      }
+  }
+
+  // A point uniform inside its pixel (uv from a pixel-constant density) moved so that it follows
+  // the bilinear lookup's luminance inside that pixel: x by the patches' marginal, then y given
+  // x, each by inverting a piecewise-linear cdf, so that stratified (u1, u2) stay stratified.
+  // With the pixel chosen by the lookup's average over it, the density is then proportional to
+  // the lookup itself, as Mitsuba's piecewise-bilinear warp is; a pixel-constant density is
+  // not, next to a small sun (docs/performance.md, "A low sun").
+  ENVGI_HD Vec2f warpInPixel(Vec2f uv) const {
+    int px = clampi(int(uv.x * float(width)), 0, width - 1), py = clampi(int(uv.y * float(height)), 0, height - 1);
+    float rx = clampf(uv.x * float(width) - float(px), 0.f, 1.f), ry = clampf(uv.y * float(height) - float(py), 0.f, 1.f);
+    float v[3][3];
+    pixelLattice(px, py, v);
+    float x = sampleTwoLinearPieces(rx, v[0][0] + 2.f * v[1][0] + v[2][0], v[0][1] + 2.f * v[1][1] + v[2][1],
+                                    v[0][2] + 2.f * v[1][2] + v[2][2]);
+    float y = sampleTwoLinearPieces(ry, twoLinearPieces(x, v[0][0], v[0][1], v[0][2]),
+                                    twoLinearPieces(x, v[1][0], v[1][1], v[1][2]),
+                                    twoLinearPieces(x, v[2][0], v[2][1], v[2][2]));
+    return {insidePixel(px, x, width), insidePixel(py, y, height)};
+  }
+
+  // warpInPixel's density at uv relative to uniform over the pixel: the lookup's luminance
+  // over its mean on the pixel (1 on a black pixel, which warpInPixel leaves uniform).
+  ENVGI_HD float densityInPixel(Vec2f uv) const {
+    int px = clampi(int(uv.x * float(width)), 0, width - 1), py = clampi(int(uv.y * float(height)), 0, height - 1);
+    float x = clampf(uv.x * float(width) - float(px), 0.f, 1.f), y = clampf(uv.y * float(height) - float(py), 0.f, 1.f);
+    float v[3][3];
+    pixelLattice(px, py, v);
+    float row[3], mean = 0.f;
+    for (int j = 0; j < 3; ++j) {
+      row[j] = twoLinearPieces(x, v[j][0], v[j][1], v[j][2]);
+      mean += (j == 1 ? 2.f : 1.f) * (v[j][0] + 2.f * v[j][1] + v[j][2]);
+    }
+    mean *= 1.f / 16.f;
+    return mean > 0.f ? twoLinearPieces(y, row[0], row[1], row[2]) / mean : 1.f;
+  }
+
+  // For the strategies that pick a pixel from a table (importance, alias, product): with
+  // bilinear lookup, the point inside the pixel follows the lookup, and *pdfUV takes its factor.
+  ENVGI_HD Vec2f placeInPixel(Vec2f uv, float* pdfUV) const {
+    if (!bilinear) return uv;
+    Vec2f w = warpInPixel(uv);
+    *pdfUV *= densityInPixel(w);
+    return w;
+  }
+  ENVGI_HD float pdfInPixel(Vec2f uv) const { return bilinear ? densityInPixel(uv) : 1.f; }
+
   ENVGI_HD Vec3f toLocal(Vec3f worldDir) const { return normalize(toWorld.inverseVector(worldDir)); }
   // toLocal up to a positive factor, a square root and a division cheaper: enough for dirToUV
   // and the product's normal buckets, which do not depend on the length.
@@ -177,17 +241,17 @@ struct EnvironmentMapView {
         return out;
       }
       case EnvStrategy::Importance: {
-        float pdf2;
-        out.uv = dist.sample(u, &pdf2);
+        float pdf2, inPixel = 1.f;
+        out.uv = placeInPixel(dist.sample(u, &pdf2), &inPixel);
         local = uvToDir(out.uv);
-        out.pdf = importancePdfUV(out.uv);
+        out.pdf = importancePdfUV(out.uv) * inPixel;
         break;
       }
       case EnvStrategy::Alias: {
-        float pmf;
-        out.uv = sampleTable(alias, u, &pmf);
+        float pmf, inPixel = 1.f;
+        out.uv = placeInPixel(sampleTable(alias, u, &pmf), &inPixel);
         local = uvToDir(out.uv);
-        out.pdf = importancePdfUV(out.uv);
+        out.pdf = importancePdfUV(out.uv) * inPixel;
         break;
       }
       case EnvStrategy::Adaptive: {
@@ -198,6 +262,7 @@ struct EnvironmentMapView {
       case EnvStrategy::Product: {
         float pdfUV;
         if (!product.sample(u, toLocalUnnormalized(normal), &out.uv, &pdfUV)) return out;
+        out.uv = placeInPixel(out.uv, &pdfUV);
         local = uvToDir(out.uv);
         out.pdf = solidAnglePdf(pdfUV, out.uv.y);
         break;
@@ -247,11 +312,11 @@ struct EnvironmentMapView {
       case EnvStrategy::Uniform: return uniformSpherePdf();
       case EnvStrategy::Cosine: return cosineHemispherePdf(dot(normalize(worldDir), normal));
       case EnvStrategy::Importance:
-      case EnvStrategy::Alias: return importancePdfUV(uv);
+      case EnvStrategy::Alias: return importancePdfUV(uv) * pdfInPixel(uv);
       case EnvStrategy::Adaptive: return adaptive.pdf(uv);
       case EnvStrategy::Points: return 0.f;  // no direction drawn by BSDF sampling hits a point
       case EnvStrategy::Product:
-        return solidAnglePdf(product.pdf(uv, toLocalUnnormalized(normal)), uv.y);
+        return solidAnglePdf(product.pdf(uv, toLocalUnnormalized(normal)) * pdfInPixel(uv), uv.y);
     }
     return 0.f;
   }

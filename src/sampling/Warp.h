@@ -44,6 +44,28 @@ ENVGI_INLINE Vec3f sampleCosineHemisphere(Vec2f u) {
 }
 ENVGI_INLINE float cosineHemispherePdf(float cosTheta) { return cosTheta > 0.f ? cosTheta * kInvPi : 0.f; }
 
+// A point of [0, 1) with density proportional to (1 - x) a + x b (a, b >= 0): the inverse of its
+// quadratic cdf, in the form that stays accurate as a approaches b.
+ENVGI_INLINE float sampleLinear(float u, float a, float b) {
+  if (a == b) return u;
+  float x = u * (a + b) / (a + std::sqrt(lerpf(u, a * a, b * b)));
+  return x < kOneMinusEpsilon ? x : kOneMinusEpsilon;
+}
+
+// The piecewise-linear function through (0, n0), (1/2, n1) and (1, n2) at x in [0, 1].
+ENVGI_INLINE float twoLinearPieces(float x, float n0, float n1, float n2) {
+  return x < 0.5f ? lerpf(2.f * x, n0, n1) : lerpf(2.f * x - 1.f, n1, n2);
+}
+
+// A point of [0, 1) with density proportional to twoLinearPieces(x, n0, n1, n2): a piece by its
+// area, then sampleLinear inside it. Uniform where the function is zero throughout.
+ENVGI_INLINE float sampleTwoLinearPieces(float u, float n0, float n1, float n2) {
+  float left = n0 + n1, right = n1 + n2, t = u * (left + right);
+  if (!(left + right > 0.f)) return u;
+  if (t < left || !(right > 0.f)) return 0.5f * sampleLinear(fminf(t / left, kOneMinusEpsilon), n0, n1);
+  return 0.5f + 0.5f * sampleLinear(fminf((t - left) / right, kOneMinusEpsilon), n1, n2);
+}
+
 ENVGI_INLINE Vec2f sampleUniformTriangle(Vec2f u) {
   float b0, b1;
   if (u.x < u.y) {

@@ -147,31 +147,49 @@ TEST(EnvSamplingSun, NearestPdfProportionalToLuminance) {
   }
 }
 
-// With bilinear lookup a pixel's sampling weight is the root mean square of the luminance
-// eval() returns over the pixel (times the row's sin theta, as Algorithm 1 weights rows): the
-// pixel-constant density of least variance for L / p. Checked against a 16 x 16 midpoint rule
-// over every pixel of the one-pixel sun (seam, poles and the sun's neighbours included) and of
-// random noise with bright specks.
-TEST(EnvSamplingSun, BilinearWeightsAreTheLookupsRootMeanSquare) {
+// With bilinear lookup, importance and alias sampling draw in proportion to what eval()
+// returns: the pixel by the lookup's average over it times the row's sin theta, the point
+// inside it by the lookup (warpInPixel). So luminance x sin(theta of the row) / pdf(u, v) is
+// the same for every draw: on the one-pixel sun, whose neighbours the lookup bleeds into, and
+// on noise with bright specks.
+TEST(EnvSamplingSun, BilinearDensityIsProportionalToTheLookup) {
   Image noise(64, 32);
   Pcg32 fill(3);
   for (float& c : noise.rgb) c = fill.nextFloat() < 0.05f ? 100.f * fill.nextFloat() : fill.nextFloat();
-  for (const Image& img : {sunMap(), noise}) {
-    EnvironmentMap env(img, {});
-    EnvironmentMapView v = env.view();
-    std::vector<float> w = EnvironmentMap::samplingWeights(img, true, false);
-    const int W = img.width, H = img.height, K = 16;
-    for (int y = 0; y < H; ++y)
-      for (int x = 0; x < W; ++x) {
-        double sq = 0.0;
-        for (int j = 0; j < K; ++j)
-          for (int i = 0; i < K; ++i) {
-            double l = luminance(v.lookupUV(Vec2f((x + (i + 0.5f) / K) / W, (y + (j + 0.5f) / K) / H)));
-            sq += l * l;
-          }
-        double rms = std::sqrt(sq / (K * K)), weight = w[size_t(y) * W + x] / std::sin(kPi * (y + 0.5f) / H);
-        ASSERT_NEAR(weight, rms, 5e-3 * rms + 1e-6) << "pixel " << x << "," << y;
+  for (const Image& img : {sunMap(), noise})
+    for (EnvStrategy s : {EnvStrategy::Importance, EnvStrategy::Alias}) {
+      EnvironmentMap env(img, {});
+      EnvironmentMapView v = env.view();
+      Pcg32 rng(8);
+      double lo = INFINITY, hi = 0.0;
+      for (int i = 0; i < 20000; ++i) {
+        EnvSample es = v.sample(s, Vec2f(rng.nextFloat(), rng.nextFloat()));
+        ASSERT_GT(es.pdf, 0.f);
+        int row = std::min(int(es.uv.y * img.height), img.height - 1);
+        double pdfUV = double(es.pdf) * 2.0 * M_PI * M_PI * std::sin(M_PI * es.uv.y);
+        double r = luminance(v.lookupUV(es.uv)) * std::sin(M_PI * (row + 0.5) / img.height) / pdfUV;
+        lo = std::min(lo, r), hi = std::max(hi, r);
       }
+      EXPECT_LT(hi / lo, 1.002) << "strategy " << int(s) << ": L / p from " << lo << " to " << hi;
+    }
+}
+
+// Where inside a pixel the draws land: on an 8 x 4 map, each pixel spans 8 x 8 cells of the
+// chi-square grid, so a warp that does not follow densityInPixel (which pdf() reports) fails.
+TEST(EnvSamplingSun, DrawsInsideAPixelFollowTheLookup) {
+  Image img(8, 4);
+  Pcg32 fill(17);
+  for (float& c : img.rgb) c = fill.nextFloat() < 0.2f ? 50.f * fill.nextFloat() : fill.nextFloat();
+  EnvironmentMap env(img, {});
+  EnvironmentMapView v = env.view();
+  Vec3f n = normalize(Vec3f(0.2f, 0.9f, 0.3f));
+  for (EnvStrategy s : {EnvStrategy::Importance, EnvStrategy::Alias, EnvStrategy::Product}) {
+    Pcg32 rng(4);
+    auto sample = [&](int) { return v.sample(s, Vec2f(rng.nextFloat(), rng.nextFloat()), n).dir; };
+    auto pdf = [&](Vec3f d) { return v.pdf(s, d, n); };
+    test::ChiSquareResult r = test::chiSquareSphere(sample, pdf, 400000, 64, 32, 8);
+    EXPECT_NEAR(r.pdfIntegral, 1.0, 2e-3) << "strategy " << int(s);
+    EXPECT_GT(r.pValue, test::sidakAlpha(3)) << "strategy " << int(s) << " chi2 " << r.chi2 << " dof " << r.dof << " " << r.message;
   }
 }
 

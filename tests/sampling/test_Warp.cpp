@@ -35,3 +35,29 @@ TEST(Mis, WeightsSumToOne) {
   EXPECT_FLOAT_EQ(misWeight(0, c2, p2, 2, 1.f), 0.5f);
   EXPECT_FLOAT_EQ(misWeight(0, c2, p2, 2, 1.f), balanceHeuristic(2.f, 0.5f, 1.f, 1.f));
 }
+
+// sampleTwoLinearPieces inverts the cdf of the piecewise-linear density through (0, n0),
+// (1/2, n1), (1, n2): the exact cdf at the returned point is u, for node values that include
+// zeros, equal pairs and a spike, and the point stays in [0, 1).
+TEST(Warp, TwoLinearPiecesInvertTheirCdf) {
+  const float nodes[][3] = {{1, 1, 1}, {0, 1, 0}, {1, 0, 1}, {0, 0, 5}, {3, 0, 0}, {0.2f, 7, 0.1f}, {1, 1, 4}, {2, 2, 0}};
+  for (const auto& n : nodes) {
+    // The cdf by the piece's trapezoid: area of [0, x] under the linear pieces, over the whole.
+    auto cdf = [&](double x) {
+      auto area = [](double a, double b, double t) { return 0.5 * (a * t + 0.5 * (b - a) * t * t); };  // [0, t] of a piece of width 1/2, t in [0, 1]
+      double left = area(n[0], n[1], 1.0), total = left + area(n[1], n[2], 1.0);
+      double part = x < 0.5 ? area(n[0], n[1], 2 * x) : left + area(n[1], n[2], 2 * x - 1);
+      return part / total;
+    };
+    for (int k = 0; k < 1000; ++k) {
+      float u = (k + 0.5f) / 1000.f;
+      float x = sampleTwoLinearPieces(u, n[0], n[1], n[2]);
+      ASSERT_GE(x, 0.f);
+      ASSERT_LT(x, 1.f);
+      ASSERT_NEAR(cdf(x), u, 2e-5) << n[0] << "," << n[1] << "," << n[2] << " u " << u;
+    }
+  }
+  EXPECT_EQ(sampleTwoLinearPieces(0.3f, 0, 0, 0), 0.3f) << "uniform where the function is zero";
+  EXPECT_FLOAT_EQ(twoLinearPieces(0.25f, 0, 2, 4), 1.f);
+  EXPECT_FLOAT_EQ(twoLinearPieces(0.75f, 0, 2, 4), 3.f);
+}
