@@ -50,7 +50,9 @@ class EnvironmentMap {
   EnvironmentMapStats stats() const;
   // Luminance power, integral of Y(L) over the sphere (zero for an all-black map).
   float luminancePower() const;
-  size_t samplingBytes() const { return dist_.bytes() + alias_.bytes() + emission_.bytes() + product_.bytes(); }
+  size_t samplingBytes() const {
+    return dist_.bytes() + alias_.bytes() + emission_.bytes() + product_.bytes() + warpBits_.size() * sizeof(uint32_t);
+  }
 
   // The collapsed map that the `points` strategy uses (envmap/CollapsedMap.h makes one).
   // Fills each light's selection pmf and cdf (by luminance; uniform when all are black).
@@ -67,6 +69,7 @@ class EnvironmentMap {
   AliasTable alias_;
   AliasTable emission_;  // plain luminance; built only when alias_ is compensated
   CosineProduct product_;
+  std::vector<uint32_t> warpBits_;  // bilinear lookup: the pixels whose draws follow it (warpInPixel)
   std::vector<DirectionalLight> points_;
   AdaptiveQuadtree adaptive_;
   size_t invalid_ = 0;

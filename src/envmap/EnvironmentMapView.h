@@ -59,6 +59,7 @@ struct EnvironmentMapView {
   AliasTableView emission;
   AdaptiveQuadtreeView adaptive;
   CosineProductView product;  // over the same weights as dist
+  const uint32_t* warpBits = nullptr;  // bit per pixel: draws inside it follow the lookup (bilinear only)
   const DirectionalLight* points = nullptr;  // the collapsed map, when one was made
   int pointCount = 0;
 
@@ -126,7 +127,8 @@ struct EnvironmentMapView {
   // With the pixel chosen by the lookup's average over it, the density is then proportional to
   // the lookup itself, as Mitsuba's piecewise-bilinear warp is; a pixel-constant density is
   // not, next to a small sun (docs/performance.md, "A low sun").
-  ENVGI_HD Vec2f warpInPixel(Vec2f uv) const {
+  // *rel: its density at the point, as densityInPixel gives it, from the same lattice.
+  ENVGI_HD Vec2f warpInPixel(Vec2f uv, float* rel) const {
     int px = clampi(int(uv.x * float(width)), 0, width - 1), py = clampi(int(uv.y * float(height)), 0, height - 1);
     float rx = clampf(uv.x * float(width) - float(px), 0.f, 1.f), ry = clampf(uv.y * float(height) - float(py), 0.f, 1.f);
     float v[3][3];
@@ -136,7 +138,10 @@ struct EnvironmentMapView {
     float y = sampleTwoLinearPieces(ry, twoLinearPieces(x, v[0][0], v[0][1], v[0][2]),
                                     twoLinearPieces(x, v[1][0], v[1][1], v[1][2]),
                                     twoLinearPieces(x, v[2][0], v[2][1], v[2][2]));
-    return {insidePixel(px, x, width), insidePixel(py, y, height)};
+    Vec2f w(insidePixel(px, x, width), insidePixel(py, y, height));
+    *rel = latticeDensity(v, clampf(w.x * float(width) - float(px), 0.f, 1.f),
+                          clampf(w.y * float(height) - float(py), 0.f, 1.f));
+    return w;
   }
 
   // warpInPixel's density at uv relative to uniform over the pixel: the lookup's luminance
@@ -146,6 +151,10 @@ struct EnvironmentMapView {
     float x = clampf(uv.x * float(width) - float(px), 0.f, 1.f), y = clampf(uv.y * float(height) - float(py), 0.f, 1.f);
     float v[3][3];
     pixelLattice(px, py, v);
+    return latticeDensity(v, x, y);
+  }
+  // The lookup over a pixel's lattice at (x, y) in [0, 1]^2 of the pixel, over its mean there.
+  ENVGI_HD static float latticeDensity(const float v[3][3], float x, float y) {
     float row[3], mean = 0.f;
     for (int j = 0; j < 3; ++j) {
       row[j] = twoLinearPieces(x, v[j][0], v[j][1], v[j][2]);
@@ -157,13 +166,20 @@ struct EnvironmentMapView {
 
   // For the strategies that pick a pixel from a table (importance, alias, product): with
   // bilinear lookup, the point inside the pixel follows the lookup, and *pdfUV takes its factor.
+  ENVGI_HD bool warpsAt(Vec2f uv) const {
+    if (!warpBits) return false;
+    int px = clampi(int(uv.x * float(width)), 0, width - 1), py = clampi(int(uv.y * float(height)), 0, height - 1);
+    size_t i = size_t(py) * size_t(width) + size_t(px);
+    return (warpBits[i >> 5] >> (i & 31)) & 1u;
+  }
   ENVGI_HD Vec2f placeInPixel(Vec2f uv, float* pdfUV) const {
-    if (!bilinear) return uv;
-    Vec2f w = warpInPixel(uv);
-    *pdfUV *= densityInPixel(w);
+    if (!warpsAt(uv)) return uv;
+    float rel;
+    Vec2f w = warpInPixel(uv, &rel);
+    *pdfUV *= rel;
     return w;
   }
-  ENVGI_HD float pdfInPixel(Vec2f uv) const { return bilinear ? densityInPixel(uv) : 1.f; }
+  ENVGI_HD float pdfInPixel(Vec2f uv) const { return warpsAt(uv) ? densityInPixel(uv) : 1.f; }
 
   ENVGI_HD Vec3f toLocal(Vec3f worldDir) const { return normalize(toWorld.inverseVector(worldDir)); }
   // toLocal up to a positive factor, a square root and a division cheaper: enough for dirToUV

@@ -16,6 +16,7 @@ EnvironmentMapView uploadEnvironment(DeviceArena& a, EnvironmentMapView v) {
   v.adaptive.nodes = a.upload(v.adaptive.nodes, size_t(v.adaptive.nodeCount), "adaptive quadtree");
   v.adaptive.leafNodes = a.upload(v.adaptive.leafNodes, size_t(v.adaptive.leafCount), "adaptive quadtree");
   v.points = a.upload(v.points, size_t(v.pointCount), "collapsed map");
+  v.warpBits = a.upload(v.warpBits, (px + 31) / 32, "environment warp mask");
   v.adaptive.leafSolidAngle = a.upload(v.adaptive.leafSolidAngle, size_t(v.adaptive.leafCount), "adaptive quadtree");
   if (v.product.valid()) {
     CosineProductView& p = v.product;
