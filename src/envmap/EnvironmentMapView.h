@@ -121,6 +121,19 @@ struct EnvironmentMapView {
       }
   }
 
+  // The pixel uv falls in, and where in it: the point's fraction across and down, in [0, 1].
+  struct PixelPoint {
+    int x, y;
+    Vec2f f;
+  };
+  ENVGI_HD PixelPoint pixelPoint(Vec2f uv) const {
+    PixelPoint p;
+    p.x = clampi(int(uv.x * float(width)), 0, width - 1);
+    p.y = clampi(int(uv.y * float(height)), 0, height - 1);
+    p.f = {clampf(uv.x * float(width) - float(p.x), 0.f, 1.f), clampf(uv.y * float(height) - float(p.y), 0.f, 1.f)};
+    return p;
+  }
+
   // A point uniform inside its pixel (uv from a pixel-constant density) moved so that it follows
   // the bilinear lookup's luminance inside that pixel: x by the patches' marginal, then y given
   // x, each by inverting a piecewise-linear cdf, so that stratified (u1, u2) stay stratified.
@@ -128,58 +141,58 @@ struct EnvironmentMapView {
   // the lookup itself, as Mitsuba's piecewise-bilinear warp is; a pixel-constant density is
   // not, next to a small sun (docs/performance.md, "A low sun").
   // *rel: its density at the point, as densityInPixel gives it, from the same lattice.
-  ENVGI_HD Vec2f warpInPixel(Vec2f uv, float* rel) const {
-    int px = clampi(int(uv.x * float(width)), 0, width - 1), py = clampi(int(uv.y * float(height)), 0, height - 1);
-    float rx = clampf(uv.x * float(width) - float(px), 0.f, 1.f), ry = clampf(uv.y * float(height) - float(py), 0.f, 1.f);
+  ENVGI_HD Vec2f warpInPixel(const PixelPoint& p, float* rel) const {
     float v[3][3];
-    pixelLattice(px, py, v);
-    float x = sampleTwoLinearPieces(rx, v[0][0] + 2.f * v[1][0] + v[2][0], v[0][1] + 2.f * v[1][1] + v[2][1],
+    pixelLattice(p.x, p.y, v);
+    float x = sampleTwoLinearPieces(p.f.x, v[0][0] + 2.f * v[1][0] + v[2][0], v[0][1] + 2.f * v[1][1] + v[2][1],
                                     v[0][2] + 2.f * v[1][2] + v[2][2]);
-    float y = sampleTwoLinearPieces(ry, twoLinearPieces(x, v[0][0], v[0][1], v[0][2]),
+    float y = sampleTwoLinearPieces(p.f.y, twoLinearPieces(x, v[0][0], v[0][1], v[0][2]),
                                     twoLinearPieces(x, v[1][0], v[1][1], v[1][2]),
                                     twoLinearPieces(x, v[2][0], v[2][1], v[2][2]));
-    Vec2f w(insidePixel(px, x, width), insidePixel(py, y, height));
-    *rel = latticeDensity(v, clampf(w.x * float(width) - float(px), 0.f, 1.f),
-                          clampf(w.y * float(height) - float(py), 0.f, 1.f));
+    Vec2f w(insidePixel(p.x, x, width), insidePixel(p.y, y, height));
+    *rel = latticeDensity(v, pixelPoint(w).f);  // the same pixel: insidePixel keeps it there
     return w;
   }
 
-  // warpInPixel's density at uv relative to uniform over the pixel: the lookup's luminance
+  // warpInPixel's density at a point relative to uniform over its pixel: the lookup's luminance
   // over its mean on the pixel (1 on a black pixel, which warpInPixel leaves uniform).
-  ENVGI_HD float densityInPixel(Vec2f uv) const {
-    int px = clampi(int(uv.x * float(width)), 0, width - 1), py = clampi(int(uv.y * float(height)), 0, height - 1);
-    float x = clampf(uv.x * float(width) - float(px), 0.f, 1.f), y = clampf(uv.y * float(height) - float(py), 0.f, 1.f);
+  ENVGI_HD float densityInPixel(const PixelPoint& p) const {
     float v[3][3];
-    pixelLattice(px, py, v);
-    return latticeDensity(v, x, y);
+    pixelLattice(p.x, p.y, v);
+    return latticeDensity(v, p.f);
   }
-  // The lookup over a pixel's lattice at (x, y) in [0, 1]^2 of the pixel, over its mean there.
-  ENVGI_HD static float latticeDensity(const float v[3][3], float x, float y) {
+  // The lookup over a pixel's lattice at fraction f of the pixel, over its mean there.
+  ENVGI_HD static float latticeDensity(const float v[3][3], Vec2f f) {
     float row[3], mean = 0.f;
     for (int j = 0; j < 3; ++j) {
-      row[j] = twoLinearPieces(x, v[j][0], v[j][1], v[j][2]);
+      row[j] = twoLinearPieces(f.x, v[j][0], v[j][1], v[j][2]);
       mean += (j == 1 ? 2.f : 1.f) * (v[j][0] + 2.f * v[j][1] + v[j][2]);
     }
     mean *= 1.f / 16.f;
-    return mean > 0.f ? twoLinearPieces(y, row[0], row[1], row[2]) / mean : 1.f;
+    return mean > 0.f ? twoLinearPieces(f.y, row[0], row[1], row[2]) / mean : 1.f;
   }
 
   // For the strategies that pick a pixel from a table (importance, alias, product): with
-  // bilinear lookup, the point inside the pixel follows the lookup, and *pdfUV takes its factor.
-  ENVGI_HD bool warpsAt(Vec2f uv) const {
+  // bilinear lookup, the point inside the pixel follows the lookup where the pixel is marked,
+  // and *pdfUV takes its factor.
+  ENVGI_HD bool warps(const PixelPoint& p) const {
     if (!warpBits) return false;
-    int px = clampi(int(uv.x * float(width)), 0, width - 1), py = clampi(int(uv.y * float(height)), 0, height - 1);
-    size_t i = size_t(py) * size_t(width) + size_t(px);
+    size_t i = size_t(p.y) * size_t(width) + size_t(p.x);
     return (warpBits[i >> 5] >> (i & 31)) & 1u;
   }
+  ENVGI_HD bool warpsAt(Vec2f uv) const { return warps(pixelPoint(uv)); }
   ENVGI_HD Vec2f placeInPixel(Vec2f uv, float* pdfUV) const {
-    if (!warpsAt(uv)) return uv;
+    PixelPoint p = pixelPoint(uv);
+    if (!warps(p)) return uv;
     float rel;
-    Vec2f w = warpInPixel(uv, &rel);
+    Vec2f w = warpInPixel(p, &rel);
     *pdfUV *= rel;
     return w;
   }
-  ENVGI_HD float pdfInPixel(Vec2f uv) const { return warpsAt(uv) ? densityInPixel(uv) : 1.f; }
+  ENVGI_HD float pdfInPixel(Vec2f uv) const {
+    PixelPoint p = pixelPoint(uv);
+    return warps(p) ? densityInPixel(p) : 1.f;
+  }
 
   ENVGI_HD Vec3f toLocal(Vec3f worldDir) const { return normalize(toWorld.inverseVector(worldDir)); }
   // toLocal up to a positive factor, a square root and a division cheaper: enough for dirToUV
