@@ -106,12 +106,17 @@ struct EnvironmentMapView {
   // 3 x 3 lattice: v[j][i] at x = i / 2, y = j / 2 across the pixel (its corners, the midpoints
   // of its edges, its centre), each the mean of the pixels around that point, wrapping in u and
   // clamping at the poles as lookupUV does.
-  ENVGI_HD void pixelLattice(int px, int py, float v[3][3]) const {
+  // The luminance of pixel (px, py) and its eight neighbours, l[j][i] for x = px - 1 + i and
+  // y = py - 1 + j, wrapping in u and clamping at the poles as lookupUV does.
+  ENVGI_HD void neighbourhoodLuminance(int px, int py, float l[3][3]) const {
     int xs[3] = {px > 0 ? px - 1 : width - 1, px, px + 1 < width ? px + 1 : 0};
     int ys[3] = {py > 0 ? py - 1 : 0, py, py + 1 < height ? py + 1 : height - 1};
-    float l[3][3];
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) l[j][i] = luminance(texel(xs[i], ys[j]));
+  }
+  ENVGI_HD void pixelLattice(int px, int py, float v[3][3]) const {
+    float l[3][3];
+    neighbourhoodLuminance(px, py, l);
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) {
         // The pixels around lattice point (i, j): the centre one, and the neighbour on the
