@@ -50,15 +50,14 @@ def mitsuba_render(scene, spp, seed):
     return img, time.perf_counter() - t
 
 
-def timed(render, repeats):
-    """The image of one render and the median time of `repeats` (same seed, so the same image):
-    one render's time moves by 10-30% on a shared machine, enough to flip a ratio near 1."""
-    runs = [render() for _ in range(repeats)]
-    return runs[0][0], statistics.median(t for _, t in runs)
-
-
-def rmse(a, b):
-    return float(np.sqrt(np.mean((a - b) ** 2)))
+def over_seeds(render, ref, seeds):
+    """RMSE over several seeds (the root of their mean squared error) and the median time.
+    One seed is not enough on a scene with fireflies: the teapot's glass moves one render's RMSE
+    by 10-20% from seed to seed, and with it a ratio near 0.7. The median time, because one
+    render's time moves by 10-30% on a shared machine."""
+    runs = [render(seed) for seed in seeds]
+    mse = statistics.fmean(float(np.mean((img - ref) ** 2)) for img, _ in runs)
+    return float(np.sqrt(mse)), statistics.median(t for _, t in runs)
 
 
 def main():
@@ -71,12 +70,15 @@ def main():
     ap.add_argument('--spp', default='16,64')
     ap.add_argument('--threads', type=int, default=os.cpu_count())
     ap.add_argument('--strategy', default='product', help="envgi's environment strategy (its default: product)")
-    ap.add_argument('--repeats', type=int, default=3, help='renders per timing; the median time is used')
+    ap.add_argument('--seeds', type=int, default=4,
+                    help='renders per measurement, seeds 7, 8, ...: RMSE from their mean squared error, '
+                         'the median time')
     ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,bunny-sunrise',
                     help='comma-separated scene files (without .xml) in --scenes to compare on')
     args = ap.parse_args()
-    if args.repeats < 1:
-        ap.error('--repeats must be at least 1')
+    if args.seeds < 1:
+        ap.error('--seeds must be at least 1')
+    seeds = range(7, 7 + args.seeds)
     mi.set_variant(args.variant)
     tmp = tempfile.mkdtemp(prefix='envgi_perf_')
     out = os.path.join(tmp, 'e.exr')
@@ -92,18 +94,18 @@ def main():
         mitsuba_render(scene, 4, 0)  # compiles its kernels
         mref, _ = mitsuba_render(scene, args.ref_spp, 1)
         for spp in (int(s) for s in args.spp.split(',')):
-            mimg, mt = timed(lambda: mitsuba_render(scene, spp, 7), args.repeats)
-            erender = lambda n: envgi_render(args.envgi, xml, out, n, 7, args.res, args.threads, args.strategy)
-            eimg, et = timed(lambda: erender(spp), args.repeats)
+            rm, mt = over_seeds(lambda seed: mitsuba_render(scene, spp, seed), mref, seeds)
+            erender = lambda n: lambda seed: envgi_render(args.envgi, xml, out, n, seed, args.res, args.threads,
+                                                          args.strategy)
+            re_, et = over_seeds(erender(spp), eref, seeds)
             espp = max(1, int(round(spp * mt / et)))
-            eimg2, et2 = timed(lambda: erender(espp), args.repeats)
-            rm, re_, re2 = rmse(mimg, mref), rmse(eimg, eref), rmse(eimg2, eref)
+            re2, et2 = over_seeds(erender(espp), eref, seeds)
             rows.append((name, spp, mt, rm, et, re_, espp, et2, re2, (re2 * re2 * et2) / (rm * rm * mt),
                          (re_ * re_ * et) / (rm * rm * mt)))
             print(rows[-1], flush=True)
     print(f'\nMitsuba {mi.__version__} {args.variant} vs envgi path (strategy {args.strategy}), {args.res}^2, '
-          f'{args.threads} threads; RMSE against each renderer\'s own {args.ref_spp}-spp reference; times are '
-          f'medians of {args.repeats} renders\n')
+          f'{args.threads} threads; RMSE against each renderer\'s own {args.ref_spp}-spp reference, over '
+          f'{args.seeds} seeds; times are the medians of those renders\n')
     print('| scene | spp | Mitsuba s | Mitsuba RMSE | envgi s | envgi RMSE | envgi spp, same time | s | RMSE | '
           'envgi RMSE² t / Mitsuba\'s, same time | same spp |')
     print('|---|---|---|---|---|---|---|---|---|---|---|')
