@@ -71,6 +71,20 @@ ENVGI_INLINE uint32_t permutationElement(uint32_t i, uint32_t l, uint32_t p) {
   return (l & (l - 1)) == 0 ? (i + p) & (l - 1) : (i + p) % l;
 }
 
+// The power-of-two block of [0, n) that i falls in, with n split into its binary digits from the
+// top (n = 96: [0, 64), then [64, 96)). A (0,2)-sequence's aligned power-of-two blocks are nets, so
+// shuffling each block on its own still hands out the first n points, and a power-of-two shuffle
+// needs neither the cycle walk nor the division (an 83-spp draw cost 1.7x a 64-spp one).
+struct IndexBlock {
+  uint32_t start, size;
+};
+ENVGI_INLINE IndexBlock powerOfTwoBlock(uint32_t i, uint32_t n) {
+  uint32_t x = i ^ n;  // the highest bit where i (< n) and n differ: n has it, i has not
+  for (uint32_t s = 1; s < 32; s <<= 1) x |= x >> s;
+  uint32_t size = (x >> 1) + 1;  // that bit alone
+  return {n & ~x, size};
+}
+
 // Salts that give each use of a pixel's hash its own stream.
 inline constexpr uint32_t kSobolShuffle1D = 0x5bd1e995u, kSobolShuffle2D = 0x68e31da4u;
 inline constexpr uint32_t kOwenSeedX = 0x1234567u, kOwenSeedY = 0x89abcdeu;
@@ -85,14 +99,22 @@ struct Sampler {
   uint64_t pixelHash = 0;
   uint32_t index = 0;
   uint32_t indexInPixel = 0;  // index % spp, taken once a sample rather than once a draw
+  IndexBlock block{0, 1};     // Sobol: the power-of-two block of [0, spp) indexInPixel is in
   uint32_t dim = 0;
   Pcg32 rng;
+
+  // Sobol: the point of the pixel's first spp this sample takes in a dimension with hash h, a
+  // shuffle within its power-of-two block (for a power of two, one shuffle of all spp).
+  ENVGI_HD uint32_t shuffledIndex(uint32_t h) const {
+    return block.start + permutationElement(indexInPixel - block.start, block.size, h);
+  }
 
   // Begin sample `sampleIndex` of a pixel (a pixel id, or any stream id for non-image work).
   ENVGI_HD void start(uint64_t pixel, uint32_t sampleIndex) {
     pixelHash = hashCombine(mixBits(pixel), seed);
     index = sampleIndex;
     indexInPixel = sampleIndex % spp;
+    block = powerOfTwoBlock(indexInPixel, spp);
     dim = 0;
     rng.setSeed(pixelHash, uint64_t(sampleIndex) + 1u);
   }
@@ -107,7 +129,7 @@ struct Sampler {
       }
       case SamplerType::Sobol: {
         uint32_t h = uint32_t(hashCombine(pixelHash, d));
-        uint32_t i = permutationElement(indexInPixel, spp, h ^ kSobolShuffle1D);
+        uint32_t i = shuffledIndex(h ^ kSobolShuffle1D);
         return bitsToFloat01(owenScrambleReversed(sobolDim0Reversed(i), h));
       }
       case SamplerType::Independent: break;
@@ -134,7 +156,7 @@ struct Sampler {
       case SamplerType::Sobol: {
         // Independent shuffles per dimension pair decorrelate the pairs (Burley 2020).
         uint32_t h = uint32_t(hashCombine(pixelHash, d));
-        uint32_t i = permutationElement(indexInPixel, spp, h ^ kSobolShuffle2D);
+        uint32_t i = shuffledIndex(h ^ kSobolShuffle2D);
         uint32_t s0 = uint32_t(mixBits(h ^ kOwenSeedX)), s1 = uint32_t(mixBits(h ^ kOwenSeedY));
         return {bitsToFloat01(owenScrambleReversed(sobolDim0Reversed(i), s0)),
                 bitsToFloat01(owenScrambleReversed(sobolDim1Reversed(i), s1))};

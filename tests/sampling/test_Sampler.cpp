@@ -75,6 +75,59 @@ TEST(Sampler, PermutationIsBijective) {
   }
 }
 
+// Power-of-two blocks split [0, n) by n's binary digits; shuffling within them is a bijection of
+// [0, n), and for a power of two it is the one shuffle of [0, n) used before the blocks.
+TEST(Sampler, PowerOfTwoBlocksShuffleTheFirstNIndices) {
+  for (uint32_t n = 1; n <= 300; ++n)
+    for (uint32_t h : {12345u, 0x9e3779b9u}) {
+      std::set<uint32_t> seen;
+      for (uint32_t i = 0; i < n; ++i) {
+        IndexBlock b = powerOfTwoBlock(i, n);
+        ASSERT_EQ(b.size & (b.size - 1), 0u) << n << " " << i;
+        ASSERT_TRUE(b.start <= i && i < b.start + b.size && b.start + b.size <= n) << n << " " << i;
+        ASSERT_EQ(b.start % b.size, 0u) << n << " " << i;  // aligned: a net of the (0,2)-sequence
+        uint32_t j = b.start + permutationElement(i - b.start, b.size, h);
+        if ((n & (n - 1)) == 0) {
+          ASSERT_EQ(j, permutationElement(i, n, h)) << n << " " << i;
+        }
+        seen.insert(j);
+      }
+      EXPECT_EQ(seen.size(), n);
+      EXPECT_LT(*seen.rbegin(), n);
+    }
+}
+
+// At any sample count, each Sobol dimension hands a pixel's samples exactly the first spp points
+// of its scrambled sequence, in a shuffled order.
+TEST(Sampler, SobolDrawsTheFirstSppPointsAtAnyCount) {
+  for (uint32_t spp : {24u, 83u, 96u, 128u}) {
+    Sampler s;
+    s.type = SamplerType::Sobol;
+    s.spp = spp;
+    s.seed = 5;
+    std::vector<std::multiset<float>> got(4);
+    for (uint32_t i = 0; i < spp; ++i) {
+      s.start(77, i);
+      got[0].insert(s.get1D());
+      Vec2f p = s.get2D();
+      got[1].insert(p.x);
+      got[2].insert(p.y);
+      got[3].insert(s.get1D());
+    }
+    s.start(77, 0);
+    uint32_t h0 = uint32_t(hashCombine(s.pixelHash, 0u)), h1 = uint32_t(hashCombine(s.pixelHash, 1u)),
+             h3 = uint32_t(hashCombine(s.pixelHash, 3u));
+    std::vector<std::multiset<float>> want(4);
+    for (uint32_t j = 0; j < spp; ++j) {
+      want[0].insert(bitsToFloat01(owenScrambleReversed(sobolDim0Reversed(j), h0)));
+      want[1].insert(bitsToFloat01(owenScrambleReversed(sobolDim0Reversed(j), uint32_t(mixBits(h1 ^ kOwenSeedX)))));
+      want[2].insert(bitsToFloat01(owenScrambleReversed(sobolDim1Reversed(j), uint32_t(mixBits(h1 ^ kOwenSeedY)))));
+      want[3].insert(bitsToFloat01(owenScrambleReversed(sobolDim0Reversed(j), h3)));
+    }
+    for (int d = 0; d < 4; ++d) EXPECT_EQ(got[d], want[d]) << spp << " dimension " << d;
+  }
+}
+
 // The fast forms the Sobol sampler draws through must give the very values of the plain ones:
 // the byte-swap bit reversal, the dimensions built already reversed, the scrambler fed reversed
 // input.
