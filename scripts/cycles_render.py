@@ -1,4 +1,5 @@
-"""One of envgi's map-lit scene files rendered by Blender Cycles, for scripts/perf_cycles.py.
+"""One of envgi's map-lit scene files rendered by Blender Cycles, for scripts/perf_compare.py
+(through scripts/perf-cycles.sh).
 
 Runs inside Blender (Debian 12's blender 3.4.1, the Cycles the issue was measured against):
   blender -b --factory-startup -noaudio --python scripts/cycles_render.py -- SCENE.xml
@@ -26,8 +27,8 @@ Y_UP_TO_Z_UP = Matrix.Rotation(math.radians(90.0), 4, 'X')
 # after the turn above: of the four, the only one whose buddha render matches envgi's (relative
 # RMSE 0.24 at 64 spp against 3.8-15 for the others; the windows of Grace line up by eye).
 ENV_TURN_DEG = 90.0
-# Normal-incidence reflectance of the conductors the scenes name (from their complex indices at
-# 650/550/450 nm): Cycles 3.4 has no conductor with a complex index, its glossy BSDF takes a colour.
+# Typical linear-RGB normal-incidence reflectances of the metals a scene may name: Cycles 3.4 has
+# no conductor with a complex index of refraction, its glossy BSDF takes a colour.
 CONDUCTOR_F0 = {'Cu': (0.955, 0.638, 0.538), 'Cr': (0.549, 0.556, 0.554), 'Al': (0.913, 0.922, 0.924),
                 'Au': (1.000, 0.766, 0.336), 'Ag': (0.972, 0.960, 0.915), 'none': (1.0, 1.0, 1.0)}
 

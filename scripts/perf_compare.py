@@ -99,8 +99,8 @@ class Cycles:
 
 
 def over_seeds(render, ref, seeds, scale=1.0):
-    """RMSE over several seeds, divided by scale, (the root of their mean squared error) and the median time.
-    One seed is not enough on a scene with fireflies: the teapot's glass moves one render's RMSE
+    """RMSE over several seeds (the root of their mean squared error), divided by scale, and the
+    median time. One seed is not enough on a scene with fireflies: the teapot's glass moves one render's RMSE
     by 10-20% from seed to seed, and with it a ratio near 0.7. The median time, because one
     render's time moves by 10-30% on a shared machine."""
     runs = [render(seed) for seed in seeds]
