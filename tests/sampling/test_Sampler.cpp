@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 #include <vector>
 
@@ -75,8 +76,8 @@ TEST(Sampler, PermutationIsBijective) {
   }
 }
 
-// Power-of-two blocks split [0, n) by n's binary digits; shuffling within them is a bijection of
-// [0, n), and for a power of two it is the one shuffle of [0, n) used before the blocks.
+// Power-of-two blocks split [0, n) by n's binary digits, and the shuffle within a block is a
+// bijection whose every prefix [0, 2^j) lands on an aligned block of 2^j indices.
 TEST(Sampler, PowerOfTwoBlocksShuffleTheFirstNIndices) {
   for (uint32_t n = 1; n <= 300; ++n)
     for (uint32_t h : {12345u, 0x9e3779b9u}) {
@@ -86,15 +87,48 @@ TEST(Sampler, PowerOfTwoBlocksShuffleTheFirstNIndices) {
         ASSERT_EQ(b.size & (b.size - 1), 0u) << n << " " << i;
         ASSERT_TRUE(b.start <= i && i < b.start + b.size && b.start + b.size <= n) << n << " " << i;
         ASSERT_EQ(b.start % b.size, 0u) << n << " " << i;  // aligned: a net of the (0,2)-sequence
-        uint32_t j = b.start + permutationElement(i - b.start, b.size, h);
-        if ((n & (n - 1)) == 0) {
-          ASSERT_EQ(j, permutationElement(i, n, h)) << n << " " << i;
-        }
-        seen.insert(j);
+        seen.insert(b.start + nestedShuffle(i - b.start, b.size, h));
       }
       EXPECT_EQ(seen.size(), n);
       EXPECT_LT(*seen.rbegin(), n);
     }
+  for (uint32_t size : {1u, 2u, 64u, 1024u})
+    for (uint32_t h : {1u, 777u, 0xdeadbeefu})
+      for (uint32_t k = 1; k <= size; k *= 2) {
+        std::set<uint32_t> blocks;  // which aligned block of k each of the first k lands in
+        for (uint32_t i = 0; i < k; ++i) blocks.insert(nestedShuffle(i, size, h) / k);
+        EXPECT_EQ(blocks.size(), 1u) << size << " " << h << " " << k;
+      }
+}
+
+// A pixel's first 2^j Sobol samples, of any larger spp, fill the 2^j strata of each 1D dimension
+// and the cells of each 2D pair's square grid once each: the viewer's frames, checkpoints and
+// time-limited renders are as even as a render of 2^j samples.
+TEST(Sampler, SobolPrefixesAtPowersOfTwoAreStratified) {
+  for (uint32_t spp : {256u, 1000u}) {
+    Sampler s;
+    s.type = SamplerType::Sobol;
+    s.spp = spp;
+    s.seed = 9;
+    for (uint32_t k : {4u, 16u, 64u}) {
+      uint32_t g = uint32_t(std::lround(std::sqrt(double(k))));
+      for (uint64_t pixel : {3u, 4242u}) {
+        std::set<int> strata, cells, cellsDeep;
+        for (uint32_t i = 0; i < k; ++i) {
+          s.start(pixel, i);
+          strata.insert(int(s.get1D() * k));
+          Vec2f p = s.get2D();
+          cells.insert(int(p.x * g) + int(g) * int(p.y * g));
+          s.get1D();
+          Vec2f q = s.get2D();
+          cellsDeep.insert(int(q.x * g) + int(g) * int(q.y * g));
+        }
+        EXPECT_EQ(strata.size(), k) << spp << " " << k;
+        EXPECT_EQ(cells.size(), k) << spp << " " << k;
+        EXPECT_EQ(cellsDeep.size(), k) << spp << " " << k;
+      }
+    }
+  }
 }
 
 // At any sample count, each Sobol dimension hands a pixel's samples exactly the first spp points
