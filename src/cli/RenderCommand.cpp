@@ -34,6 +34,7 @@ struct RenderArgs {
   float exposure = 0.f;
   bool aces = false;
   double checkpoint = 60.0;
+  double timeLimit = 0.0;
   std::string device = "auto", sampler, pointMethod, filter;
   int points = 0;
   int gpu = 0;
@@ -89,6 +90,7 @@ void runRender(const RenderArgs& a) {
     spdlog::info("checkpoint: {} spp written to {}", done, a.output);
   };
   ro.cancel = &g_cancel;
+  ro.timeLimitSeconds = a.timeLimit;
   std::signal(SIGINT, onInterrupt);
   std::signal(SIGTERM, onInterrupt);
   RenderStats st;
@@ -121,6 +123,9 @@ void runRender(const RenderArgs& a) {
   std::signal(SIGTERM, SIG_DFL);
   write(img);
   if (st.cancelled) spdlog::warn("interrupted: wrote the {} samples per pixel finished so far", st.sppDone);
+  if (st.timeLimited)
+    spdlog::info("time limit of {:g} s: stopped after {} of {} spp", a.timeLimit, st.sppDone,
+                 a.spp > 0 ? a.spp : scene.sampler.sampleCount);
   spdlog::info("done in {:.2f} s: {} spp, {:.3g} rays, {:.3g} Mrays/s", st.seconds, st.sppDone, double(st.rays),
                st.raysPerSecond() / 1e6);
   spdlog::info("wrote {}{}", fs::absolute(a.output).string(),
@@ -168,6 +173,9 @@ void addRenderCommand(CLI::App& app) {
   c->add_flag("--aces", a->aces, "ACES-style tone curve for 8-bit output");
   c->add_flag("--no-progress", a->noProgress, "No progress bar");
   c->add_option("--checkpoint", a->checkpoint, "Seconds between writes of the image so far (0: never)");
+  c->add_option("--time-limit", a->timeLimit,
+                "Seconds of sampling at most: stop at the last pass that fits, with the samples done (0: none)")
+      ->check(CLI::NonNegativeNumber);
   c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
   c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(CLI::NonNegativeNumber);
   c->add_option("--filter", a->filter, "Pixel filter: " + nameList(kFilterNames) + " (overrides the scene)");

@@ -239,18 +239,24 @@ Image filmMean(const FilmSums& film, int width, int height, int samples) {
 }
 
 Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts, RenderStats* stats) {
-  // Passes double in size (1, 1, 2, 4, ...) up to the executor's limit (64 samples on the CPU),
-  // so a checkpoint comes early.
+  // Passes double the samples done (1, 1, 2, 4, ...) up to the executor's limit (64 samples on
+  // the CPU), so a checkpoint comes early, and each pass ends at a power of two or a multiple of
+  // the limit: there a pixel's Sobol samples so far are a net (Sampler::shuffledIndex), so a
+  // checkpoint or a time-limited render is as even as a render of that many samples.
   std::vector<std::pair<int, int>> passes;
   const int maxPass = std::max(1, ex.maxPassSize());
-  for (int s = 0, n = 1; s < spp; s += n, n = std::min(2 * n, maxPass)) passes.push_back({s, std::min(spp, s + n)});
+  for (int s = 0; s < spp;) {
+    int n = std::clamp(s, 1, maxPass);
+    passes.push_back({s, std::min(spp, s + n)});
+    s += n;
+  }
   Progress progress(size_t(W) * H * spp, opts.progress);
   PassCounters counters;
   FilmSums film;
   auto t0 = Clock::now();
   auto lastCheckpoint = t0;
   int sppDone = 0;
-  bool cancelled = false;
+  bool cancelled = false, timeLimited = false;
   auto meanImage = [&](int n) {
     ex.readFilm(&film);
     return filmMean(film, W, H, n);
@@ -259,6 +265,13 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     if (opts.cancel && opts.cancel->load()) {
       cancelled = true;
       break;
+    }
+    if (opts.timeLimitSeconds > 0.0 && sppDone > 0) {
+      double spent = std::chrono::duration<double>(Clock::now() - t0).count();
+      if (spent + spent / sppDone * (s1 - s0) > opts.timeLimitSeconds) {
+        timeLimited = true;
+        break;
+      }
     }
     ex.runPass(s0, s1, progress, &counters);
     sppDone = s1;
@@ -275,6 +288,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     stats->rays = counters.rays;
     stats->nonFiniteSamples = counters.dropped;
     stats->cancelled = cancelled;
+    stats->timeLimited = timeLimited;
   }
   if (opts.varianceOut && sppDone > 0) {
     if (film.sumSqLum.empty()) throw std::runtime_error("this executor kept no per-pixel variance");

@@ -32,6 +32,9 @@ struct RenderOptions {
   // Called with the mean image of the passes done so far (checkpoints).
   std::function<void(const Image&, int sppDone)> checkpoint;
   const std::atomic<bool>* cancel = nullptr;  // stop after the current pass when set
+  // Stop before a pass that would end past this many seconds of passes, at the rate of those
+  // done (0: no limit); the first pass always runs. Cycles' time limit, Mitsuba's timeout.
+  double timeLimitSeconds = 0.0;
   // When set, receives the variance of each pixel's mean luminance (for Z-tests between
   // estimators, as Mitsuba's render tests use).
   std::vector<float>* varianceOut = nullptr;
@@ -46,6 +49,7 @@ struct RenderStats {
   uint64_t rays = 0;
   uint64_t nonFiniteSamples = 0;
   bool cancelled = false;
+  bool timeLimited = false;  // stopped by timeLimitSeconds before the requested samples
   double raysPerSecond() const { return seconds > 0.0 ? double(rays) / seconds : 0.0; }
 };
 

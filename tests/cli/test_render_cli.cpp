@@ -109,6 +109,28 @@ TEST(CliRender, InterruptKeepsFinishedWork) {
   EXPECT_NE(log.find("interrupted"), std::string::npos) << log;
 }
 
+// A time limit ends a render of far more samples than fit at a pass boundary, with the image
+// of the samples done and a log line saying how many.
+TEST(CliRender, TimeLimitStopsAtAPassWithTheSamplesDone) {
+  TempDir d;
+  std::string scene = tinyScene(d, 32, 1000000);
+  std::string out = d.file("limited.exr");
+  auto t0 = std::chrono::steady_clock::now();
+  CliResult r = runCli("render " + scene + " -o " + out + " --no-progress --time-limit 0.5");
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_LT(seconds, 60.0);  // a million samples of 32x32 would take minutes
+  EXPECT_NE(r.output.find("time limit of 0.5 s: stopped after"), std::string::npos) << r.output;
+  envgi::Image img = envgi::loadImage(out);
+  EXPECT_EQ(img.width, 32);
+  double sum = 0.0;
+  for (float v : img.rgb) sum += v;
+  EXPECT_GT(sum, 0.0);
+  CliResult bad = runCli("render " + scene + " -o " + d.file("x.exr") + " --time-limit -1");
+  EXPECT_NE(bad.code, 0) << bad.output;
+  EXPECT_FALSE(fs::exists(d.file("x.exr")));
+}
+
 TEST(CliPhotons, DrawsPhotonsAndRejectsBadInput) {
   TempDir d;
   std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml";
