@@ -10,12 +10,18 @@ namespace envgi {
 
 class Progress {
  public:
-  Progress(size_t total, bool enabled);
+  // timeLimit > 0: the work may stop then (render --time-limit), so the bar shows whichever of
+  // the work and the time is further along, and the time left is at most the limit's.
+  Progress(size_t total, bool enabled, double timeLimit = 0.0);
   void add(size_t n);
+  // Ends the bar's line when the work stopped short of the total (a time limit, Ctrl-C).
+  void finish();
 
  private:
   size_t total_;
   bool enabled_, tty_;
+  double timeLimit_;
+  bool open_ = false;  // a bar is drawn on a terminal line not yet ended
   std::chrono::steady_clock::time_point start_;
   std::atomic<size_t> done_{0};
   std::mutex m_;

@@ -250,7 +250,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     passes.push_back({s, std::min(spp, s + n)});
     s += n;
   }
-  Progress progress(size_t(W) * H * spp, opts.progress);
+  Progress progress(size_t(W) * H * spp, opts.progress, opts.timeLimitSeconds);
   PassCounters counters;
   FilmSums film;
   auto t0 = Clock::now();
@@ -281,6 +281,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
       lastCheckpoint = Clock::now();
     }
   }
+  progress.finish();
   Image img = meanImage(std::max(sppDone, 1));
   if (stats) {
     stats->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
