@@ -131,6 +131,30 @@ TEST(CliRender, TimeLimitStopsAtAPassWithTheSamplesDone) {
   EXPECT_FALSE(fs::exists(d.file("x.exr")));
 }
 
+// Under a time limit the progress log (every 10% when not on a terminal) counts the time too:
+// no line promises more time left than the limit, and the bar gets past half way (by samples
+// alone it would stay near 0%).
+TEST(CliRender, TimeLimitProgressFollowsTheClock) {
+  TempDir d;
+  std::string scene = tinyScene(d, 32, 1000000);
+  CliResult r = runCli("render " + scene + " -o " + d.file("p.exr") + " --time-limit 1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::istringstream lines(r.output);
+  std::string line;
+  int bars = 0, lastPct = -1;
+  while (std::getline(lines, line)) {
+    size_t left = line.find("s left");
+    if (line.empty() || line[0] != '[' || left == std::string::npos) continue;
+    ++bars;
+    size_t comma = line.rfind(", ", left);
+    ASSERT_NE(comma, std::string::npos) << line;
+    EXPECT_LE(std::stod(line.substr(comma + 2, left - comma - 2)), 1.0) << line;
+    lastPct = std::stoi(line.substr(line.find(']') + 1));
+  }
+  EXPECT_GE(bars, 2) << r.output;
+  EXPECT_GE(lastPct, 50) << r.output;
+}
+
 TEST(CliPhotons, DrawsPhotonsAndRejectsBadInput) {
   TempDir d;
   std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml";
