@@ -95,9 +95,9 @@ void runRender(const RenderArgs& a) {
   std::signal(SIGTERM, onInterrupt);
   RenderStats st;
   const IntegratorSettings& is = scene.integrator;
+  const int requestedSpp = a.spp > 0 ? a.spp : scene.sampler.sampleCount;
   spdlog::info("rendering {}x{} with '{}' (strategy {}), {} spp, {} sampler", scene.camera.width, scene.camera.height,
-               integratorName(is.type), is.env.strategy, a.spp > 0 ? a.spp : scene.sampler.sampleCount,
-               samplerName(scene.sampler.type));
+               integratorName(is.type), is.env.strategy, requestedSpp, samplerName(scene.sampler.type));
   Image img;
   if (cuda) {
     Bvh bvh(scene);
@@ -124,8 +124,7 @@ void runRender(const RenderArgs& a) {
   write(img);
   if (st.cancelled) spdlog::warn("interrupted: wrote the {} samples per pixel finished so far", st.sppDone);
   if (st.timeLimited)
-    spdlog::info("time limit of {:g} s: stopped after {} of {} spp", a.timeLimit, st.sppDone,
-                 a.spp > 0 ? a.spp : scene.sampler.sampleCount);
+    spdlog::info("time limit of {:g} s: stopped after {} of {} spp", a.timeLimit, st.sppDone, requestedSpp);
   spdlog::info("done in {:.2f} s: {} spp, {:.3g} rays, {:.3g} Mrays/s", st.seconds, st.sppDone, double(st.rays),
                st.raysPerSecond() / 1e6);
   spdlog::info("wrote {}{}", fs::absolute(a.output).string(),

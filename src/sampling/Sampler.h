@@ -93,9 +93,9 @@ ENVGI_INLINE IndexBlock powerOfTwoBlock(uint32_t i, uint32_t n) {
 // viewer's frames, checkpoints and time-limited renders converge as a render of 2^j samples.
 // (Kensler's permutation, used before, hands a prefix a scattered subset of the points.)
 ENVGI_INLINE uint32_t nestedShuffle(uint32_t i, uint32_t size, uint32_t seed) {
-  // On reversed bits the Laine-Karras hash flips each bit by the bits below it, so here by the
-  // bits above it; the bits at and above log2(size) are zero, so the mask keeps a bijection.
-  return reverseBits32(laineKarrasPermutation(reverseBits32(i), seed)) & (size - 1);
+  // Owen scrambling of i itself: each bit flipped by the bits above it; the bits at and above
+  // log2(size) are zero, so the mask keeps a bijection.
+  return owenScrambleReversed(reverseBits32(i), seed) & (size - 1);
 }
 
 // Salts that give each use of a pixel's hash its own stream.
