@@ -75,16 +75,22 @@ Image loadExr(const std::string& path) {
 
 // stb_image for .hdr, .png and .jpg. stb pads a truncated file with zeros rather than failing
 // (and its HDR run-length decoder never ends on zeros), so reads go through callbacks that note
-// a read past the end and answer it with 0xFF bytes, on which every decoder ends quickly.
+// a read past the end and answer it with 0xFF bytes, on which the HDR decoder ends within a
+// scanline. The padding is bounded, since a JPEG's marker search skips 0xFF bytes forever and
+// a PNG's chunk skipping would run through gigabytes of it; after it comes the end of file.
 struct StbStream {
   FILE* f;
   bool pastEnd = false;
+  size_t padded = 0;
 };
+constexpr size_t kStbPadding = size_t(1) << 16;
 int stbRead(void* user, char* data, int size) {
   auto* s = static_cast<StbStream*>(user);
   size_t n = std::fread(data, 1, size_t(size), s->f);
   if (n == 0 && size > 0) {
     s->pastEnd = true;
+    if (s->padded >= kStbPadding) return 0;
+    s->padded += size_t(size);
     std::memset(data, 0xFF, size_t(size));
     return size;
   }
@@ -93,7 +99,35 @@ int stbRead(void* user, char* data, int size) {
 void stbSkip(void* user, int n) { std::fseek(static_cast<StbStream*>(user)->f, n, SEEK_CUR); }
 int stbEof(void* user) { return std::feof(static_cast<StbStream*>(user)->f); }
 
+// stb reads a Radiance header line by line until a blank one and, answered with padding past
+// the end, would look for it forever; and it allocates the pixels that the resolution line
+// names before reading them. So the header is checked here first: it must end inside the file,
+// and the bytes after it must be able to hold the pixels (a run-length scanline takes at least
+// 4 bytes and 2 per 127 pixels of each of its 4 channels; a flat one 4 bytes a pixel).
+void checkRadianceHeader(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(size_t(1) << 16, '\0');
+  in.read(head.data(), std::streamsize(head.size()));
+  head.resize(size_t(in.gcount()));
+  auto bad = [&](const std::string& what) { return std::runtime_error("cannot read image '" + path + "': " + what); };
+  size_t blank = head.find("\n\n");
+  if (blank == std::string::npos) throw bad("the Radiance header does not end (truncated?)");
+  size_t lineStart = blank + 2, lineEnd = head.find('\n', lineStart);
+  if (lineEnd == std::string::npos) throw bad("the Radiance header has no resolution line (truncated?)");
+  long long h = 0, w = 0;
+  std::string res = head.substr(lineStart, lineEnd - lineStart);
+  // Other layouts than "-Y h +X w" are left to stb, which names them unsupported.
+  if (std::sscanf(res.c_str(), "-Y %lld +X %lld", &h, &w) != 2) return;
+  if (w <= 0 || h <= 0) throw std::runtime_error("image '" + path + "' has no pixels");
+  std::error_code ec;
+  uintmax_t size = fs::file_size(path, ec);
+  uintmax_t left = ec || size < lineEnd + 1 ? 0 : size - (lineEnd + 1);
+  uintmax_t perRow = w >= 8 && w < 32768 ? 4 + 8 * uintmax_t((w + 126) / 127) : 4 * uintmax_t(w);
+  if (left / perRow < uintmax_t(h)) throw bad("file is truncated");
+}
+
 Image loadStb(const std::string& path, bool hdr) {
+  if (hdr) checkRadianceHeader(path);
   FilePtr f(std::fopen(path.c_str(), "rb"));
   if (!f) throw std::runtime_error("cannot open image '" + path + "'");
   StbStream s{f.get()};
@@ -105,6 +139,8 @@ Image loadStb(const std::string& path, bool hdr) {
   std::unique_ptr<stbi_uc, void (*)(void*)> holdL(ldr, stbi_image_free);
   if (!data && !ldr) throw std::runtime_error("cannot read image '" + path + "': " + stbi_failure_reason());
   if (s.pastEnd) throw std::runtime_error("cannot read image '" + path + "': file is truncated");
+  // stb accepts a header's zero width ("+X 0") and returns an empty buffer.
+  if (w <= 0 || h <= 0) throw std::runtime_error("image '" + path + "' has no pixels");
   Image img(w, h);
   size_t n = size_t(w) * h * 3;
   if (data) {
@@ -135,6 +171,14 @@ Image loadPfm(const std::string& path) {
   if (std::fgetc(f.get()) == EOF) throw std::runtime_error("cannot read image '" + path + "': file is truncated");
   int nc = magic[1] == 'F' ? 3 : 1;
   bool swap = scale > 0.f;  // big-endian data on this little-endian host
+  // The header's size against the bytes that follow it, before allocating: a short file with
+  // a large header would otherwise reserve gigabytes.
+  long start = std::ftell(f.get());
+  std::error_code ec;
+  uintmax_t fileSize = fs::file_size(path, ec);
+  if (ec || start < 0 || fileSize < uintmax_t(start) ||
+      (fileSize - uintmax_t(start)) / (sizeof(float) * nc) < uintmax_t(w) * uintmax_t(h))
+    throw std::runtime_error("cannot read image '" + path + "': file is truncated");
   std::vector<float> raw(size_t(w) * h * nc);
   if (std::fread(raw.data(), sizeof(float), raw.size(), f.get()) != raw.size())
     throw std::runtime_error("cannot read image '" + path + "': file is truncated");

@@ -36,8 +36,14 @@ TriangleMesh loadObj(const std::string& path) {
     auto key = std::make_tuple(idx.vertex_index, n, t);
     auto it = remap.find(key);
     if (it != remap.end()) return it->second;
-    if (idx.vertex_index < 0 || size_t(3 * idx.vertex_index + 2) >= a.vertices.size())
+    // tinyobjloader resolves negative (relative) indices but leaves the range to the caller.
+    auto outside = [](int i, int k, size_t n) { return i < 0 || size_t(i) >= n / k; };
+    if (outside(idx.vertex_index, 3, a.vertices.size()))
       throw std::runtime_error("OBJ file '" + path + "': vertex index out of range");
+    if (n >= 0 && outside(n, 3, a.normals.size()))
+      throw std::runtime_error("OBJ file '" + path + "': normal index out of range");
+    if (t >= 0 && outside(t, 2, a.texcoords.size()))
+      throw std::runtime_error("OBJ file '" + path + "': texture coordinate index out of range");
     uint32_t id = uint32_t(mesh.positions.size());
     mesh.positions.push_back({a.vertices[3 * idx.vertex_index], a.vertices[3 * idx.vertex_index + 1],
                               a.vertices[3 * idx.vertex_index + 2]});

@@ -60,6 +60,13 @@ class Cursor {
     std::memcpy(&v, b, 8);
     return v;
   }
+  // A list's length, read as its count type; NaN, negative or absurd lengths are errors.
+  size_t listLength(const std::string& countType) {
+    double n = read(countType);
+    if (!(n >= 0 && n <= 1e6)) fail("a list near byte " + std::to_string(pos_) + " has a bad length");
+    return size_t(n);
+  }
+  size_t remaining() const { return d_.size() - pos_; }
   [[noreturn]] void fail(const std::string& what) const { throw std::runtime_error("PLY file '" + path_ + "': " + what); }
 
  private:
@@ -78,6 +85,13 @@ class Cursor {
   Fmt fmt_;
   const std::string& path_;
 };
+
+// A value read from the file, as the error should show it (9, 1e+300, nan).
+std::string numberText(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
 
 }  // namespace
 
@@ -155,6 +169,14 @@ TriangleMesh loadPly(const std::string& path) {
   Cursor cur(data, pos, fmt, path);
   bool sawVertex = false, sawFace = false;
   for (const Element& e : elements) {
+    // Every item takes at least a byte a property (a digit in ASCII), so the bytes left bound
+    // the count before anything is allocated for it.
+    size_t minBytes = 0;
+    for (const Property& p : e.props)
+      minBytes += fmt == Fmt::Ascii ? 1 : size_t(typeSize(p.countType.empty() ? p.type : p.countType, path));
+    if (minBytes > 0 && e.count > cur.remaining() / minBytes)
+      fail("element '" + e.name + "' declares " + std::to_string(e.count) + " items, more than the " +
+           std::to_string(cur.remaining()) + " bytes after the header hold (truncated?)");
     if (e.name == "vertex") {
       sawVertex = true;
       int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, iu = -1, iv = -1;
@@ -180,7 +202,7 @@ TriangleMesh loadPly(const std::string& path) {
         for (size_t k = 0; k < e.props.size(); ++k) {
           const Property& p = e.props[k];
           if (!p.countType.empty()) {
-            size_t n = size_t(cur.read(p.countType));
+            size_t n = cur.listLength(p.countType);
             for (size_t j = 0; j < n; ++j) cur.read(p.type);
             vals[k] = 0.0;
           } else {
@@ -208,12 +230,12 @@ TriangleMesh loadPly(const std::string& path) {
             continue;
           }
           double n = cur.read(p.countType);
-          if (n < 0 || n > 1e6) fail("face " + std::to_string(i) + " has a bad vertex count");
+          if (!(n >= 0 && n <= 1e6)) fail("face " + std::to_string(i) + " has a bad vertex count");
           poly.clear();
           for (size_t j = 0; j < size_t(n); ++j) {
             double idx = cur.read(p.type);
-            if (idx < 0 || idx >= double(mesh.positions.size()))
-              fail("face " + std::to_string(i) + " refers to vertex " + std::to_string(static_cast<long long>(idx)) + " of " +
+            if (!(idx >= 0 && idx < double(mesh.positions.size())))
+              fail("face " + std::to_string(i) + " refers to vertex " + numberText(idx) + " of " +
                    std::to_string(mesh.positions.size()));
             poly.push_back(uint32_t(idx));
           }
@@ -227,13 +249,15 @@ TriangleMesh loadPly(const std::string& path) {
         }
       }
     } else {
-      // Other elements (edges, materials) are skipped, but must still be read past.
+      // Other elements (edges, materials) are skipped, but must still be read past; one
+      // without properties takes no bytes.
+      if (e.props.empty()) continue;
       for (size_t i = 0; i < e.count; ++i)
         for (const Property& p : e.props) {
           if (p.countType.empty()) {
             cur.read(p.type);
           } else {
-            size_t n = size_t(cur.read(p.countType));
+            size_t n = cur.listLength(p.countType);
             for (size_t j = 0; j < n; ++j) cur.read(p.type);
           }
         }

@@ -36,6 +36,16 @@ std::string binaryPly(bool bigEndian) {
 
 void write(const std::string& path, const std::string& s) { std::ofstream(path, std::ios::binary) << s; }
 
+template <class F>
+void expectError(F&& f, const std::string& expect) {
+  try {
+    f();
+    ADD_FAILURE() << "no error for: " << expect;
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(expect), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 
 TEST(MeshIO, AsciiPlyWithNormalsAndQuad) {
@@ -75,6 +85,11 @@ TEST(MeshIO, MalformedPlyGivesClearErrors) {
       {std::string(kAsciiPly).replace(ascii.find("4 0 1 2 3"), 9, "3 0 1 9"), "refers to vertex 9"},
       {std::string(kAsciiPly).replace(ascii.find("property float x"), 16, "property quux x"), "unknown property type"},
       {std::string(kAsciiPly).replace(ascii.find("1 1 0 0"), 7, "1 a 0 0"), "expected a number"},
+      // Counts the bytes left cannot hold fail before anything is allocated for them, and an
+      // element without properties is not read item by item (found by tests/fuzz).
+      {std::string(kAsciiPly).replace(ascii.find("vertex 4"), 8, "vertex 4000000000000"), "declares 4000000000000 items"},
+      {std::string(kAsciiPly).replace(ascii.find("4 0 1 2 3"), 9, "nan 0 1 2 3"), "bad vertex count"},
+      {std::string(kAsciiPly).replace(ascii.find("4 0 1 2 3"), 9, "3 0 1 nan"), "refers to vertex nan"},
   };
   for (const Bad& b : bad) {
     write(d.file("bad.ply"), b.content);
@@ -87,12 +102,25 @@ TEST(MeshIO, MalformedPlyGivesClearErrors) {
   }
 }
 
+TEST(MeshIO, PlyElementWithoutPropertiesTakesNoBytes) {
+  // It used to be read item by item: a count of 9e18 hung the reader (found by tests/fuzz).
+  test::TempDir d;
+  std::string ascii = kAsciiPly;
+  write(d.file("e.ply"), ascii.replace(ascii.find("element face"), 0, "element edge 8888888888888888888\n"));
+  EXPECT_EQ(loadPly(d.file("e.ply")).triangleCount(), 2u);
+}
+
 TEST(MeshIO, ObjAndErrors) {
   test::TempDir d;
   write(d.file("t.obj"), "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n");
   TriangleMesh m = loadObj(d.file("t.obj"));
   EXPECT_EQ(m.triangleCount(), 2u);
   EXPECT_EQ(m.normals.size(), m.positions.size());
+  // tinyobjloader leaves the normal and uv indices unchecked (found by tests/fuzz).
+  write(d.file("n.obj"), "v 0 0 0\nv 1 0 0\nv 1 1 0\nvn 0 0 1\nf 1//1 2//1 3//2\n");
+  expectError([&] { loadObj(d.file("n.obj")); }, "normal index out of range");
+  write(d.file("t.obj"), "v 0 0 0\nv 1 0 0\nv 1 1 0\nvt 0 0\nf 1/1 2/1 3/2\n");
+  expectError([&] { loadObj(d.file("t.obj")); }, "texture coordinate index out of range");
   write(d.file("empty.obj"), "v 0 0 0\nv 1 0 0\n");
   EXPECT_THROW(loadObj(d.file("empty.obj")), std::runtime_error);
   EXPECT_THROW(loadObj(d.file("missing.obj")), std::runtime_error);
