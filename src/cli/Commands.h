@@ -17,6 +17,13 @@ void addStudyCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
 void addViewCommand(CLI::App& app);
 
+// Option checks whose errors read as sentences ("--spp must be at least 1, not 0"); CLI11's
+// PositiveNumber names a range up to 1.8e308 and lets NaN through where the option is a float.
+// A finite number no smaller than `lo`:
+CLI::Validator atLeast(double lo);
+// Any finite number:
+CLI::Validator finiteNumber();
+
 // -D name=value pairs into a map; throws on a pair without '='.
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds);
 

@@ -48,13 +48,13 @@ std::vector<EnvSample> drawSamples(const EnvironmentMap& env, const SampleArgs& 
 
 void addSampleOptions(CLI::App* c, SampleArgs& a) {
   c->add_option("map", a.map, "Lat-long map (.hdr, .exr, .pfm)")->required();
-  c->add_option("--count,-n", a.count, "Number of samples")->check(CLI::PositiveNumber);
+  c->add_option("--count,-n", a.count, "Number of samples")->check(atLeast(1));
   c->add_option("--strategy,-s", a.strategy, strategyNameList(true) + " (cosine and product about --normal)");
   c->add_option("--normal", a.normal, "x,y,z: the surface normal, in the map's frame, for cosine and product (default 0,1,0)")
       ->expected(3)
       ->delimiter(',');
   c->add_option("--sampler", a.sampler, nameList(kSamplerNames));
-  c->add_option("--seed", a.seed, "Seed");
+  c->add_option("--seed", a.seed, "Seed")->check(atLeast(0));
   c->add_flag("--mis-compensation", a.misCompensation, "Sample max(L - mean, 0) (Karlik et al. 2019)");
 }
 
@@ -150,7 +150,7 @@ void addEnvmapCommands(CLI::App& app) {
   CLI::App* plot = env->add_subcommand("plot", "The paper's Figure 2: the map with its samples drawn on it");
   addSampleOptions(plot, *pa);
   plot->add_option("-o,--output", pa->out, "Image (.png)")->required();
-  plot->add_option("--exposure", *exposure, "Exposure in stops (default: automatic)");
+  plot->add_option("--exposure", *exposure, "Exposure in stops (default: automatic)")->check(finiteNumber());
   plot->callback([pa, exposure] { runPlot(*pa, *exposure); });
 }
 

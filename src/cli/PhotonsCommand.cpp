@@ -76,8 +76,8 @@ void addPhotonsCommand(CLI::App& app) {
   CLI::App* c = app.add_subcommand("photons", "Draw the photon maps over the scene (the paper's Figure 4a)");
   c->add_option("scene", a->scene, "Scene file (.xml)")->required()->check(CLI::ExistingFile);
   c->add_option("-o,--output", a->output, "Image (.png or .exr)")->required();
-  c->add_option("--global", a->global, "Global photons to store");
-  c->add_option("--caustic", a->caustic, "Caustic photons to store");
+  c->add_option("--global", a->global, "Global photons to store")->check(atLeast(0));
+  c->add_option("--caustic", a->caustic, "Caustic photons to store")->check(atLeast(0));
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
   c->callback([a] { runPhotons(*a); });
 }

@@ -159,24 +159,24 @@ void addRenderCommand(CLI::App& app) {
   CLI::App* c = app.add_subcommand("render", "Render a scene (Mitsuba 3 XML subset) to an image");
   c->add_option("scene", a->scene, "Scene file (.xml)")->required()->check(CLI::ExistingFile);
   c->add_option("-o,--output", a->output, "Output image (.exr, .pfm, .hdr or .png)")->required();
-  c->add_option("--spp", a->spp, "Samples per pixel, or passes for sppm (default: the scene's)")->check(CLI::PositiveNumber);
+  c->add_option("--spp", a->spp, "Samples per pixel, or passes for sppm (default: the scene's)")->check(atLeast(1));
   c->add_option("--integrator", a->integrator, "Integrator: " + nameList(kIntegratorNames) + " (overrides the scene)");
   c->add_option("--strategy", a->strategy, "Environment strategy: " + strategyNameList());
-  c->add_option("--points", a->points, "points: directional lights in the collapsed map (default 64)")->check(CLI::PositiveNumber);
+  c->add_option("--points", a->points, "points: directional lights in the collapsed map (default 64)")->check(atLeast(1));
   c->add_option("--point-method", a->pointMethod, "points: sample (Algorithm 1 draws, power L/pdf/N) | mediancut");
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
-  c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
-  c->add_option("--seed", a->seed, "Sampler seed (overrides the scene)")->check(CLI::NonNegativeNumber);
+  c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(atLeast(0));
+  c->add_option("--seed", a->seed, "Sampler seed (overrides the scene)")->check(atLeast(0));
   c->add_flag("--png", a->png, "Also write a tonemapped PNG beside the output");
-  c->add_option("--exposure", a->exposure, "Exposure in stops for 8-bit output");
+  c->add_option("--exposure", a->exposure, "Exposure in stops for 8-bit output")->check(finiteNumber());
   c->add_flag("--aces", a->aces, "ACES-style tone curve for 8-bit output");
   c->add_flag("--no-progress", a->noProgress, "No progress bar");
-  c->add_option("--checkpoint", a->checkpoint, "Seconds between writes of the image so far (0: never)");
+  c->add_option("--checkpoint", a->checkpoint, "Seconds between writes of the image so far (0: never)")->check(atLeast(0));
   c->add_option("--time-limit", a->timeLimit,
                 "Seconds of sampling at most: stop at the last pass that fits, with the samples done (0: none)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(atLeast(0));
   c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
-  c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(CLI::NonNegativeNumber);
+  c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(atLeast(0));
   c->add_option("--filter", a->filter, "Pixel filter: " + nameList(kFilterNames) + " (overrides the scene)");
   c->add_option("--sampler", a->sampler, "Sample sequence: " + nameList(kSamplerNames) + " (overrides the scene)");
   c->callback([a] { runRender(*a); });

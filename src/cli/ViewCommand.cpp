@@ -63,11 +63,11 @@ void addViewCommand(CLI::App& app) {
   c->add_option("--host", a->host, "Address to bind (default 127.0.0.1; anything wider requires the printed token)");
   c->add_option("--integrator", a->integrator, "Integrator: " + nameList(kIntegratorNames));
   c->add_option("--strategy", a->strategy, "Environment strategy: " + strategyNameList());
-  c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(CLI::NonNegativeNumber);
-  c->add_option("--max-spp", a->maxSpp, "Stop refining at this many samples per pixel")->check(CLI::PositiveNumber);
+  c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(atLeast(0));
+  c->add_option("--max-spp", a->maxSpp, "Stop refining at this many samples per pixel")->check(atLeast(1));
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
   c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
-  c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(CLI::NonNegativeNumber);
+  c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(atLeast(0));
   c->callback([a] { runView(*a); });
 }
 

@@ -262,6 +262,35 @@ TEST(RenderCli, SamplerVersionAndParseErrors) {
   EXPECT_EQ(std::count(missing.output.begin(), missing.output.end(), '\n'), 1) << missing.output;
 }
 
+// Numeric options out of range, or NaN, are one sentence naming the option and the value, exit
+// 2, and no file; they used to pass (NaN time limit and exposure, negative photon counts and
+// checkpoint periods) or quote a range up to 1.8e308.
+TEST(RenderCli, NumericOptionsOutOfRangeAreOneClearError) {
+  TempDir d;
+  std::string scene = tinyScene(d, 8, 2);
+  struct Case {
+    std::string args, expect;
+  };
+  std::string render = "render " + scene + " -o " + d.file("bad.png") + " --no-progress ";
+  std::vector<Case> cases = {
+      {render + "--spp 0", "--spp: must be at least 1, not 0"},
+      {render + "--time-limit nan", "--time-limit: 'nan' is not a number"},
+      {render + "--checkpoint -1", "--checkpoint: must be at least 0, not -1"},
+      {render + "--exposure inf", "--exposure: 'inf' is not a finite number"},
+      {render + "--threads -2", "--threads: must be at least 0, not -2"},
+      {"photons " + scene + " -o " + d.file("bad.png") + " --global -5", "--global: must be at least 0, not -5"},
+      {"study " + scene + " -o " + d.file("study") + " --reference-spp 0", "--reference-spp: must be at least 1, not 0"},
+      {"study " + scene + " -o " + d.file("study") + " --threads -1", "--threads: must be at least 0, not -1"},
+  };
+  for (const Case& c : cases) {
+    CliResult r = runCli(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << ": " << r.output;
+    EXPECT_EQ(r.output.rfind("envgi: error: " + c.expect, 0), 0u) << c.args << ": " << r.output;
+  }
+  EXPECT_FALSE(fs::exists(d.file("bad.png")));
+  EXPECT_FALSE(fs::exists(d.file("study")));
+}
+
 // compare: an image against itself has no error, a noisier one has some, a wrong size is one
 // error line and no table.
 TEST(CliCompare, ErrorsAgainstAReference) {
