@@ -22,7 +22,9 @@ for t in "${targets[@]}"; do
   echo "fuzz.sh: $t for ${secs} s"
   # RSS grows slowly across millions of runs (allocator caches), so the limit that matters is
   # the one on a single allocation.
-  if ! (cd "$findings" && "$OLDPWD/build-fuzz/tests/fuzz/envgi_fuzz_$t" "$OLDPWD/$work" -max_len=4096 \
+  dict=()
+  [ -f tests/fuzz/$t.dict ] && dict=(-dict="$PWD/tests/fuzz/$t.dict")
+  if ! (cd "$findings" && "$OLDPWD/build-fuzz/tests/fuzz/envgi_fuzz_$t" "$OLDPWD/$work" "${dict[@]}" -max_len=4096 \
         -timeout=10 -rss_limit_mb=6000 -malloc_limit_mb=2048 -max_total_time="$secs" \
         -print_final_stats=1 > ../$t.log 2>&1); then
     echo "fuzz.sh: $t found a defect: $(grep -m1 -E 'SUMMARY|ERROR' build-fuzz/findings/$t.log)"

@@ -3,6 +3,7 @@
 // parallel fuzzing jobs do not share one.
 #pragma once
 
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <cstdint>
@@ -11,6 +12,9 @@
 #include <string>
 
 namespace envgi::fuzz {
+
+// Warnings about the inputs (NaN texels, unknown properties) would be most of the run time.
+inline const bool kQuietLog = (spdlog::set_level(spdlog::level::err), true);
 
 inline std::string writeInput(const uint8_t* data, size_t size, const std::string& ext) {
   namespace fs = std::filesystem;
