@@ -140,6 +140,54 @@ StudyRun fromJson(const nlohmann::json& j) {
   return r;
 }
 
+// What the runs in the output folder are made with: the scene file (name and a hash of its
+// text), the -D values, the integrator and the reference. A re-run reuses the folder's runs only
+// when these are the same, so old runs never mix with a changed scene or a new reference.
+nlohmann::json studySettings(const StudyArgs& a) {
+  std::ifstream f(a.scene, std::ios::binary);
+  std::string xml((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  uint64_t h = 1469598103934665603ull;  // FNV-1a, stable across builds
+  for (unsigned char c : xml) h = (h ^ c) * 1099511628211ull;
+  nlohmann::json defines = nlohmann::json::object();
+  for (const auto& [k, v] : parseDefines(a.defines)) defines[k] = v;
+  return {{"scene", fs::path(a.scene).filename().string()},
+          {"scene_fnv1a", fmt::format("{:016x}", h)},
+          {"defines", defines},
+          {"integrator", a.integrator},
+          {"reference", a.reference.empty() ? fmt::format("rendered with mis at {} spp", a.referenceSpp)
+                                            : fs::absolute(a.reference).lexically_normal().string()}};
+}
+
+// Refuses a folder whose recorded settings differ from this run's, naming what differs; returns
+// the settings to record once the reference has passed its checks.
+nlohmann::json checkStudyFolder(const StudyArgs& a) {
+  std::string path = a.out + "/study.json";
+  nlohmann::json now = studySettings(a);
+  if (fs::exists(path)) {
+    nlohmann::json before;
+    try {
+      std::ifstream f(path);
+      before = nlohmann::json::parse(f);
+    } catch (const nlohmann::json::exception& e) {
+      throw std::runtime_error(path + " is unreadable (" + e.what() + "); remove it or choose another -o folder");
+    }
+    if (before != now) {
+      std::string diff;
+      for (const auto& [key, value] : now.items())
+        if (!before.contains(key) || before[key] != value)
+          diff += fmt::format("{}{}: {} before, {} now", diff.empty() ? "" : "; ", key,
+                              before.contains(key) ? before[key].dump() : "none", value.dump());
+      throw std::runtime_error(fmt::format("{} holds a study made with other settings ({}); choose another -o folder "
+                                           "or remove it",
+                                           a.out, diff));
+    }
+  } else if (!fs::is_empty(a.out + "/runs")) {
+    spdlog::warn("study: {} has runs but no study.json (written before envgi recorded a study's settings): reusing them as they are",
+                 a.out);
+  }
+  return now;
+}
+
 void runStudy(const StudyArgs& a) {
   auto t0 = std::chrono::steady_clock::now();
   std::vector<std::string> strategies = splitList(a.strategies);
@@ -171,6 +219,7 @@ void runStudy(const StudyArgs& a) {
   std::string probe = a.out + "/.write_test";
   writeFileAtomically(probe, "ok");  // an unwritable folder fails here, before any rendering
   fs::remove(probe);
+  nlohmann::json settings = checkStudyFolder(a);
 
   // The reference: given, or rendered once (and reused by a re-run).
   Image ref;
@@ -190,6 +239,7 @@ void runStudy(const StudyArgs& a) {
   if (scene.camera.width != ref.width || scene.camera.height != ref.height)
     throw std::runtime_error(fmt::format("reference '{}' is {}x{}, the scene renders {}x{}", refPath, ref.width,
                                          ref.height, scene.camera.width, scene.camera.height));
+  writeFileAtomically(a.out + "/study.json", settings.dump(2));
 
   std::vector<StudyRun> plan;
   for (const std::string& s : strategies)
@@ -207,12 +257,22 @@ void runStudy(const StudyArgs& a) {
     ++done;
     std::string key = runKey(r), json = a.out + "/runs/" + key + ".json", exr = a.out + "/runs/" + key + ".exr";
     bool wantImage = r.timeBudget == 0 && r.spp == middleSpp && r.seed == 0;
-    if (fs::exists(json) && (!wantImage || fs::exists(exr))) {
-      std::ifstream f(json);
-      r = fromJson(nlohmann::json::parse(f));
-      ++skipped;
-      if (wantImage) images.push_back({r.strategy, r.spp, loadImage(exr)});
-    } else {
+    bool reuse = fs::exists(json) && (!wantImage || fs::exists(exr));
+    if (reuse) {
+      // A run file that cannot be read (cut short by a full disk, edited) is rendered again.
+      StudyRun planned = r;
+      try {
+        std::ifstream f(json);
+        r = fromJson(nlohmann::json::parse(f));
+        if (wantImage) images.push_back({r.strategy, r.spp, loadImage(exr)});
+        ++skipped;
+      } catch (const std::exception& e) {
+        spdlog::warn("study: {} is unreadable ({}): rendering it again", json, e.what());
+        r = planned;
+        reuse = false;
+      }
+    }
+    if (!reuse) {
       if (r.timeBudget > 0) {
         double sps = secondsPerSpp.count(r.strategy) ? secondsPerSpp[r.strategy] : 0.0;
         r.spp = sps > 0 ? std::max(1, int(r.timeBudget / sps)) : 1;

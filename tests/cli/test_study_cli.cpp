@@ -49,6 +49,43 @@ TEST(StudyCli, WritesResultsAndResumes) {
   EXPECT_NE(again.output.find("9 runs (9 already done)"), std::string::npos) << again.output;
 }
 
+// A folder keeps the settings its runs were made with (study.json): a re-run with another
+// integrator or -D value is refused before anything is written, and a run file that cannot be
+// read is rendered again instead of ending the study.
+TEST(StudyCli, RefusesAFolderOfOtherSettingsAndRedoesUnreadableRuns) {
+  TempDir d;
+  std::string out = d.file("study");
+  std::string args = "study " + buddha() + " -o " + out + " -D res=12 --spp 1 --seeds 1 --reference-spp 8 --strategies uniform";
+  CliResult r = runCli(args);
+  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_TRUE(fs::exists(out + "/study.json"));
+  std::string csv = slurp(out + "/results.csv");
+
+  CliResult other = runCli(args + " --integrator path");
+  EXPECT_EQ(other.code, 1) << other.output;
+  EXPECT_NE(other.output.find("holds a study made with other settings (integrator: \"direct\" before, \"path\" now)"),
+            std::string::npos)
+      << other.output;
+  CliResult res = runCli("study " + buddha() + " -o " + out + " -D res=12 -D max_depth=3 --spp 1 --seeds 1 "
+                         "--reference-spp 8 --strategies uniform");
+  EXPECT_EQ(res.code, 1) << res.output;
+  EXPECT_NE(res.output.find("defines: {\"res\":\"12\"} before, {\"max_depth\":\"3\",\"res\":\"12\"} now"),
+            std::string::npos)
+      << res.output;
+  EXPECT_EQ(slurp(out + "/results.csv"), csv);
+
+  std::string run;
+  for (const auto& e : fs::directory_iterator(out + "/runs"))
+    if (e.path().extension() == ".json") run = e.path().string();
+  ASSERT_FALSE(run.empty());
+  std::ofstream(run) << "{\"strategy\": ";
+  CliResult again = runCli(args);
+  ASSERT_EQ(again.code, 0) << again.output;
+  EXPECT_NE(again.output.find("is unreadable"), std::string::npos) << again.output;
+  EXPECT_NE(again.output.find("1 runs (0 already done)"), std::string::npos) << again.output;
+  EXPECT_NE(slurp(run).find("\"rmse\""), std::string::npos);
+}
+
 TEST(StudyCli, BadInputIsOneErrorLine) {
   TempDir d;
   auto expectError = [&](const std::string& extra, const std::string& text) {
