@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -32,18 +33,23 @@ struct ViewSession::State {
 };
 
 namespace {
+// JSON numbers are doubles; one beyond a float's range would make the conversion undefined, so
+// each is range-checked as a double first.
+float finiteFloat(const json& v, const char* key) {
+  double d = v.get<double>();
+  if (!(std::fabs(d) <= 3.0e38)) throw std::runtime_error(std::string("'") + key + "' must be finite");
+  return float(d);
+}
 Vec3f vec3(const json& j, const char* key) {
   const json& v = j.at(key);
   if (!v.is_array() || v.size() != 3) throw std::runtime_error(std::string("'") + key + "' must be 3 numbers");
-  Vec3f r(v[0].get<float>(), v[1].get<float>(), v[2].get<float>());
-  if (!isFiniteVec(r)) throw std::runtime_error(std::string("'") + key + "' must be finite");
-  return r;
+  return Vec3f(finiteFloat(v[0], key), finiteFloat(v[1], key), finiteFloat(v[2], key));
 }
 json arr(Vec3f v) { return json::array({v.x, v.y, v.z}); }
 float number(const json& j, const char* key, float lo, float hi) {
-  float v = j.at(key).get<float>();
+  double v = j.at(key).get<double>();
   if (!(v >= lo && v <= hi)) throw std::runtime_error(fmt::format("'{}' must be in [{}, {}]", key, lo, hi));
-  return v;
+  return float(v);
 }
 }  // namespace
 
@@ -123,7 +129,13 @@ std::string ViewSession::handle(const std::string& message) {
       next.up = vec3(j, "up");
       if (length(next.target - next.origin) < 1e-6f || length(cross(next.target - next.origin, next.up)) < 1e-6f)
         throw std::runtime_error("camera: origin, target and up must span a frame");
-      next.cameraVersion = j.value("version", next.cameraVersion + 1);
+      next.cameraVersion = next.cameraVersion + 1;
+      if (j.contains("version")) {
+        const json& v = j["version"];
+        if (!v.is_number_integer() || v.get<int64_t>() < 0 || v.get<int64_t>() > INT32_MAX)
+          throw std::runtime_error("'version' must be a non-negative integer");
+        next.cameraVersion = int(v.get<int64_t>());
+      }
       next.restart = true;
     } else if (type == "exposure") {
       next.exposure = number(j, "value", -20.f, 20.f);
