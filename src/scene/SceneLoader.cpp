@@ -80,6 +80,7 @@ class Loader {
   std::vector<std::unique_ptr<SourceFile>> files_;
   std::vector<std::unique_ptr<pugi::xml_document>> docs_;
   std::map<std::string, int> bsdfIds_;
+  std::map<std::string, std::string> bsdfIdWhere_;  // "file:line" of each id's definition
   std::set<std::string> warned_;
   bool haveSensor_ = false;
 
@@ -342,7 +343,13 @@ class Loader {
       int id = bsdf(f, n);
       std::string name = attr(f, n, "id", false);
       if (name.empty()) warnOnce(fmt::format("{}:{}: a top-level <bsdf> without an id is never used", f->path, f->lineOf(n.offset_debug())));
-      else bsdfIds_[name] = id;
+      else {
+        // As Mitsuba: a second definition of an id is an error, not a silent replacement.
+        std::string where = fmt::format("{}:{}", f->path, f->lineOf(n.offset_debug()));
+        auto [it, fresh] = bsdfIdWhere_.emplace(name, where);
+        if (!fresh) fail(f, n, fmt::format("duplicate BSDF id '{}' (first defined at {})", name, it->second));
+        bsdfIds_[name] = id;
+      }
     } else if (tag == "texture" || tag == "medium" || tag == "phase") {
       warnOnce(fmt::format("{}:{}: <{}> is not supported and was ignored", f->path, f->lineOf(n.offset_debug()), tag));
     } else {

@@ -147,6 +147,8 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
       {"<widget/>", "unknown element <widget>"},
       {"<emitter type=\"area\"/>", "must be inside a <shape>"},
       {"<shape type=\"rectangle\"><transform name=\"to_world\"><shear value=\"1\"/></transform></shape>", "unknown transform operation"},
+      {"<bsdf type=\"diffuse\" id=\"a\"/>\n<bsdf type=\"conductor\" id=\"a\"/>",
+       "s.xml:3: duplicate BSDF id 'a' (first defined at " + f.dir.file("s.xml") + ":2)"},
   };
   for (const Case& c : cases) {
     std::string err = loadError(f.scene(c.body + std::string(kSensor)));
