@@ -1,12 +1,12 @@
-"""One of envgi's map-lit scene files rendered by Blender Cycles, for scripts/perf_compare.py
+"""One of envgi's scene files rendered by Blender Cycles, for scripts/perf_compare.py
 (through scripts/perf-cycles.sh).
 
 Runs inside Blender (Debian 12's blender 3.4.1, the Cycles the issue was measured against):
   blender -b --factory-startup -noaudio --python scripts/cycles_render.py -- SCENE.xml
       --out X.exr --spp N --seed S --threads T [-D name=value ...]
 It reads the part of Mitsuba's format that envgi's map-lit example scenes use (perspective
-sensor, envmap, ply/obj/sphere/rectangle shapes, diffuse, roughplastic, dielectric and
-(rough)conductor BSDFs) and stops with an error on anything else. The materials are Cycles'
+sensor, envmap, ply/obj/sphere/rectangle shapes, area lights on shapes, diffuse, roughplastic,
+dielectric and (rough)conductor BSDFs) and stops with an error on anything else. The materials are Cycles'
 nearest nodes, not the same BSDFs, so each renderer is measured against its own reference.
 Prints 'cycles render: T s' (the render call: scene sync, BVH and samples).
 """
@@ -162,14 +162,41 @@ def add_shape(sc, e, i):
         obj = bpy.context.active_object
     else:
         fail(f"shape '{t}' is not supported")
-    if any(c.tag == 'emitter' for c in e):
-        fail('area lights are not supported (the comparison is of map-lit scenes)')
     obj.matrix_world = Y_UP_TO_Z_UP @ to_world
     b = next((c for c in e if c.tag in ('bsdf', 'ref')), None)
     if b is None:
-        fail(f'shape {i} has no bsdf')
+        b = ET.fromstring('<bsdf type="diffuse"/>')  # Mitsuba's default for a shape without one
+    m = material(sc, b, f'm{i}')
+    emitter = next((c for c in e if c.tag == 'emitter'), None)
+    if emitter is not None:
+        if emitter.get('type') != 'area':
+            fail(f"a shape's emitter must be 'area', not '{emitter.get('type')}'")
+        add_area_emission(m, sc.prop(emitter, 'radiance', (1.0,) * 3))
     obj.data.materials.clear()
-    obj.data.materials.append(material(sc, b, f'm{i}'))
+    obj.data.materials.append(m)
+
+
+def add_area_emission(m, radiance):
+    """Mitsuba's area light: radiance L from the front face only, added to the shape's BSDF.
+    Cycles' emission shader (strength 1) has radiance equal to its colour, from both faces, so
+    the back face is masked to black through the geometry's Backfacing output."""
+    nt = m.node_tree
+    out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
+    bsdf_socket = out.inputs['Surface'].links[0].from_socket
+    emit = nt.nodes.new('ShaderNodeEmission')
+    emit.inputs['Color'].default_value = (*radiance, 1)
+    emit.inputs['Strength'].default_value = 1.0
+    black = nt.nodes.new('ShaderNodeEmission')
+    black.inputs['Strength'].default_value = 0.0
+    geo = nt.nodes.new('ShaderNodeNewGeometry')
+    mix = nt.nodes.new('ShaderNodeMixShader')
+    nt.links.new(geo.outputs['Backfacing'], mix.inputs['Fac'])
+    nt.links.new(emit.outputs[0], mix.inputs[1])
+    nt.links.new(black.outputs[0], mix.inputs[2])
+    add = nt.nodes.new('ShaderNodeAddShader')
+    nt.links.new(bsdf_socket, add.inputs[0])
+    nt.links.new(mix.outputs[0], add.inputs[1])
+    nt.links.new(add.outputs[0], out.inputs['Surface'])
 
 
 def main():
@@ -207,13 +234,23 @@ def main():
     scene.camera = cobj
 
     emitters = [e for e in sc.root if e.tag == 'emitter']
-    if len(emitters) != 1 or emitters[0].get('type') != 'envmap':
-        fail('needs exactly one envmap emitter')
-    env = emitters[0]
+    if len(emitters) > 1 or any(e.get('type') != 'envmap' for e in emitters):
+        fail('needs at most one emitter outside the shapes, an envmap')
     world = bpy.data.worlds.new('world')
     scene.world = world
     world.use_nodes = True
     nt = world.node_tree
+    if not emitters:  # lit by area lights alone: a black world
+        nt.nodes['Background'].inputs['Strength'].default_value = 0.0
+    else:
+        add_envmap(sc, nt, emitters[0])
+
+    for i, e in enumerate(c for c in sc.root if c.tag == 'shape'):
+        add_shape(sc, e, i)
+    render(sc, scene, a, max_depth)
+
+
+def add_envmap(sc, nt, env):
     nt.nodes.clear()
     tex = nt.nodes.new('ShaderNodeTexEnvironment')
     tex.image = bpy.data.images.load(sc.path(sc.prop(env, 'filename')))
@@ -231,9 +268,8 @@ def main():
     if env.find('transform') is not None:
         fail('a rotated envmap is not supported')
 
-    for i, e in enumerate(c for c in sc.root if c.tag == 'shape'):
-        add_shape(sc, e, i)
 
+def render(sc, scene, a, max_depth):
     scene.render.engine = 'CYCLES'
     c = scene.cycles
     c.device = 'CPU'
