@@ -2,6 +2,8 @@
 // worst of a 4x4 grid of regions, as the study measures it) and its mean, one row an image.
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "cli/Commands.h"
 #include "image/Image.h"
 #include "study/ErrorMetrics.h"
@@ -14,6 +16,12 @@ struct CompareArgs {
   std::vector<std::string> images;
 };
 
+size_t nonFinite(const Image& img) {
+  size_t n = 0;
+  for (float v : img.rgb) n += !std::isfinite(v);
+  return n;
+}
+
 double meanOf(const Image& img) {
   double s = 0.0;
   for (float v : img.rgb) s += v;
@@ -22,22 +30,28 @@ double meanOf(const Image& img) {
 
 void runCompare(const CompareArgs& a) {
   Image ref = loadImage(a.reference);
+  if (size_t n = nonFinite(ref))
+    throw std::runtime_error(fmt::format("reference '{}' has {} NaN or infinite values", a.reference, n));
   // Every image read and checked before the table starts, so an error leaves no half table.
   std::vector<std::pair<double, ImageError>> rows;
+  std::vector<Image> images;
   for (const std::string& path : a.images) {
-    Image img = loadImage(path);
+    Image& img = images.emplace_back(loadImage(path));
     try {
       rows.push_back({meanOf(img), imageError(img, ref)});
     } catch (const std::runtime_error& e) {
       throw std::runtime_error(path + ": " + e.what());
     }
   }
-  fmt::print("{:<40} {:>10} {:>10} {:>10} {:>12}\n", "image", "mean", "RMSE", "relMSE", "worst-region");
-  fmt::print("{:<40} {:>10.5f} {:>10} {:>10} {:>12}\n", a.reference + " (reference)", meanOf(ref), "-", "-", "-");
+  // The last column counts NaN and infinite values: a render with any has every error NaN.
+  fmt::print("{:<40} {:>10} {:>10} {:>10} {:>12} {:>10}\n", "image", "mean", "RMSE", "relMSE", "worst-region",
+             "non-finite");
+  fmt::print("{:<40} {:>10.5f} {:>10} {:>10} {:>12} {:>10}\n", a.reference + " (reference)", meanOf(ref), "-", "-", "-",
+             0);
   for (size_t i = 0; i < rows.size(); ++i) {
     const ImageError& e = rows[i].second;
-    fmt::print("{:<40} {:>10.5f} {:>10.5f} {:>10.5f} {:>12.5f}\n", a.images[i], rows[i].first, e.rmse, e.relMse,
-               e.worstRegionRmse);
+    fmt::print("{:<40} {:>10.5f} {:>10.5f} {:>10.5f} {:>12.5f} {:>10}\n", a.images[i], rows[i].first, e.rmse,
+               e.relMse, e.worstRegionRmse, nonFinite(images[i]));
   }
 }
 }  // namespace

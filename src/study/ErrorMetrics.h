@@ -43,7 +43,9 @@ inline ImageError imageError(const Image& a, const Image& ref) {
             s2 += d * d;
             ++cnt;
           }
-      if (cnt > 0) e.worstRegionRmse = std::max(e.worstRegionRmse, std::sqrt(s2 / double(cnt)));
+      // A region with a NaN makes the worst region NaN too (std::max would drop it).
+      double r = cnt > 0 ? std::sqrt(s2 / double(cnt)) : 0.0;
+      if (!std::isnan(e.worstRegionRmse) && !(r <= e.worstRegionRmse)) e.worstRegionRmse = r;
     }
   return e;
 }

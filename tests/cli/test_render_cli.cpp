@@ -2,6 +2,7 @@
 // interrupted render still writes the samples it finished.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <csignal>
 #include <filesystem>
 #include <fstream>
@@ -316,4 +317,21 @@ TEST(CliCompare, ErrorsAgainstAReference) {
   EXPECT_NE(bad.code, 0);
   EXPECT_NE(bad.output.find("reference is 16x16, the image 8x8"), std::string::npos) << bad.output;
   EXPECT_EQ(bad.output.find("RMSE"), std::string::npos) << "no half table: " << bad.output;
+
+  // NaN: counted in the last column, and every error of that image NaN (the worst region was
+  // 0); a reference with one is an error.
+  envgi::Image nan = envgi::loadImage(d.file("b.pfm"));
+  nan.rgb[40] = NAN;
+  envgi::saveImage(nan, d.file("nan.pfm"));
+  CliResult withNan = runCli("compare " + d.file("a.pfm") + " " + d.file("nan.pfm"));
+  ASSERT_EQ(withNan.code, 0) << withNan.output;
+  std::string row = withNan.output.substr(withNan.output.find("nan.pfm"));
+  std::istringstream fields(row);
+  std::string path, meanText, rmseText, rel, worst, count;
+  fields >> path >> meanText >> rmseText >> rel >> worst >> count;
+  EXPECT_EQ(worst, "nan") << withNan.output;
+  EXPECT_EQ(count, "1") << withNan.output;
+  CliResult nanRef = runCli("compare " + d.file("nan.pfm") + " " + d.file("a.pfm"));
+  EXPECT_EQ(nanRef.code, 1);
+  EXPECT_NE(nanRef.output.find("has 1 NaN or infinite values"), std::string::npos) << nanRef.output;
 }
