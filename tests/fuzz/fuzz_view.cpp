@@ -2,7 +2,6 @@
 // to a session that renders on its own thread meanwhile, as a page would send them. A message
 // may be refused with std::runtime_error; anything else, a crash or a sanitizer report on
 // either thread, is a defect.
-#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
@@ -16,10 +15,7 @@ namespace {
 
 envgi::ViewSession& session() {
   static std::unique_ptr<envgi::ViewSession> s = [] {
-    namespace fs = std::filesystem;
-    fs::path dir = fs::temp_directory_path() / ("envgi-fuzz-view-" + std::to_string(getpid()));
-    fs::create_directories(dir);
-    std::string xml = (dir / "ball.xml").string();
+    std::string xml = (envgi::fuzz::inputDir() / "ball.xml").string();
     std::ofstream(xml) << R"(<scene version="3.0.0">
   <integrator type="path"><integer name="max_depth" value="3"/></integrator>
   <sensor type="perspective"><float name="fov" value="40"/>
