@@ -7,7 +7,9 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cctype>
 #include <filesystem>
+#include <regex>
 #include <fstream>
 #include <stdexcept>
 
@@ -26,6 +28,20 @@ void writeAssets(const std::filesystem::path& dir) {
   envgi::Image map(16, 8);
   for (size_t i = 0; i < map.rgb.size(); ++i) map.rgb[i] = float(i % 7) * 0.25f;
   envgi::saveImage(map, (dir / "fuzz-e.hdr").string());
+}
+
+// Every number in the text between 1e-3 and 1e4 in magnitude (or 0), and no inf or nan: a scene
+// whose samples should all be finite.
+bool moderateNumbers(const std::string& text) {
+  std::string lower = text;
+  for (char& c : lower) c = char(std::tolower((unsigned char)c));
+  if (lower.find("inf") != std::string::npos || lower.find("nan") != std::string::npos) return false;
+  static const std::regex number(R"([-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), number); it != std::sregex_iterator(); ++it) {
+    double v = std::fabs(std::strtod(it->str().c_str(), nullptr));
+    if (v != 0.0 && (v < 1e-3 || v > 1e4)) return false;
+  }
+  return true;
 }
 
 }  // namespace
@@ -76,6 +92,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         std::fprintf(stderr, "fuzz_scene: a non-finite pixel in the render\n");
         std::abort();
       }
+    // The renderer drops NaN and infinite samples; a scene of moderate numbers should make none.
+    if (stats.nonFiniteSamples > 0 && moderateNumbers(std::string(reinterpret_cast<const char*>(data), size))) {
+      std::fprintf(stderr, "fuzz_scene: %llu non-finite samples from a scene of moderate numbers\n",
+                   (unsigned long long)stats.nonFiniteSamples);
+      std::abort();
+    }
   } catch (const std::runtime_error&) {
   }
   return 0;
