@@ -52,6 +52,7 @@ Transform scale(Vec3f s) {
 }
 
 Transform rotate(Vec3f axis, float degrees) {
+  if (!(lengthSq(axis) > 0.f) || !isFiniteVec(axis)) throw std::runtime_error("rotate: the axis must be a finite, non-zero vector");
   Vec3f a = normalize(axis);
   float th = degrees * kPi / 180.f;
   float s = std::sin(th), c = std::cos(th);
@@ -69,9 +70,15 @@ Transform rotate(Vec3f axis, float degrees) {
 }
 
 Transform lookAt(Vec3f origin, Vec3f target, Vec3f up) {
+  // Each check is written to fail on NaN too: a NaN camera reaches Embree, whose Debian build
+  // aborts the program on an invalid ray.
+  if (!(isFiniteVec(origin) && isFiniteVec(target) && isFiniteVec(up)))
+    throw std::runtime_error("lookat: origin, target and up must be finite");
+  if (!(lengthSq(target - origin) > 0.f)) throw std::runtime_error("lookat: origin and target are the same point");
+  if (!(lengthSq(up) > 0.f)) throw std::runtime_error("lookat: 'up' is zero");
   Vec3f dir = normalize(target - origin);
   Vec3f left = cross(normalize(up), dir);
-  if (lengthSq(left) < 1e-12f) throw std::runtime_error("lookat: 'up' is parallel to the view direction");
+  if (!(lengthSq(left) >= 1e-12f)) throw std::runtime_error("lookat: 'up' is parallel to the view direction");
   left = normalize(left);
   Vec3f newUp = cross(dir, left);
   Matrix4 m;

@@ -147,6 +147,10 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
       {"<widget/>", "unknown element <widget>"},
       {"<emitter type=\"area\"/>", "must be inside a <shape>"},
       {"<shape type=\"rectangle\"><transform name=\"to_world\"><shear value=\"1\"/></transform></shape>", "unknown transform operation"},
+      // A degenerate camera or rotation used to become NaN, and Debian's Embree aborts the
+      // program on a NaN ray (found by tests/fuzz).
+      {"<shape type=\"sphere\"><transform name=\"to_world\"><rotate x=\"0\" angle=\"30\"/></transform></shape>",
+       "rotate: the axis must be a finite, non-zero vector"},
       {"<bsdf type=\"diffuse\" id=\"a\"/>\n<bsdf type=\"conductor\" id=\"a\"/>",
        "s.xml:3: duplicate BSDF id 'a' (first defined at " + f.dir.file("s.xml") + ":2)"},
   };
@@ -155,6 +159,14 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
     EXPECT_NE(err.find(c.expect), std::string::npos) << "for " << c.body << "\n got: " << err;
   }
   EXPECT_NE(loadError(f.scene("")).find("no <sensor>"), std::string::npos);
+  for (const char* lookat : {R"(origin="0,0,0" target="0,0,0" up="0,1,0")", R"(origin="0,0,0" target="0,0,1" up="0,0,0")"}) {
+    std::string sensor = std::string(kSensor), original = R"(origin="0,0,5" target="0,0,0" up="0,1,0")";
+    sensor.replace(sensor.find(original), original.size(), lookat);
+    std::string err = loadError(f.scene(sensor));
+    EXPECT_TRUE(err.find("origin and target are the same point") != std::string::npos ||
+                err.find("'up' is zero") != std::string::npos)
+        << lookat << ": " << err;
+  }
   EXPECT_NE(loadError(f.dir.file("none.xml")).find("cannot open scene file"), std::string::npos);
   f.write("bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n");
   EXPECT_NE(loadError(f.scene("<shape type=\"ply\"><string name=\"filename\" value=\"bad.ply\"/></shape>" +
