@@ -3,6 +3,8 @@
 
 #include <embree3/rtcore.h>
 
+#include <cmath>
+
 #include "scene/Scene.h"
 
 namespace envgi {
@@ -14,7 +16,18 @@ class EmbreeAccel {
   EmbreeAccel(const EmbreeAccel&) = delete;
   EmbreeAccel& operator=(const EmbreeAccel&) = delete;
 
+  // Embree's precondition on a ray (RayK::valid in its sources): origin and direction within
+  // 1.844e18 a coordinate, no NaN. Debian builds Embree with its assertions on, so a ray outside
+  // it aborts the program. Such rays (a camera at 3e38, a NaN from a degenerate scene) miss
+  // here, and their shadow rays are blocked.
+  static bool traceable(const Ray& r) {
+    constexpr float kLarge = 1.844e18f;
+    return std::fabs(r.o.x) <= kLarge && std::fabs(r.o.y) <= kLarge && std::fabs(r.o.z) <= kLarge &&
+           std::fabs(r.d.x) <= kLarge && std::fabs(r.d.y) <= kLarge && std::fabs(r.d.z) <= kLarge && r.tMax == r.tMax;
+  }
+
   bool intersect(const Ray& ray, Hit* hit) const {
+    if (!traceable(ray)) return false;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRayHit rh;
@@ -32,6 +45,7 @@ class EmbreeAccel {
   }
 
   bool occluded(Vec3f o, Vec3f d, float tMax) const {
+    if (!traceable(Ray{o, d, tMax})) return true;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay r;

@@ -263,6 +263,24 @@ TEST(RenderCli, SamplerVersionAndParseErrors) {
   EXPECT_EQ(std::count(missing.output.begin(), missing.output.end(), '\n'), 1) << missing.output;
 }
 
+// A camera at 3e38 makes rays outside Embree's range (1.844e18), on which Debian's Embree
+// asserts and aborts: every integrator must render it (those rays miss) and exit 0.
+TEST(CliRender, RaysOutsideEmbreesRangeMissInsteadOfAborting) {
+  TempDir d;
+  std::ofstream(d.file("far.xml")) << R"(<scene version="3.0.0">
+  <sensor type="perspective"><transform name="to_world"><translate x="3e38"/></transform>
+    <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>
+  <emitter type="constant"/>
+  <shape type="sphere"/>
+</scene>)";
+  for (std::string integrator : {"path", "direct", "photon", "sppm", "grid"}) {
+    CliResult r = runCli("render " + d.file("far.xml") + " --integrator " + integrator + " --spp 2 --no-progress -o " +
+                         d.file(integrator + ".exr"));
+    EXPECT_EQ(r.code, 0) << integrator << ": " << r.output;
+    EXPECT_TRUE(fs::exists(d.file(integrator + ".exr"))) << integrator;
+  }
+}
+
 // Numeric options out of range, or NaN, are one sentence naming the option and the value, exit
 // 2, and no file; they used to pass (NaN time limit and exposure, negative photon counts and
 // checkpoint periods) or quote a range up to 1.8e308.
