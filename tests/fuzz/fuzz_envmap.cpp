@@ -86,6 +86,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
           if (!smp.delta) {
             float p = view.pdf(s, smp.dir, normal);
             check(std::isfinite(p) && p >= 0.f, "pdf of a drawn direction not finite or negative");
+            // The density a draw reports is the one pdf() gives its direction, away from pixel
+            // edges and the poles (where the round trip through a direction may change pixel).
+            float fx = smp.uv.x * float(w), fy = smp.uv.y * float(h);
+            float ex = std::fabs(fx - std::round(fx)), ey = std::fabs(fy - std::round(fy));
+            if (ex > 1e-3f && ey > 1e-3f && smp.uv.y > 1e-3f && smp.uv.y < 1.f - 1e-3f && smp.pdf > 1e-6f &&
+                smp.pdf < 1e6f && std::fabs(p - smp.pdf) > 1e-2f * smp.pdf) {
+              std::fprintf(stderr, "fuzz_envmap: strategy %d drew pdf %g, pdf() gives %g at uv (%g, %g)\n", int(s),
+                           smp.pdf, p, smp.uv.x, smp.uv.y);
+              std::abort();
+            }
             float q = 0.f;
             Color l = view.evalWithPdf(s, smp.dir, normal, &q);
             check(finite(l) && std::isfinite(q) && q >= 0.f, "evalWithPdf not finite");
