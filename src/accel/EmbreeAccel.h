@@ -45,11 +45,12 @@ class EmbreeAccel {
   }
 
   bool occluded(Vec3f o, Vec3f d, float tMax) const {
-    if (!traceable(Ray{o, d, tMax})) return true;
+    Ray ray{o, d, tMax};
+    if (!traceable(ray)) return true;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     RTCRay r;
-    fillRay(Ray{o, d, tMax}, r);
+    fillRay(ray, r);
     rtcOccluded1(scene_, &ctx, &r);
     return r.tfar < 0.f;  // Embree sets tfar to -inf on a hit
   }

@@ -2,8 +2,6 @@
 // worst of a 4x4 grid of regions, as the study measures it) and its mean, one row an image.
 #include <fmt/format.h>
 
-#include <cmath>
-
 #include "cli/Commands.h"
 #include "image/Image.h"
 #include "study/ErrorMetrics.h"
@@ -16,12 +14,6 @@ struct CompareArgs {
   std::vector<std::string> images;
 };
 
-size_t nonFinite(const Image& img) {
-  size_t n = 0;
-  for (float v : img.rgb) n += !std::isfinite(v);
-  return n;
-}
-
 double meanOf(const Image& img) {
   double s = 0.0;
   for (float v : img.rgb) s += v;
@@ -30,15 +22,19 @@ double meanOf(const Image& img) {
 
 void runCompare(const CompareArgs& a) {
   Image ref = loadImage(a.reference);
-  if (size_t n = nonFinite(ref))
+  if (size_t n = nonFiniteValues(ref))
     throw std::runtime_error(fmt::format("reference '{}' has {} NaN or infinite values", a.reference, n));
   // Every image read and checked before the table starts, so an error leaves no half table.
-  std::vector<std::pair<double, ImageError>> rows;
-  std::vector<Image> images;
+  struct Row {
+    double mean;
+    ImageError error;
+    size_t nonFinite;
+  };
+  std::vector<Row> rows;
   for (const std::string& path : a.images) {
-    Image& img = images.emplace_back(loadImage(path));
+    Image img = loadImage(path);
     try {
-      rows.push_back({meanOf(img), imageError(img, ref)});
+      rows.push_back({meanOf(img), imageError(img, ref), nonFiniteValues(img)});
     } catch (const std::runtime_error& e) {
       throw std::runtime_error(path + ": " + e.what());
     }
@@ -49,9 +45,9 @@ void runCompare(const CompareArgs& a) {
   fmt::print("{:<40} {:>10.5f} {:>10} {:>10} {:>12} {:>10}\n", a.reference + " (reference)", meanOf(ref), "-", "-", "-",
              0);
   for (size_t i = 0; i < rows.size(); ++i) {
-    const ImageError& e = rows[i].second;
-    fmt::print("{:<40} {:>10.5f} {:>10.5f} {:>10.5f} {:>12.5f} {:>10}\n", a.images[i], rows[i].first, e.rmse,
-               e.relMse, e.worstRegionRmse, nonFinite(images[i]));
+    const ImageError& e = rows[i].error;
+    fmt::print("{:<40} {:>10.5f} {:>10.5f} {:>10.5f} {:>12.5f} {:>10}\n", a.images[i], rows[i].mean, e.rmse, e.relMse,
+               e.worstRegionRmse, rows[i].nonFinite);
   }
 }
 }  // namespace

@@ -234,8 +234,7 @@ void runStudy(const StudyArgs& a) {
     saveImage(ref, refPath);
     spdlog::info("study: reference done in {:.1f} s", r.seconds);
   }
-  for (float v : ref.rgb)
-    if (!std::isfinite(v)) throw std::runtime_error("reference '" + refPath + "' has NaN or infinite pixels");
+  if (nonFiniteValues(ref) > 0) throw std::runtime_error("reference '" + refPath + "' has NaN or infinite pixels");
   if (scene.camera.width != ref.width || scene.camera.height != ref.height)
     throw std::runtime_error(fmt::format("reference '{}' is {}x{}, the scene renders {}x{}", refPath, ref.width,
                                          ref.height, scene.camera.width, scene.camera.height));

@@ -355,6 +355,12 @@ std::string encodeJpeg(int width, int height, const std::vector<unsigned char>& 
   return out;
 }
 
+size_t nonFiniteValues(const Image& img) {
+  size_t n = 0;
+  for (float v : img.rgb) n += !std::isfinite(v);
+  return n;
+}
+
 std::vector<unsigned char> toneMapImage(const Image& img, const SaveOptions& opts) {
   static const SrgbSteps steps;
   const float scale = std::exp2(opts.exposure);

@@ -49,6 +49,9 @@ std::string encodePng(int width, int height, const std::vector<unsigned char>& r
 // 8-bit RGB as a baseline JPEG (quality 1-100), for streaming frames.
 std::string encodeJpeg(int width, int height, const std::vector<unsigned char>& rgb, int quality);
 
+// How many channel values are NaN or infinite.
+size_t nonFiniteValues(const Image& img);
+
 // The whole image as 8-bit sRGB, 3 bytes a pixel.
 std::vector<unsigned char> toneMapImage(const Image& img, const SaveOptions& opts);
 

@@ -79,8 +79,11 @@ class Loader {
   std::map<std::string, std::string> cliDefines_, params_;
   std::vector<std::unique_ptr<SourceFile>> files_;
   std::vector<std::unique_ptr<pugi::xml_document>> docs_;
-  std::map<std::string, int> bsdfIds_;
-  std::map<std::string, std::string> bsdfIdWhere_;  // "file:line" of each id's definition
+  struct NamedBsdf {
+    int index;          // into scene_.bsdfs
+    std::string where;  // "file:line" of its definition, for a duplicate's error
+  };
+  std::map<std::string, NamedBsdf> bsdfIds_;
   std::set<std::string> warned_;
   bool haveSensor_ = false;
 
@@ -346,9 +349,8 @@ class Loader {
       else {
         // As Mitsuba: a second definition of an id is an error, not a silent replacement.
         std::string where = fmt::format("{}:{}", f->path, f->lineOf(n.offset_debug()));
-        auto [it, fresh] = bsdfIdWhere_.emplace(name, where);
-        if (!fresh) fail(f, n, fmt::format("duplicate BSDF id '{}' (first defined at {})", name, it->second));
-        bsdfIds_[name] = id;
+        auto [it, fresh] = bsdfIds_.emplace(name, NamedBsdf{id, where});
+        if (!fresh) fail(f, n, fmt::format("duplicate BSDF id '{}' (first defined at {})", name, it->second.where));
       }
     } else if (tag == "texture" || tag == "medium" || tag == "phase") {
       warnOnce(fmt::format("{}:{}: <{}> is not supported and was ignored", f->path, f->lineOf(n.offset_debug()), tag));
@@ -547,7 +549,7 @@ class Loader {
           checkAttrs(f, c, {"id", "name"});
           auto it = bsdfIds_.find(attr(f, c, "id"));
           if (it == bsdfIds_.end()) fail(f, c, fmt::format("unknown BSDF id '{}'", attr(f, c, "id")));
-          Bsdf copy = scene_.bsdfs[size_t(it->second)];
+          Bsdf copy = scene_.bsdfs[size_t(it->second.index)];
           copy.twoSided = true;
           scene_.bsdfs.push_back(copy);
           return int(scene_.bsdfs.size() - 1);
@@ -679,7 +681,7 @@ class Loader {
         auto it = bsdfIds_.find(attr(f, c, "id"));
         if (it == bsdfIds_.end()) fail(f, c, fmt::format("unknown BSDF id '{}'", attr(f, c, "id")));
         if (entry.bsdf >= 0) fail(f, c, "a shape has at most one BSDF");
-        entry.bsdf = it->second;
+        entry.bsdf = it->second.index;
       } else if (tag == "emitter") {
         emitter(f, c, &entry);
       } else if (!isPropTag(tag)) {

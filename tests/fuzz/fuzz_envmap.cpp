@@ -1,8 +1,9 @@
 // libFuzzer target: the map's sampling structures on small adversarial maps (1 to 16 pixels a
 // side; zeros, denormals, 1e30, NaN and negative texels; bilinear or not; MIS compensation;
 // turned), drawn from with every strategy at fuzzed (u1, u2) and normals, the zero normal
-// included. What is checked: no read outside a table (AddressSanitizer), and every draw and
-// density finite, non-negative, with a unit direction.
+// included. What is checked: no read outside a table (AddressSanitizer); every draw and
+// density finite, non-negative, with a unit direction; and a draw's density equal to pdf() of
+// its direction, away from pixel edges and the poles.
 #include <cmath>
 #include <cstdlib>
 #include <cstring>

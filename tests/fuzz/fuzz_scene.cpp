@@ -87,11 +87,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     envgi::EmbreeAccel accel(scene);
     envgi::RenderStats stats;
     envgi::Image img = envgi::render(scene, accel, opts, &stats);
-    for (float v : img.rgb)
-      if (!std::isfinite(v)) {
-        std::fprintf(stderr, "fuzz_scene: a non-finite pixel in the render\n");
-        std::abort();
-      }
+    if (envgi::nonFiniteValues(img) > 0) {
+      std::fprintf(stderr, "fuzz_scene: a non-finite pixel in the render\n");
+      std::abort();
+    }
     // The renderer drops NaN and infinite samples; a scene of moderate numbers should make none.
     if (stats.nonFiniteSamples > 0 && moderateNumbers(std::string(reinterpret_cast<const char*>(data), size))) {
       std::fprintf(stderr, "fuzz_scene: %llu non-finite samples from a scene of moderate numbers\n",

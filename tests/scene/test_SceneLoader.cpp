@@ -159,13 +159,14 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
     EXPECT_NE(err.find(c.expect), std::string::npos) << "for " << c.body << "\n got: " << err;
   }
   EXPECT_NE(loadError(f.scene("")).find("no <sensor>"), std::string::npos);
-  for (const char* lookat : {R"(origin="0,0,0" target="0,0,0" up="0,1,0")", R"(origin="0,0,0" target="0,0,1" up="0,0,0")"}) {
+  const std::pair<const char*, const char*> lookats[] = {
+      {R"(origin="0,0,0" target="0,0,0" up="0,1,0")", "lookat: origin and target are the same point"},
+      {R"(origin="0,0,0" target="0,0,1" up="0,0,0")", "lookat: 'up' is zero"}};
+  for (const auto& [lookat, expect] : lookats) {
     std::string sensor = std::string(kSensor), original = R"(origin="0,0,5" target="0,0,0" up="0,1,0")";
     sensor.replace(sensor.find(original), original.size(), lookat);
     std::string err = loadError(f.scene(sensor));
-    EXPECT_TRUE(err.find("origin and target are the same point") != std::string::npos ||
-                err.find("'up' is zero") != std::string::npos)
-        << lookat << ": " << err;
+    EXPECT_NE(err.find(expect), std::string::npos) << lookat << ": " << err;
   }
   EXPECT_NE(loadError(f.dir.file("none.xml")).find("cannot open scene file"), std::string::npos);
   f.write("bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n");

@@ -154,8 +154,8 @@ TEST(ViewSession, BadMessagesAreErrorsAndChangeNothing) {
   EXPECT_EQ(errorOf(R"({"type":"environment","rotation":10,"scale":-1})"),
             "environment: 'scale' must be in [0, 10000]");
   EXPECT_EQ(errorOf(R"({"type":"resolution","scale":9})"), "resolution: 'scale' must be in [0.1, 2]");
-  // Numbers beyond a float's or an int's range are refused before any conversion (found by
-  // tests/fuzz: the conversions were undefined behaviour).
+  // Numbers beyond a float's or an int's range are refused before any conversion (the
+  // conversions were undefined behaviour; UBSan showed the version's).
   EXPECT_EQ(errorOf(R"({"type":"exposure","value":1e300})"), "exposure: 'value' must be in [-20, 20]");
   EXPECT_EQ(errorOf(R"({"type":"camera","origin":[1e300,0,1],"target":[0,0,0],"up":[0,1,0]})"),
             "camera: 'origin' must be finite");
