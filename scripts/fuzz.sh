@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Fuzzes envgi's file readers with libFuzzer (clang, AddressSanitizer, UBSan):
-#   bash scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]     targets: image mesh scene
+# Fuzzes envgi's file readers, map sampling and viewer messages with libFuzzer (clang,
+# AddressSanitizer, UBSan):
+#   bash scripts/fuzz.sh [SECONDS_PER_TARGET] [TARGET...]   targets: image mesh scene envmap view
+#                                                           (all of tests/fuzz/fuzz_*.cpp by default)
 # Builds in build-fuzz, starts each target from its checked-in corpus (tests/fuzz/corpus) and
 # keeps what it finds in build-fuzz/findings/TARGET: crash-*, timeout-*, oom-* inputs to add to
 # the corpus once fixed (the unit suite replays that corpus in every build).
@@ -9,7 +11,9 @@ cd "$(dirname "$0")/.."
 secs=${1:-120}
 shift || true
 targets=("$@")
-[ ${#targets[@]} -eq 0 ] && targets=(image mesh scene)
+if [ ${#targets[@]} -eq 0 ]; then
+  for f in tests/fuzz/fuzz_*.cpp; do targets+=("$(basename "$f" .cpp | sed 's/^fuzz_//')"); done
+fi
 command -v clang++ >/dev/null || { echo "fuzz.sh: needs clang (apt-get install clang)" >&2; exit 2; }
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DENVGI_CUDA=OFF \
   -DENVGI_BENCH=OFF -DENVGI_GPU_TOOLS=OFF -DENVGI_SANITIZE=ON -DENVGI_FUZZ=ON > build-fuzz.cmake.log
