@@ -19,6 +19,8 @@ void addViewCommand(CLI::App& app);
 
 // Option checks whose errors read as sentences ("--spp must be at least 1, not 0"); CLI11's
 // PositiveNumber names a range up to 1.8e308 and lets NaN through where the option is a float.
+// The whole text as a finite number ("1x", "", "inf" and "nan" are not).
+bool parseFiniteNumber(const std::string& s, double& v);
 // A finite number no smaller than `lo`:
 CLI::Validator atLeast(double lo);
 // Any finite number:

@@ -48,18 +48,12 @@ std::vector<std::string> splitList(const std::string& s) {
   return out;
 }
 
-// A comma-separated list of positive numbers; `what` names the option in errors.
+// A comma-separated list of positive finite numbers; `what` names the option in errors.
 std::vector<double> positiveNumbers(const std::string& list, const std::string& option, const std::string& what) {
   std::vector<double> out;
   for (const std::string& s : splitList(list)) {
     double v = 0;
-    try {
-      size_t used = 0;
-      v = std::stod(s, &used);
-      if (used != s.size()) v = 0;
-    } catch (...) {
-    }
-    if (!(v > 0)) throw std::runtime_error(option + ": '" + s + "' is not " + what);
+    if (!parseFiniteNumber(s, v) || !(v > 0)) throw std::runtime_error(option + ": '" + s + "' is not " + what);
     out.push_back(v);
   }
   return out;

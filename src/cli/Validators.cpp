@@ -8,23 +8,17 @@
 
 namespace envgi::cli {
 
-namespace {
-
-// The whole text as a number; false for anything else ("1x", "", "nan" parses but is caught
-// by the callers' isfinite).
-bool parseNumber(const std::string& s, double& v) {
+bool parseFiniteNumber(const std::string& s, double& v) {
   char* end = nullptr;
   v = std::strtod(s.c_str(), &end);
-  return !s.empty() && end == s.c_str() + s.size();
+  return !s.empty() && end == s.c_str() + s.size() && std::isfinite(v);
 }
-
-}  // namespace
 
 CLI::Validator atLeast(double lo) {
   return CLI::Validator(
       [lo](std::string& s) -> std::string {
         double v = 0;
-        if (!parseNumber(s, v) || !std::isfinite(v)) return fmt::format("'{}' is not a number", s);
+        if (!parseFiniteNumber(s, v)) return fmt::format("'{}' is not a number", s);
         if (v < lo) return fmt::format("must be at least {}, not {}", lo, s);
         return "";
       },
@@ -35,7 +29,7 @@ CLI::Validator finiteNumber() {
   return CLI::Validator(
       [](std::string& s) -> std::string {
         double v = 0;
-        if (!parseNumber(s, v) || !std::isfinite(v)) return fmt::format("'{}' is not a finite number", s);
+        if (!parseFiniteNumber(s, v)) return fmt::format("'{}' is not a finite number", s);
         return "";
       },
       "NUMBER");

@@ -98,6 +98,8 @@ TEST(StudyCli, BadInputIsOneErrorLine) {
   expectError("--spp ,", "--spp is empty");
   expectError("--spp 4,x", "not a positive sample count");
   expectError("--time 0", "not a positive number of seconds");
+  expectError("--time 1,inf", "--time: 'inf' is not a positive number of seconds");  // was taken, then cast to int
+  expectError("--spp 4,1e999", "--spp: '1e999' is not a positive sample count");
   expectError("--seeds 0", "--seeds must be at least 1");
   expectError("--integrator photon", "--integrator must be direct or path");
   expectError("--strategies points", "name its size, points-N");
