@@ -84,6 +84,15 @@ TEST(StudyCli, RefusesAFolderOfOtherSettingsAndRedoesUnreadableRuns) {
   EXPECT_NE(again.output.find("is unreadable"), std::string::npos) << again.output;
   EXPECT_NE(again.output.find("1 runs (0 already done)"), std::string::npos) << again.output;
   EXPECT_NE(slurp(run).find("\"rmse\""), std::string::npos);
+
+  // A settings file that cannot be read is one error naming it, not a guess.
+  std::ofstream(out + "/study.json") << "{ not json";
+  CliResult broken = runCli(args);
+  EXPECT_EQ(broken.code, 1) << broken.output;
+  EXPECT_NE(broken.output.find("study.json is unreadable"), std::string::npos) << broken.output;
+  size_t at = broken.output.find("envgi: error: ");
+  ASSERT_NE(at, std::string::npos) << broken.output;
+  EXPECT_EQ(broken.output.find("envgi: error: ", at + 1), std::string::npos) << "one error line: " << broken.output;
 }
 
 TEST(StudyCli, BadInputIsOneErrorLine) {
