@@ -53,6 +53,10 @@ DeviceScene::DeviceScene(const Scene& scene, const Bvh& hostBvh) {
   view.meshes = arena.upload(meshes.data(), meshes.size(), "meshes");
   view.spheres = arena.upload(hv.spheres, size_t(hv.sphereCount), "spheres");
   view.bsdfs = arena.upload(hv.bsdfs, scene.bsdfs.size(), "materials");
+  std::vector<TextureView> textures(hv.textures, hv.textures + scene.textures.size());
+  for (TextureView& t : textures)
+    if (t.texels) t.texels = arena.upload(t.texels, size_t(t.width) * size_t(t.height), "texture texels");
+  view.textures = arena.upload(textures.data(), textures.size(), "textures");
   view.lights = arena.upload(hv.lights, size_t(hv.lightCount), "lights");
   view.lightSelect.bins = arena.upload(hv.lightSelect.bins, size_t(hv.lightSelect.n), "light table");
   if (hv.hasEnvironment) view.env = uploadEnvironment(arena, hv.env);

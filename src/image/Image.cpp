@@ -126,7 +126,7 @@ void checkRadianceHeader(const std::string& path) {
   if (left / perRow < uintmax_t(h)) throw bad("file is truncated");
 }
 
-Image loadStb(const std::string& path, bool hdr) {
+Image loadStb(const std::string& path, bool hdr, bool decodeSrgb) {
   if (hdr) checkRadianceHeader(path);
   FilePtr f(std::fopen(path.c_str(), "rb"));
   if (!f) throw std::runtime_error("cannot open image '" + path + "'");
@@ -146,10 +146,10 @@ Image loadStb(const std::string& path, bool hdr) {
   if (data) {
     std::memcpy(img.rgb.data(), data, n * sizeof(float));
   } else {
-    // 8-bit files are sRGB-encoded: decode to linear.
+    // 8-bit files are sRGB-encoded: decode to linear, unless the caller wants the raw codes.
     for (size_t i = 0; i < n; ++i) {
       float c = ldr[i] / 255.f;
-      img.rgb[i] = c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
+      img.rgb[i] = !decodeSrgb ? c : c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
     }
   }
   return img;
@@ -227,13 +227,13 @@ bool writeExr(const Image& img, const fs::path& path) {
 
 }  // namespace
 
-Image loadImage(const std::string& path) {
+Image loadImage(const std::string& path, bool decodeSrgb) {
   if (!fs::exists(path)) throw std::runtime_error("cannot open image '" + path + "': no such file");
   std::string ext = lowerExtension(path);
   if (ext == ".exr") return loadExr(path);
   if (ext == ".pfm") return loadPfm(path);
-  if (ext == ".hdr" || ext == ".pic") return loadStb(path, true);
-  if (ext == ".png" || ext == ".jpg" || ext == ".jpeg") return loadStb(path, false);
+  if (ext == ".hdr" || ext == ".pic") return loadStb(path, true, false);
+  if (ext == ".png" || ext == ".jpg" || ext == ".jpeg") return loadStb(path, false, decodeSrgb);
   throw std::runtime_error("cannot read image '" + path + "': unknown format '" + ext +
                            "' (envgi reads .exr, .hdr, .pfm, .png, .jpg)");
 }

@@ -35,8 +35,8 @@ struct SaveOptions {
 
 // Reads .exr (OpenEXR), .hdr, .png, .jpg (stb_image; 8-bit files are decoded from sRGB) and
 // .pfm into linear RGB; throws std::runtime_error naming the file on a missing, unreadable or
-// truncated file.
-Image loadImage(const std::string& path);
+// truncated file. decodeSrgb = false keeps 8-bit codes as code / 255 (Mitsuba's `raw`).
+Image loadImage(const std::string& path, bool decodeSrgb = true);
 
 // Writes by extension: .exr, .pfm and .hdr as linear float, .png/.jpg as 8-bit sRGB after
 // exposure and tone curve. The file appears atomically (a temporary file, then rename).

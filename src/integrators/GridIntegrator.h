@@ -26,7 +26,7 @@ ENVGI_HD Color gridTrace(const SceneView& sc, const Tracer& tracer, const Ray& r
   auto estimate = [&](const SurfaceInteraction& si, Vec3f wo, Sampler&, uint64_t*) {
     Vec3f n = faceForward(si.shading.n, wo);
     Color E = grid.irradiance(si.p, n) + causticIrradiance(si.p, faceForward(si.ng, wo));
-    return diffuseAlbedo(sc.bsdfs[si.bsdf]) * kInvPi * E;
+    return diffuseAlbedo(sc.bsdfAt(si)) * kInvPi * E;
   };
   return traceSpecularChain(sc, tracer, ray, smp, gp.chain, estimate, rays);
 }
@@ -48,7 +48,7 @@ ENVGI_HD Color gridGather(const SceneView& sc, const Tracer& tracer, Ray ray, Sa
     ++*rays;
     if (!tracer.intersect(ray, &h)) return Color(0.f);
     SurfaceInteraction si = sc.interaction(ray, h);
-    const Bsdf& bsdf = sc.bsdfs[si.bsdf];
+    const Bsdf bsdf = sc.bsdfAt(si);
     if (depth == 0 && dot(si.ng, ray.d) > 0.f && !bsdf.twoSided && !bsdfTransmits(bsdf)) {
       *backFace = true;
       return Color(0.f);

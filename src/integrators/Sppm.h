@@ -20,6 +20,7 @@ struct VisiblePoint {
   Vec3f wo;
   Frame shading;
   Color beta;
+  Vec2f uv;  // where the material's textures are read
   int bsdf = 0;
   bool valid = false;
 };
@@ -41,7 +42,7 @@ ENVGI_HD VisiblePoint sppmCameraPath(const SceneView& sc, const Tracer& tracer, 
     SurfaceInteraction si = sc.interaction(ray, h);
     Vec3f wo = -ray.d;
     *Ld += beta * sc.emitted(si, wo);
-    const Bsdf& bsdf = sc.bsdfs[si.bsdf];
+    const Bsdf bsdf = sc.bsdfAt(si);
     // Smooth plastic's coat is a mirror: follow it with its sampling probability (what it
     // reflects may be lit, not emitting), and make the visible point on the base otherwise.
     float pDelta = bsdfDeltaProb(bsdf, si.shading.toLocal(wo));
@@ -54,6 +55,7 @@ ENVGI_HD VisiblePoint sppmCameraPath(const SceneView& sc, const Tracer& tracer, 
       vp.shading = si.shading;
       vp.beta = beta;
       vp.bsdf = si.bsdf;
+      vp.uv = si.uv;
       vp.valid = true;
       return vp;
     }
@@ -70,7 +72,7 @@ ENVGI_HD VisiblePoint sppmCameraPath(const SceneView& sc, const Tracer& tracer, 
 
 // A photon's contribution f(wo, wi) beta_vp Phi at one visible point within its radius.
 ENVGI_INLINE Color sppmContribution(const SceneView& sc, const VisiblePoint& vp, Vec3f wi, Color power) {
-  const Bsdf& b = sc.bsdfs[vp.bsdf];
+  const Bsdf b = sc.bsdfAt(vp.bsdf, vp.uv);
   Vec3f wiLocal = vp.shading.toLocal(wi);
   float c = std::fabs(wiLocal.z);
   if (c <= 0.f) return Color(0.f);

@@ -34,6 +34,8 @@ struct Bsdf {
   float fdrInt = 0.f;                    // plastic: diffuse Fresnel reflectance seen from inside
   float fdrExt = 0.f;                    // plastic: the same seen from outside
   float specularSamplingWeight = 0.5f;   // plastic: share of samples given to the coating
+  // Textures replacing the colours above at a hit (SceneView::bsdfAt); -1: none.
+  int reflectanceTexture = -1, specularReflectanceTexture = -1, specularTransmittanceTexture = -1;
 };
 
 struct BsdfSample {

@@ -27,6 +27,7 @@ void Scene::finalize() {
       SphereView& v = sphereViews_[s.index];
       v.center = sp.center;
       v.radius = sp.radius;
+      v.axes = sp.axes;
       v.bsdf = s.bsdf;
       v.flipNormals = sp.flipNormals;
       lo = vmin(lo, sp.center - Vec3f(sp.radius));
@@ -71,6 +72,12 @@ void Scene::finalize() {
   view_.spheres = sphereViews_.data();
   view_.sphereCount = int(sphereViews_.size());
   view_.bsdfs = bsdfs.data();
+  textureViews_.clear();
+  for (const Texture& t : textures) {
+    textureViews_.push_back(t.params);
+    textureViews_.back().texels = t.texels.empty() ? nullptr : t.texels.data();
+  }
+  view_.textures = textureViews_.data();
   view_.lights = lights_.data();
   view_.lightCount = int(lights_.size());
   if (!lights_.empty()) view_.lightSelect = lightTable_.view();

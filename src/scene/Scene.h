@@ -18,6 +18,13 @@ struct Sphere {
   Vec3f center;
   float radius = 1.f;
   bool flipNormals = false;
+  Frame axes{{1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}, {0.f, 0.f, 1.f}};
+};
+
+// A texture on the host: its parameters and, for a bitmap, the texels its view points into.
+struct Texture {
+  TextureView params;
+  std::vector<Color> texels;
 };
 
 // A shape with its material and, when it is an area light, its radiance.
@@ -41,6 +48,7 @@ class Scene {
   std::vector<Sphere> spheres;
   std::vector<ShapeEntry> shapes;
   std::vector<Bsdf> bsdfs;
+  std::vector<Texture> textures;
   std::unique_ptr<EnvironmentMap> env;
   Camera camera;
   IntegratorSettings integrator;
@@ -58,6 +66,7 @@ class Scene {
  private:
   std::vector<MeshView> meshViews_;
   std::vector<SphereView> sphereViews_;
+  std::vector<TextureView> textureViews_;
   std::vector<LightPrim> lights_;
   AliasTable lightTable_;
   SceneView view_;

@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "image/Image.h"
 #include "materials/BsdfFactory.h"
 #include "scene/NameTables.h"
 #include "scene/Properties.h"
@@ -79,11 +80,11 @@ class Loader {
   std::map<std::string, std::string> cliDefines_, params_;
   std::vector<std::unique_ptr<SourceFile>> files_;
   std::vector<std::unique_ptr<pugi::xml_document>> docs_;
-  struct NamedBsdf {
-    int index;          // into scene_.bsdfs
+  struct NamedIndex {
+    int index;          // into scene_.bsdfs or scene_.textures
     std::string where;  // "file:line" of its definition, for a duplicate's error
   };
-  std::map<std::string, NamedBsdf> bsdfIds_;
+  std::map<std::string, NamedIndex> bsdfIds_, textureIds_;
   std::set<std::string> warned_;
   bool haveSensor_ = false;
 
@@ -323,6 +324,20 @@ class Loader {
   }
 
   // ---- elements ------------------------------------------------------------------------------
+  // Files a top-level element's index under its id, for <ref>s that follow.
+  void nameTopLevel(const SourceFile* f, pugi::xml_node n, int index, std::map<std::string, NamedIndex>& ids,
+                    const char* kind) {
+    std::string name = attr(f, n, "id", false);
+    std::string where = fmt::format("{}:{}", f->path, f->lineOf(n.offset_debug()));
+    if (name.empty()) {
+      warnOnce(fmt::format("{}: a top-level <{}> without an id is never used", where, n.name()));
+      return;
+    }
+    // As Mitsuba: a second definition of an id is an error, not a silent replacement.
+    auto [it, fresh] = ids.emplace(name, NamedIndex{index, where});
+    if (!fresh) fail(f, n, fmt::format("duplicate {} id '{}' (first defined at {})", kind, name, it->second.where));
+  }
+
   void topLevel(const SourceFile* f, pugi::xml_node n, int depth) {
     std::string tag = n.name();
     if (tag == "default") {
@@ -343,16 +358,10 @@ class Loader {
     } else if (tag == "shape") {
       shape(f, n);
     } else if (tag == "bsdf") {
-      int id = bsdf(f, n);
-      std::string name = attr(f, n, "id", false);
-      if (name.empty()) warnOnce(fmt::format("{}:{}: a top-level <bsdf> without an id is never used", f->path, f->lineOf(n.offset_debug())));
-      else {
-        // As Mitsuba: a second definition of an id is an error, not a silent replacement.
-        std::string where = fmt::format("{}:{}", f->path, f->lineOf(n.offset_debug()));
-        auto [it, fresh] = bsdfIds_.emplace(name, NamedBsdf{id, where});
-        if (!fresh) fail(f, n, fmt::format("duplicate BSDF id '{}' (first defined at {})", name, it->second.where));
-      }
-    } else if (tag == "texture" || tag == "medium" || tag == "phase") {
+      nameTopLevel(f, n, bsdf(f, n), bsdfIds_, "BSDF");
+    } else if (tag == "texture") {
+      nameTopLevel(f, n, texture(f, n), textureIds_, "texture");
+    } else if (tag == "medium" || tag == "phase") {
       warnOnce(fmt::format("{}:{}: <{}> is not supported and was ignored", f->path, f->lineOf(n.offset_debug()), tag));
     } else {
       fail(f, n, fmt::format("unknown element <{}>", tag));
@@ -496,6 +505,12 @@ class Loader {
     checkAttrs(f, n, {"type", "id", "name"});
     std::string type = attr(f, n, "type");
     Props p = collectProps(f, n);
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element || isPropTag(c.name())) continue;
+      if (std::string(c.name()) != "texture") fail(f, c, fmt::format("unexpected <{}> in <emitter>", c.name()));
+      warnOnce(fmt::format("{}:{}: a texture for '{}' of emitter '{}' is not supported; the property keeps its default",
+                           f->path, f->lineOf(c.offset_debug()), c.attribute("name").as_string(), type));
+    }
     if (type == "area") {
       if (!shape) fail(f, n, "an 'area' emitter must be inside a <shape>");
       shape->emissive = true;
@@ -559,6 +574,26 @@ class Loader {
       scene_.bsdfs[size_t(id)].twoSided = true;
       return id;
     }
+    // Textured properties, by name: nested <texture name=...> or <ref id=... name=...>.
+    std::map<std::string, std::pair<int, pugi::xml_node>> textures;
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element) continue;
+      std::string tag = c.name();
+      int index = -1;
+      if (tag == "texture") {
+        index = texture(f, c);
+      } else if (tag == "ref") {
+        checkAttrs(f, c, {"id", "name"});
+        auto it = textureIds_.find(attr(f, c, "id"));
+        if (it == textureIds_.end()) fail(f, c, fmt::format("unknown texture id '{}'", attr(f, c, "id")));
+        index = it->second.index;
+      } else {
+        continue;
+      }
+      std::string name = attr(f, c, "name");
+      if (p.count(name) || textures.count(name)) fail(f, c, fmt::format("property '{}' given twice", name));
+      textures[name] = {index, c};
+    }
     if (type == "diffuse") {
       b.type = BsdfType::Diffuse;
       b.reflectance = getColor(f, p, "reflectance", Color(0.5f));
@@ -595,18 +630,87 @@ class Loader {
     } else {
       fail(f, n, fmt::format("unknown BSDF type '{}'", type));
     }
-    for (pugi::xml_node c : n.children())
-      if (c.type() == pugi::node_element && !isPropTag(c.name())) {
-        if (std::string(c.name()) == "texture") {
-          warnOnce(fmt::format("{}:{}: textures are not supported; the property keeps its default", f->path,
-                               f->lineOf(c.offset_debug())));
-          continue;
-        }
-        fail(f, c, fmt::format("unexpected <{}> in <bsdf>", c.name()));
+    for (const auto& [name, tex] : textures) {
+      int* slot = textureSlot(b, name);
+      if (!slot) {
+        warnOnce(fmt::format("{}:{}: a texture for '{}' of bsdf '{}' is not supported; the property keeps its default",
+                             f->path, f->lineOf(tex.second.offset_debug()), name, type));
+        continue;
       }
+      *slot = tex.first;
+    }
+    for (pugi::xml_node c : n.children())
+      if (c.type() == pugi::node_element && !isPropTag(c.name()) && std::string(c.name()) != "texture" &&
+          std::string(c.name()) != "ref")
+        fail(f, c, fmt::format("unexpected <{}> in <bsdf>", c.name()));
     warnUnused(f, p, "bsdf '" + type + "'");
     scene_.bsdfs.push_back(b);
     return int(scene_.bsdfs.size() - 1);
+  }
+
+  // Where a texture for property `name` goes in b (the colours Mitsuba lets a texture give);
+  // null for a property envgi reads as a constant only.
+  static int* textureSlot(Bsdf& b, const std::string& name) {
+    bool plastic = b.type == BsdfType::Plastic || b.type == BsdfType::RoughPlastic;
+    if ((b.type == BsdfType::Diffuse && name == "reflectance") || (plastic && name == "diffuse_reflectance"))
+      return &b.reflectanceTexture;
+    if (b.type != BsdfType::Diffuse && name == "specular_reflectance") return &b.specularReflectanceTexture;
+    if (bsdfTransmits(b) && name == "specular_transmittance") return &b.specularTransmittanceTexture;
+    return nullptr;
+  }
+
+  // Mitsuba's bitmap and checkerboard textures; returns the index into scene_.textures.
+  int texture(const SourceFile* f, pugi::xml_node n) {
+    checkAttrs(f, n, {"type", "id", "name"});
+    std::string type = attr(f, n, "type");
+    Props p = collectProps(f, n);
+    Texture t;
+    TextureView& v = t.params;
+    if (type == "bitmap") {
+      v.type = TextureType::Bitmap;
+      std::string file = getString(f, p, "filename", "");
+      if (file.empty()) fail(f, n, "bitmap needs a 'filename'");
+      std::string filter = getString(f, p, "filter_type", "bilinear");
+      if (filter != "bilinear" && filter != "nearest") fail(f, n, "filter_type must be bilinear or nearest");
+      v.bilinear = filter == "bilinear";
+      std::string wrap = getString(f, p, "wrap_mode", "repeat");
+      if (wrap == "repeat") v.wrap = TextureWrap::Repeat;
+      else if (wrap == "mirror") v.wrap = TextureWrap::Mirror;
+      else if (wrap == "clamp") v.wrap = TextureWrap::Clamp;
+      else fail(f, n, fmt::format("wrap_mode must be repeat, mirror or clamp, not '{}'", wrap));
+      bool raw = getBool(f, p, "raw", false);
+      fs::path path = fs::path(f->path).parent_path() / file;
+      Image img;
+      try {
+        img = loadImage(path.string(), !raw);
+      } catch (const std::runtime_error& e) {
+        rethrowAt(f, n, e);
+      }
+      // A texel that is NaN, infinite or negative would poison every path that reads it.
+      for (float x : img.rgb)
+        if (!(x >= 0.f && x <= 3.4e38f))
+          fail(f, n, fmt::format("texture '{}' has a negative, NaN or infinite texel", path.string()));
+      v.width = img.width;
+      v.height = img.height;
+      t.texels.resize(size_t(img.width) * img.height);
+      for (size_t i = 0; i < t.texels.size(); ++i) t.texels[i] = {img.rgb[3 * i], img.rgb[3 * i + 1], img.rgb[3 * i + 2]};
+    } else if (type == "checkerboard") {
+      v.type = TextureType::Checkerboard;
+      v.color0 = getColor(f, p, "color0", Color(0.4f));
+      v.color1 = getColor(f, p, "color1", Color(0.2f));
+    } else {
+      fail(f, n, fmt::format("unknown texture type '{}' (bitmap, checkerboard)", type));
+    }
+    // to_uv acts on (u, v, 0, 1): its upper-left 2x2 and the translation's x and y.
+    Matrix4 m = getTransform(f, p, "to_uv").mat;
+    float toUv[6] = {m.m[0][0], m.m[0][1], m.m[0][3], m.m[1][0], m.m[1][1], m.m[1][3]};
+    std::copy(toUv, toUv + 6, v.toUv);
+    for (pugi::xml_node c : n.children())
+      if (c.type() == pugi::node_element && !isPropTag(c.name()))
+        fail(f, c, fmt::format("unexpected <{}> in <texture> (a texture's colours are constants)", c.name()));
+    warnUnused(f, p, "texture '" + type + "'");
+    scene_.textures.push_back(std::move(t));
+    return int(scene_.textures.size() - 1);
   }
 
   void roughness(const SourceFile* f, pugi::xml_node n, Props& p, Bsdf& b, const std::string& type) {
@@ -632,6 +736,8 @@ class Loader {
       if (!(r > 0.f)) fail(f, n, "sphere radius must be positive");
       s.center = toWorld.point(c);
       s.radius = r * length(toWorld.vector(Vec3f(1.f, 0.f, 0.f)));
+      s.axes = {normalize(toWorld.vector(Vec3f(1.f, 0.f, 0.f))), normalize(toWorld.vector(Vec3f(0.f, 1.f, 0.f))),
+                normalize(toWorld.vector(Vec3f(0.f, 0.f, 1.f)))};
       s.flipNormals = flip;
       entry.isSphere = true;
       entry.index = scene_.spheres.size();
@@ -658,6 +764,9 @@ class Loader {
         rethrowAt(f, n, e);
       }
       bool faceNormals = getBool(f, p, "face_normals", false);
+      // Mitsuba's mesh loaders flip v by default: files give v up the image, bitmaps store rows down.
+      if ((type == "ply" || type == "obj") && getBool(f, p, "flip_tex_coords", true))
+        for (Vec2f& uv : mesh.uvs) uv.y = 1.f - uv.y;
       mesh.transform(toWorld);
       if (faceNormals) mesh.normals.clear();
       else if (mesh.normals.empty() && (type == "ply" || type == "obj")) mesh.computeVertexNormals();

@@ -1,8 +1,11 @@
 // The scene as plain data that kernels read: meshes, spheres, materials, lights, camera.
 #pragma once
 
+#include "core/Atan2.h"
+#include "core/Frame.h"
 #include "envmap/EnvironmentMapView.h"
 #include "materials/Bsdf.h"
+#include "materials/Texture.h"
 #include "scene/Camera.h"
 #include "scene/Ray.h"
 
@@ -24,6 +27,7 @@ struct SphereView {
   int bsdf = 0;
   int light = -1;
   bool flipNormals = false;
+  Frame axes{{1.f, 0.f, 0.f}, {0.f, 1.f, 0.f}, {0.f, 0.f, 1.f}};  // to_world's axes, for (u, v)
 };
 
 // One emitting primitive: a triangle of a mesh or a whole sphere.
@@ -50,6 +54,7 @@ struct SceneView {
   const SphereView* spheres = nullptr;
   int sphereCount = 0;
   const Bsdf* bsdfs = nullptr;
+  const TextureView* textures = nullptr;
   const LightPrim* lights = nullptr;
   int lightCount = 0;
   AliasTableView lightSelect;  // area lights by power
@@ -90,15 +95,31 @@ struct SceneView {
       Vec3f p = ray.o + ray.d * h.t;
       Vec3f n = normalize(p - s.center);
       si.p = s.center + n * s.radius;  // re-projected: removes the hit point's float error
+      // Mitsuba's sphere coordinates: u the azimuth about local z from local x, v the polar angle.
+      Vec3f l = s.axes.toLocal(n);
+      float phi = polyAtan2(l.y, l.x);
+      si.uv = Vec2f((phi < 0.f ? phi + 2.f * kPi : phi) * (0.5f * kInvPi), acosf(fminf(fmaxf(l.z, -1.f), 1.f)) * kInvPi);
       if (s.flipNormals) n = -n;
       si.ng = n;
       si.shading = Frame::fromNormal(n);
-      si.uv = Vec2f(0.f, 0.f);
       si.bsdf = s.bsdf;
       si.light = s.light;
     }
     return si;
   }
+
+  // Material `index` at surface coordinates uv: its textured colours looked up there. A copy,
+  // so that kernels keep reading a plain Bsdf.
+  ENVGI_HD Bsdf bsdfAt(int index, Vec2f uv) const {
+    Bsdf b = bsdfs[index];
+    if (b.reflectanceTexture >= 0) b.reflectance = textureEval(textures[b.reflectanceTexture], uv);
+    if (b.specularReflectanceTexture >= 0)
+      b.specularReflectance = textureEval(textures[b.specularReflectanceTexture], uv);
+    if (b.specularTransmittanceTexture >= 0)
+      b.specularTransmittance = textureEval(textures[b.specularTransmittanceTexture], uv);
+    return b;
+  }
+  ENVGI_HD Bsdf bsdfAt(const SurfaceInteraction& si) const { return bsdfAt(si.bsdf, si.uv); }
 
   // What interaction() reads for a triangle hit, asked for ahead (CPU only: a batch of hits
   // prefetches its triangles' indices, then their vertices, so that the misses overlap).

@@ -192,6 +192,49 @@ TEST(CliRender, PhotonSppmAndGridIntegrators) {
   EXPECT_NE(bad.output.find("alpha must be in (0, 1)"), std::string::npos) << bad.output;
 }
 
+// A textured diffuse square filling the view under a constant sky of radiance 1 reflects its
+// albedo, so each quarter of the image shows its texel, in every integrator. The rectangle's
+// v runs up the square and texture rows down the image (as in Mitsuba): texel row 0 is the
+// image's bottom half.
+TEST(CliRender, TexturedAlbedoInEveryIntegrator) {
+  TempDir d;
+  envgi::Image tex(2, 2);
+  const envgi::Color texels[2][2] = {{{0.2f, 0.4f, 0.6f}, {0.8f, 0.1f, 0.3f}}, {{0.05f, 0.5f, 0.9f}, {0.7f, 0.7f, 0.1f}}};
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 2; ++x) tex.set(x, y, texels[y][x]);
+  envgi::saveImage(tex, d.file("tex.exr"));
+  std::ofstream(d.file("tex.xml")) << R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="3"/></integrator>
+  <sensor type="perspective"><float name="fov" value="43.6028"/>
+    <transform name="to_world"><lookat origin="0,0,2.5" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/></film>
+    <sampler type="independent"><integer name="sample_count" value="16"/></sampler></sensor>
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <shape type="rectangle"><bsdf type="diffuse"><texture type="bitmap" name="reflectance">
+    <string name="filename" value="tex.exr"/><string name="filter_type" value="nearest"/></texture></bsdf></shape>
+</scene>)";
+  for (std::string integ : {"path", "direct", "photon", "sppm", "grid"}) {
+    CliResult r = runCli("render " + d.file("tex.xml") + " -o " + d.file("t.exr") + " --integrator " + integ +
+                         " --seed 5 --no-progress");
+    ASSERT_EQ(r.code, 0) << r.output;
+    envgi::Image img = envgi::loadImage(d.file("t.exr"));
+    for (int qy = 0; qy < 2; ++qy)
+      for (int qx = 0; qx < 2; ++qx) {
+        // The middle of each quarter: photon estimates blur the square's outer edges.
+        double sum[3] = {0, 0, 0};
+        int n = 0;
+        for (int y = qy * 16 + 4; y < qy * 16 + 12; ++y)
+          for (int x = qx * 16 + 4; x < qx * 16 + 12; ++x, ++n)
+            for (int c = 0; c < 3; ++c) sum[c] += img.rgb[(size_t(y) * 32 + x) * 3 + c];
+        const envgi::Color want = texels[1 - qy][qx];
+        const float wantC[3] = {want.x, want.y, want.z};
+        for (int c = 0; c < 3; ++c)
+          EXPECT_NEAR(sum[c] / n, wantC[c], 0.04 * wantC[c] + 0.01)
+              << integ << ", quarter (" << qx << ", " << qy << "), channel " << c;
+      }
+  }
+}
+
 // --device: auto falls back to the CPU without a GPU, and says so; cuda without one is one
 // error line and no output file; a bad device name is an error.
 TEST(RenderCli, DeviceChoice) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "materials/BsdfFactory.h"
+#include "scene/NameTables.h"
 #include "support/TestScenes.h"
 
 using namespace envgi;
@@ -145,5 +146,93 @@ TEST(Furnace, EveryBsdfMatchesMitsubaReference) {
   for (const Case& c : cases) {
     double m = furnace(c.bsdf, 256);
     EXPECT_NEAR(m, c.mitsuba, c.tolerance * c.mitsuba) << c.name;
+  }
+}
+
+// Inside a closed sphere that emits Le everywhere, any point sees any patch of the wall under
+// the same form factor (dA / 4 pi R^2), so the radiance leaving x is L(x) = Le + rho(x) Lbar,
+// where Lbar = Le / (1 - mean rho) is the wall's mean radiance. A checkerboard albedo then
+// gives two known values, which every integrator must reach through its textured bounces (the
+// direct integrator, one bounce: Le + rho(x) Le).
+TEST(Furnace, TexturedEnclosureGivesItsAnalyticRadiance) {
+  const Color c0(0.8f, 0.2f, 0.5f), c1(0.2f, 0.6f, 0.4f);
+  auto build = [&](const std::string& integrator) {
+    auto s = std::make_unique<Scene>();
+    Texture checks;
+    checks.params.type = TextureType::Checkerboard;
+    checks.params.color0 = c0;
+    checks.params.color1 = c1;
+    s->textures.push_back(checks);
+    Bsdf wall;
+    wall.reflectanceTexture = 0;
+    s->bsdfs.push_back(wall);
+    s->spheres.push_back({Vec3f(0.f), 1.f, true});
+    s->shapes.push_back({true, 0, 0, true, Color(1.f)});
+    // From the centre towards +x: u = 0 and v = 1/2 cross there, so the four squares around
+    // that point fill the four quarters of the image.
+    s->camera.toWorld = lookAt(Vec3f(0.f), Vec3f(1, 0, 0), Vec3f(0, 1, 0));
+    s->camera.width = s->camera.height = 16;
+    s->camera.tanHalfX = s->camera.tanHalfY = std::tan(0.5f * 50.f * kPi / 180.f);
+    s->camera.filter = FilterType::Box;
+    s->sampler.sampleCount = 32;
+    s->sampler.type = SamplerType::Sobol;
+    // "photon-map": the photon integrator reading its global map at the visible point.
+    s->integrator.type = findIntegrator(integrator == "photon-map" ? "photon" : integrator);
+    if (integrator == "photon-map") s->integrator.photon.gatherSamples = 0;
+    s->integrator.path.maxDepth = 64;
+    // Enough photons for 1%, no more: the wall is smooth and diffuse.
+    s->integrator.photon.globalPhotons = s->integrator.grid.globalPhotons = 50000;
+    s->integrator.photon.causticPhotons = s->integrator.grid.causticPhotons = 1000;
+    s->integrator.sppm.passes = 32;
+    s->integrator.sppm.photonCount = 20000;
+    s->integrator.grid.resolution = 16;
+    s->finalize();
+    return s;
+  };
+  // Each square covers half of each hemisphere: the wall's mean albedo is the squares' mean.
+  const Color mean = (c0 + c1) * 0.5f;
+  const Color lbar(1.f / (1.f - mean.x), 1.f / (1.f - mean.y), 1.f / (1.f - mean.z));
+  for (std::string name : {"path", "direct", "photon", "photon-map", "sppm", "grid"}) {
+    auto s = build(name);
+    EmbreeAccel accel(*s);
+    RenderOptions o;
+    o.progress = false;
+    RenderStats st;
+    Image img = render(*s, accel, o, &st);
+    const SceneView& v = s->view();
+    // Pixels whose whole footprint lies on one square, by square.
+    Color sum[2] = {Color(0.f), Color(0.f)};
+    int n[2] = {0, 0};
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) {
+        int square = -1;
+        for (float dy : {0.f, 1.f})
+          for (float dx : {0.f, 1.f}) {
+            Ray r = v.camera.generateRay(float(x) + dx, float(y) + dy);
+            Hit h;
+            h.t = 1.f;
+            h.geomId = v.meshCount;
+            h.primId = 0;
+            r.d = normalize(r.d);
+            r.o = Vec3f(0.f);
+            Color rho = v.bsdfAt(v.interaction(r, h)).reflectance;
+            int sq = rho.x > 0.5f ? 0 : 1;
+            square = square == -1 || square == sq ? sq : 2;
+          }
+        if (square > 1) continue;
+        sum[square] += img.at(x, y);
+        ++n[square];
+      }
+    bool direct = name == "direct";
+    // Read directly, the global map's k nearest photons on a curved wall are 1-1.5% high.
+    float tolerance = name == "photon-map" ? 0.025f : 0.01f;
+    for (int k = 0; k < 2; ++k) {
+      ASSERT_GT(n[k], 40) << name;
+      Color rho = k == 0 ? c0 : c1;
+      Color want = Color(1.f) + rho * (direct ? Color(1.f) : lbar);
+      Color got = sum[k] / float(n[k]);
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(got[c], want[c], tolerance * want[c]) << name << ", square " << k << ", channel " << c;
+    }
   }
 }

@@ -2,6 +2,7 @@
 // give "FILE:LINE: what" errors.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "cli/CliRunner.h"
@@ -181,8 +182,128 @@ TEST(SceneLoader, HarmlessUnsupportedElementsOnlyWarn) {
   Scene s;
   EXPECT_NO_THROW(loadScene(f.scene(std::string(kSensor) + R"(
     <emitter type="point"/>
-    <texture type="bitmap" id="t"/>
-    <shape type="sphere"><float name="mystery" value="1"/></shape>)"),
+    <phase type="hg"/>
+    <shape type="sphere"><float name="mystery" value="1"/></shape>
+    <shape type="sphere"><emitter type="area"><texture type="checkerboard" name="radiance"/></emitter></shape>)"),
                             {}, s));
-  EXPECT_EQ(s.shapes.size(), 1u);
+  EXPECT_EQ(s.shapes.size(), 2u);
+  EXPECT_EQ(s.shapes[1].radiance.x, 1.f) << "an emitter's texture keeps the default radiance";
+}
+
+TEST(SceneLoader, TexturesNestedReferencedAndOnEveryColourTheyReplace) {
+  Fixture f;
+  Image img(2, 1);
+  img.set(0, 0, Color(0.1f, 0.2f, 0.3f));
+  img.set(1, 0, Color(0.4f, 0.5f, 0.6f));
+  saveImage(img, f.dir.file("tex.exr"));
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <texture type="checkerboard" id="checks"><rgb name="color0" value="1, 0, 0"/>
+      <transform name="to_uv"><scale x="4" y="2"/><translate x="0.5"/></transform></texture>
+    <shape type="sphere"><bsdf type="diffuse"><texture type="bitmap" name="reflectance">
+      <string name="filename" value="tex.exr"/><string name="wrap_mode" value="mirror"/>
+      <string name="filter_type" value="nearest"/></texture></bsdf></shape>
+    <shape type="sphere"><bsdf type="roughplastic"><ref id="checks" name="diffuse_reflectance"/>
+      <ref id="checks" name="specular_reflectance"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="dielectric"><ref id="checks" name="specular_transmittance"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="roughconductor"><ref id="checks" name="alpha"/></bsdf></shape>)"),
+            {}, s);
+  ASSERT_EQ(s.textures.size(), 2u);
+  const TextureView& checks = s.textures[0].params;
+  EXPECT_EQ(checks.type, TextureType::Checkerboard);
+  EXPECT_EQ(checks.color0.x, 1.f);
+  EXPECT_EQ(checks.color1.x, 0.2f);  // Mitsuba's default
+  const float toUv[6] = {4.f, 0.f, 0.5f, 0.f, 2.f, 0.f};
+  for (int i = 0; i < 6; ++i) EXPECT_NEAR(checks.toUv[i], toUv[i], 1e-6f) << i;
+  const Texture& bitmap = s.textures[1];
+  EXPECT_EQ(bitmap.params.wrap, TextureWrap::Mirror);
+  EXPECT_FALSE(bitmap.params.bilinear);
+  ASSERT_EQ(bitmap.texels.size(), 2u);
+  EXPECT_NEAR(bitmap.texels[1].z, 0.6f, 1e-6f);
+  auto bsdf = [&](size_t shape) { return s.bsdfs[size_t(s.shapes[shape].bsdf)]; };
+  EXPECT_EQ(bsdf(0).reflectanceTexture, 1);
+  EXPECT_EQ(bsdf(1).reflectanceTexture, 0);
+  EXPECT_EQ(bsdf(1).specularReflectanceTexture, 0);
+  EXPECT_EQ(bsdf(2).specularTransmittanceTexture, 0);
+  EXPECT_EQ(bsdf(2).reflectanceTexture, -1);
+  // A texture for a property read as a constant warns and leaves it alone.
+  EXPECT_EQ(bsdf(3).reflectanceTexture, -1);
+  EXPECT_EQ(bsdf(3).specularReflectanceTexture, -1);
+  EXPECT_NEAR(bsdf(3).alpha, 0.1f, 1e-6f);
+  // The view resolves them at a hit's uv: texel 1 of the bitmap is u in [0.5, 1).
+  const SceneView& v = s.view();
+  EXPECT_NEAR(v.bsdfAt(s.shapes[0].bsdf, Vec2f(0.75f, 0.5f)).reflectance.y, 0.5f, 1e-6f);
+  EXPECT_NEAR(v.bsdfAt(s.shapes[0].bsdf, Vec2f(1.25f, 0.5f)).reflectance.y, 0.5f, 1e-6f) << "mirrored";
+  // Checks at uv (0.1, 0.1): to_uv gives (0.9, 0.2), squares (1, 0): odd, color1.
+  EXPECT_NEAR(v.bsdfAt(s.shapes[1].bsdf, Vec2f(0.1f, 0.1f)).reflectance.x, 0.2f, 1e-6f);
+  EXPECT_NEAR(v.bsdfAt(s.shapes[1].bsdf, Vec2f(0.15f, 0.1f)).specularReflectance.x, 1.f, 1e-6f);  // (1.1, 0.2)
+}
+
+// uv as Mitsuba makes them: v flipped in OBJ and PLY files (unless flip_tex_coords is false),
+// and on a sphere u the azimuth about its local z from local x, v the polar angle from +z.
+TEST(SceneLoader, SurfaceCoordinatesFollowMitsuba) {
+  Fixture f;
+  f.write("uv.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.25 0.125\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n");
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <shape type="obj"><string name="filename" value="uv.obj"/></shape>
+    <shape type="obj"><string name="filename" value="uv.obj"/><boolean name="flip_tex_coords" value="false"/></shape>
+    <shape type="sphere"/>
+    <shape type="sphere"><transform name="to_world"><rotate z="1" angle="90"/><translate x="10"/></transform></shape>)"),
+            {}, s);
+  EXPECT_NEAR(s.meshes[0].uvs[0].y, 0.875f, 1e-6f);
+  EXPECT_NEAR(s.meshes[1].uvs[0].y, 0.125f, 1e-6f);
+  const SceneView& v = s.view();
+  auto sphereUv = [&](int sphere, Vec3f center, Vec3f dir) {
+    Ray r{center - dir * 5.f, dir, INFINITY};
+    Hit h;
+    h.t = 4.f;
+    h.geomId = v.meshCount + sphere;
+    h.primId = 0;
+    return v.interaction(r, h).uv;
+  };
+  struct Case {
+    Vec3f dir;  // the ray's direction: it hits the sphere at -dir
+    float u, v;
+  } cases[] = {{{0, 0, -1}, 0.f, 0.f}, {{-1, 0, 0}, 0.f, 0.5f}, {{0, -1, 0}, 0.25f, 0.5f},
+               {{1, 0, 0}, 0.5f, 0.5f}, {{0, 1, 0}, 0.75f, 0.5f}, {{0, 0, 1}, 0.f, 1.f}};
+  for (const Case& c : cases) {
+    Vec2f uv = sphereUv(0, Vec3f(0.f), c.dir);
+    if (c.v > 0.f && c.v < 1.f) EXPECT_NEAR(std::remainder(uv.x - c.u, 1.f), 0.f, 1e-5f) << c.dir.x << c.dir.y << c.dir.z;
+    EXPECT_NEAR(uv.y, c.v, 1e-5f) << c.dir.x << c.dir.y << c.dir.z;
+  }
+  // Turned a quarter about z: world +y is the sphere's local +x (u = 0, which is also 1).
+  EXPECT_NEAR(std::remainder(sphereUv(1, Vec3f(10.f, 0.f, 0.f), Vec3f(0.f, -1.f, 0.f)).x, 1.f), 0.f, 1e-5f);
+  EXPECT_NEAR(sphereUv(1, Vec3f(10.f, 0.f, 0.f), Vec3f(1.f, 0.f, 0.f)).x, 0.25f, 1e-5f);
+}
+
+TEST(SceneLoader, TextureErrorsNameTheLineAndTheProblem) {
+  Fixture f;
+  Image nan(1, 1);
+  nan.rgb[1] = NAN;
+  saveImage(nan, f.dir.file("nan.pfm"));
+  struct Case {
+    std::string body, expect;
+  } cases[] = {
+      {R"(<texture type="wood" id="t"/>)", "s.xml:2: unknown texture type 'wood' (bitmap, checkerboard)"},
+      {R"(<texture type="bitmap" id="t"/>)", "bitmap needs a 'filename'"},
+      {R"(<texture type="bitmap" id="t"><string name="filename" value="none.png"/></texture>)", "cannot open image"},
+      {R"(<texture type="bitmap" id="t"><string name="filename" value="nan.pfm"/></texture>)",
+       "has a negative, NaN or infinite texel"},
+      {R"(<texture type="bitmap" id="t"><string name="filename" value="sky.exr"/><string name="wrap_mode" value="tile"/></texture>)",
+       "wrap_mode must be repeat, mirror or clamp, not 'tile'"},
+      {R"(<texture type="checkerboard" id="t"><texture type="checkerboard" name="color0"/></texture>)",
+       "s.xml:2: unexpected <texture> in <texture>"},
+      {R"(<texture type="checkerboard" id="t"/><texture type="checkerboard" id="t"/>)", "duplicate texture id 't'"},
+      {R"(<bsdf type="diffuse"><ref id="nothing" name="reflectance"/></bsdf>)", "unknown texture id 'nothing'"},
+      {R"(<bsdf type="diffuse"><rgb name="reflectance" value="0.5"/>
+          <texture type="checkerboard" name="reflectance"/></bsdf>)",
+       "s.xml:3: property 'reflectance' given twice"},
+      {R"(<bsdf type="diffuse"><texture type="checkerboard"/></bsdf>)", "<texture> needs a 'name' attribute"},
+      {R"(<emitter type="constant"><bsdf type="diffuse"/></emitter>)", "s.xml:2: unexpected <bsdf> in <emitter>"},
+  };
+  for (const Case& c : cases) {
+    std::string err = loadError(f.scene(c.body + std::string(kSensor)));
+    EXPECT_NE(err.find(c.expect), std::string::npos) << "for " << c.body << "\n got: " << err;
+  }
 }
