@@ -120,7 +120,7 @@ def main():
         open(path, 'w').write(FURNACE.format(res=args.res, spp=args.spp, bsdf=b))
         # The centre of the sphere: regions over the middle third of the image.
         configs.append(('furnace: ' + name, path, {}, 1, True))
-    for s in ('buddha', 'cornell-box', 'teapot-glass'):
+    for s in ('buddha', 'cornell-box', 'teapot-glass', 'textured'):
         configs.append((f'scene: {s}', os.path.join(args.scenes, s + '.xml'), {'res': str(args.res), 'spp': str(args.spp)}, 4, False))
     configs = [c for c in configs if args.only in c[0]]
     total_regions = sum(c[3] * c[3] for c in configs)

@@ -80,7 +80,7 @@ void expectAgreement(const Agreement& a, const std::string& what) {
 
 TEST(Bvh, MatchesEmbreeOnBundledScenes) {
   size_t total = 0;
-  for (std::string name : {"buddha", "teapot-glass", "cornell-box"}) {
+  for (std::string name : {"buddha", "teapot-glass", "cornell-box", "textured"}) {
     Scene scene;
     loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/" + name + ".xml", {}, scene);
     Agreement a = compare(scene, 80000, 17);
