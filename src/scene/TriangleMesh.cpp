@@ -42,6 +42,22 @@ TriangleMesh makeRectangle() {
   return m;
 }
 
+// Mitsuba's cube (u, v) on each face, read from its mesh: each coordinate is (1 +- one of the
+// point's coordinates) / 2, the axis and the sign depending on the face.
+static Vec2f cubeFaceUv(Vec3f n, Vec3f p) {
+  struct Rule {
+    int uAxis;
+    float uSign;
+    int vAxis;
+    float vSign;
+  };
+  // Faces -x, +x, -y, +y, -z, +z.
+  static const Rule rules[6] = {{1, 1, 2, 1}, {1, 1, 2, -1}, {2, 1, 0, 1}, {0, -1, 2, -1}, {1, -1, 0, 1}, {1, 1, 0, 1}};
+  int axis = n.x != 0.f ? 0 : (n.y != 0.f ? 1 : 2);
+  const Rule& r = rules[2 * axis + (n[axis] > 0.f ? 1 : 0)];
+  return {0.5f * (1.f + r.uSign * p[r.uAxis]), 0.5f * (1.f + r.vSign * p[r.vAxis])};
+}
+
 TriangleMesh makeCube() {
   TriangleMesh m;
   m.name = "cube";
@@ -57,6 +73,7 @@ TriangleMesh makeCube() {
       m.positions.push_back(n + u + v);
       m.positions.push_back(n - u + v);
       for (int k = 0; k < 4; ++k) m.normals.push_back(n);
+      for (int k = 0; k < 4; ++k) m.uvs.push_back(cubeFaceUv(n, m.positions[base + uint32_t(k)]));
       for (uint32_t k : {0u, 1u, 2u, 0u, 2u, 3u}) m.indices.push_back(base + k);
     }
   return m;
@@ -65,17 +82,22 @@ TriangleMesh makeCube() {
 TriangleMesh makeDisk(int segments) {
   TriangleMesh m;
   m.name = "disk";
-  m.positions.push_back({0, 0, 0});
-  for (int i = 0; i < segments; ++i) {
-    float phi = 2.f * kPi * float(i) / float(segments);
+  // Mitsuba's disk has (u, v) = (radius, azimuth / 2 pi). Each triangle of the fan gets its own
+  // centre vertex at its middle azimuth, and the rim closes on a copy of its first vertex at
+  // v = 1, so that interpolating (u, v) over a triangle stays close to the exact coordinates.
+  for (int i = 0; i <= segments; ++i) {
+    float t = float(i) / float(segments), phi = 2.f * kPi * t;
     m.positions.push_back({std::cos(phi), std::sin(phi), 0.f});
+    m.uvs.push_back({1.f, t});
+  }
+  for (int i = 0; i < segments; ++i) {
+    m.positions.push_back({0, 0, 0});
+    m.uvs.push_back({0.f, (float(i) + 0.5f) / float(segments)});
+    m.indices.push_back(uint32_t(segments + 1 + i));
+    m.indices.push_back(uint32_t(i));
+    m.indices.push_back(uint32_t(i + 1));
   }
   m.normals.assign(m.positions.size(), Vec3f(0, 0, 1));
-  for (int i = 0; i < segments; ++i) {
-    m.indices.push_back(0);
-    m.indices.push_back(uint32_t(1 + i));
-    m.indices.push_back(uint32_t(1 + (i + 1) % segments));
-  }
   return m;
 }
 

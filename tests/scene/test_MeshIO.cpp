@@ -162,3 +162,39 @@ TEST(MeshIO, PrimitivesAreClosedAndOriented) {
   }
   EXPECT_NEAR(area, M_PI, 0.01);
 }
+
+// The primitives' (u, v) as Mitsuba 3.9.1 gives them: its cube mesh's texture coordinates at six
+// corners (one a face, read from mi.traverse of a cube), and its disk's (radius, azimuth / 2 pi)
+// inside a fan triangle, within the tessellation's error.
+TEST(MeshIO, PrimitivesHaveMitsubasSurfaceCoordinates) {
+  TriangleMesh c = makeCube();
+  ASSERT_EQ(c.uvs.size(), c.positions.size());
+  struct Corner {
+    Vec3f p, n;
+    Vec2f uv;
+  } corners[] = {{{1, -1, -1}, {0, -1, 0}, {0, 1}}, {{-1, 1, -1}, {0, 1, 0}, {1, 1}}, {{1, 1, 1}, {1, 0, 0}, {1, 0}},
+                 {{-1, 1, 1}, {0, 0, 1}, {1, 0}},   {{-1, -1, 1}, {-1, 0, 0}, {0, 1}}, {{1, -1, -1}, {0, 0, -1}, {1, 1}}};
+  for (const Corner& k : corners) {
+    int found = 0;
+    for (size_t i = 0; i < c.positions.size(); ++i)
+      if (length(c.positions[i] - k.p) < 1e-6f && length(c.normals[i] - k.n) < 1e-6f) {
+        EXPECT_EQ(c.uvs[i].x, k.uv.x) << k.p.x << k.p.y << k.p.z;
+        EXPECT_EQ(c.uvs[i].y, k.uv.y) << k.p.x << k.p.y << k.p.z;
+        ++found;
+      }
+    EXPECT_EQ(found, 1);
+  }
+  TriangleMesh disk = makeDisk(128);
+  ASSERT_EQ(disk.uvs.size(), disk.positions.size());
+  for (size_t t = 0; t < disk.triangleCount(); t += 7) {
+    uint32_t i0 = disk.indices[3 * t], i1 = disk.indices[3 * t + 1], i2 = disk.indices[3 * t + 2];
+    for (Vec3f b : {Vec3f(0.2f, 0.4f, 0.4f), Vec3f(0.7f, 0.1f, 0.2f), Vec3f(0.05f, 0.9f, 0.05f)}) {
+      Vec3f p = disk.positions[i0] * b.x + disk.positions[i1] * b.y + disk.positions[i2] * b.z;
+      Vec2f uv = disk.uvs[i0] * b.x + disk.uvs[i1] * b.y + disk.uvs[i2] * b.z;
+      float phi = std::atan2(p.y, p.x);
+      if (phi < 0.f) phi += 2.f * float(M_PI);
+      EXPECT_NEAR(uv.x, length(p), 1e-3f) << t;
+      EXPECT_NEAR(uv.y, phi / (2.f * float(M_PI)), 1e-3f) << t;
+    }
+  }
+}
