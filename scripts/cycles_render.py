@@ -6,7 +6,8 @@ Runs inside Blender (Debian 12's blender 3.4.1, the Cycles the issue was measure
       --out X.exr --spp N --seed S --threads T [-D name=value ...]
 It reads the part of Mitsuba's format that envgi's map-lit example scenes use (perspective
 sensor, envmap, ply/obj/sphere/rectangle shapes, area lights on shapes, diffuse, roughplastic,
-dielectric and (rough)conductor BSDFs) and stops with an error on anything else. The materials are Cycles'
+dielectric and (rough)conductor BSDFs, bitmap and checkerboard textures on their colours) and
+stops with an error on anything else. The materials are Cycles'
 nearest nodes, not the same BSDFs, so each renderer is measured against its own reference.
 Prints 'cycles render: T s' (the render call: scene sync, BVH and samples).
 """
@@ -103,23 +104,108 @@ class Scene:
         return p if os.path.isabs(p) else os.path.join(self.dir, p)
 
 
-def material(sc, b, name):
+def node_math(nt, op, a, b=0.0):
+    """One Math node, op(a, b), whose inputs are sockets or numbers; returns its output."""
+    n = nt.nodes.new('ShaderNodeMath')
+    n.operation = op
+    for i, x in enumerate((a, b)):
+        if isinstance(x, (int, float)):
+            n.inputs[i].default_value = float(x)
+        else:
+            nt.links.new(x, n.inputs[i])
+    return n.outputs[0]
+
+
+def mitsuba_uv(nt, kind):
+    """Mitsuba's (u, v) on a shape as node outputs: a sphere's lat-long in its own frame, a
+    rectangle's ((x + 1) / 2, (y + 1) / 2), a mesh's file uvs with v flipped (Blender's UV
+    output keeps the file's v)."""
+    coord = nt.nodes.new('ShaderNodeTexCoord')
+    sep = nt.nodes.new('ShaderNodeSeparateXYZ')
+    nt.links.new(coord.outputs['UV' if kind == 'mesh' else 'Object'], sep.inputs[0])
+    x, y, z = sep.outputs['X'], sep.outputs['Y'], sep.outputs['Z']
+    if kind == 'mesh':
+        return x, node_math(nt, 'SUBTRACT', 1.0, y)
+    if kind == 'rectangle':
+        return (node_math(nt, 'ADD', node_math(nt, 'MULTIPLY', x, 0.5), 0.5),
+                node_math(nt, 'ADD', node_math(nt, 'MULTIPLY', y, 0.5), 0.5))
+    u = node_math(nt, 'FRACT', node_math(nt, 'MULTIPLY', node_math(nt, 'ARCTAN2', y, x), 0.5 / math.pi))
+    return u, node_math(nt, 'DIVIDE', node_math(nt, 'ARCCOSINE', z), math.pi)
+
+
+def to_uv(sc, tex, nt, u, v):
+    """The texture's to_uv, its 2D part: (m00 u + m01 v + m03, m10 u + m11 v + m13)."""
+    m = sc.transform(tex)
+    out = []
+    for r in (0, 1):
+        a = node_math(nt, 'MULTIPLY', u, m[r][0])
+        b = node_math(nt, 'MULTIPLY', v, m[r][1])
+        out.append(node_math(nt, 'ADD', node_math(nt, 'ADD', a, b), m[r][3]))
+    return out
+
+
+def colour(sc, nt, b, name, default, kind):
+    """A BSDF colour property as a node output: a constant, or Mitsuba's bitmap or checkerboard
+    texture (nested or a <ref>) looked up at Mitsuba's (u, v)."""
+    tex = next((c for c in b if c.get('name') == name and c.tag in ('texture', 'ref')), None)
+    rgb = nt.nodes.new('ShaderNodeRGB')
+    if tex is None:
+        rgb.outputs[0].default_value = (*sc.prop(b, name, default), 1)
+        return rgb.outputs[0]
+    if tex.tag == 'ref':
+        tex = sc.ids[tex.get('id')]
+    u, v = to_uv(sc, tex, nt, *mitsuba_uv(nt, kind))
+    if tex.get('type') == 'checkerboard':
+        # color0 where floor(2u) + floor(2v) is even.
+        s = node_math(nt, 'ADD', node_math(nt, 'FLOOR', node_math(nt, 'MULTIPLY', u, 2.0)),
+                      node_math(nt, 'FLOOR', node_math(nt, 'MULTIPLY', v, 2.0)))
+        odd = node_math(nt, 'MULTIPLY', node_math(nt, 'FRACT', node_math(nt, 'MULTIPLY', s, 0.5)), 2.0)
+        mix = nt.nodes.new('ShaderNodeMixRGB')
+        nt.links.new(odd, mix.inputs['Fac'])
+        mix.inputs['Color1'].default_value = (*sc.prop(tex, 'color0', (0.4,) * 3), 1)
+        mix.inputs['Color2'].default_value = (*sc.prop(tex, 'color1', (0.2,) * 3), 1)
+        return mix.outputs[0]
+    if tex.get('type') != 'bitmap':
+        fail(f"texture '{tex.get('type')}' is not supported")
+    img = nt.nodes.new('ShaderNodeTexImage')
+    img.image = bpy.data.images.load(sc.path(sc.prop(tex, 'filename')))
+    if sc.prop(tex, 'raw', 'false') == 'true':
+        img.image.colorspace_settings.name = 'Non-Color'
+    img.interpolation = 'Closest' if sc.prop(tex, 'filter_type', 'bilinear') == 'nearest' else 'Linear'
+    wrap = sc.prop(tex, 'wrap_mode', 'repeat')
+    if wrap == 'mirror':
+        fail("bitmap wrap_mode 'mirror' is not supported")
+    img.extension = 'EXTEND' if wrap == 'clamp' else 'REPEAT'
+    # Mitsuba's bitmap row 0 is v = 0; Blender's image v = 0 is its bottom row.
+    vec = nt.nodes.new('ShaderNodeCombineXYZ')
+    nt.links.new(u, vec.inputs['X'])
+    nt.links.new(node_math(nt, 'SUBTRACT', 1.0, v), vec.inputs['Y'])
+    nt.links.new(vec.outputs[0], img.inputs['Vector'])
+    return img.outputs['Color']
+
+
+def material(sc, b, name, kind):
     if b.tag == 'ref':
         b = sc.ids[b.get('id')]
     t = b.get('type')
     if t == 'twosided':  # Cycles' surfaces are two-sided already
-        return material(sc, next(c for c in b if c.tag in ('bsdf', 'ref')), name)
+        return material(sc, next(c for c in b if c.tag in ('bsdf', 'ref')), name, kind)
     m = bpy.data.materials.new(name)
     m.use_nodes = True
     nt = m.node_tree
     nt.nodes.clear()
     out = nt.nodes.new('ShaderNodeOutputMaterial')
+    textured = {c.get('name') for c in b if c.tag in ('texture', 'ref')}
+    allowed = {'diffuse': {'reflectance'}, 'plastic': {'diffuse_reflectance'}, 'roughplastic': {'diffuse_reflectance'},
+               'conductor': {'specular_reflectance'}, 'roughconductor': {'specular_reflectance'}}.get(t, set())
+    if textured - allowed:
+        fail(f"bsdf '{t}' with a texture for {sorted(textured - allowed)} is not supported")
     if t == 'diffuse':
         n = nt.nodes.new('ShaderNodeBsdfDiffuse')
-        n.inputs['Color'].default_value = (*sc.prop(b, 'reflectance', (0.5,) * 3), 1)
+        nt.links.new(colour(sc, nt, b, 'reflectance', (0.5,) * 3, kind), n.inputs['Color'])
     elif t in ('roughplastic', 'plastic'):
         n = nt.nodes.new('ShaderNodeBsdfPrincipled')
-        n.inputs['Base Color'].default_value = (*sc.prop(b, 'diffuse_reflectance', (0.5,) * 3), 1)
+        nt.links.new(colour(sc, nt, b, 'diffuse_reflectance', (0.5,) * 3, kind), n.inputs['Base Color'])
         n.inputs['Roughness'].default_value = math.sqrt(sc.prop(b, 'alpha', 0.1)) if t == 'roughplastic' else 0.0
         n.inputs['Specular'].default_value = 0.5  # F0 = 0.04, Mitsuba's default ior 1.49
     elif t == 'dielectric':
@@ -133,7 +219,12 @@ def material(sc, b, name):
         mat = sc.prop(b, 'material', 'none')
         if mat not in CONDUCTOR_F0:
             fail(f"conductor material '{mat}' has no colour here")
-        n.inputs['Color'].default_value = (*CONDUCTOR_F0[mat], 1)
+        tint = nt.nodes.new('ShaderNodeMixRGB')
+        tint.blend_type = 'MULTIPLY'
+        tint.inputs['Fac'].default_value = 1.0
+        tint.inputs['Color1'].default_value = (*CONDUCTOR_F0[mat], 1)
+        nt.links.new(colour(sc, nt, b, 'specular_reflectance', (1.0,) * 3, kind), tint.inputs['Color2'])
+        nt.links.new(tint.outputs[0], n.inputs['Color'])
     else:
         fail(f"bsdf '{t}' is not supported")
     nt.links.new(n.outputs[0], out.inputs['Surface'])
@@ -154,7 +245,9 @@ def add_shape(sc, e, i):
         bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=1.0)
         obj = bpy.context.active_object
         bpy.ops.object.shade_smooth()
-        c = Vector(floats(sc.val(next(c for c in e if c.get('name') == 'center')), 3))
+        ce = next((c for c in e if c.get('name') == 'center'), None)
+        c = Vector((0.0, 0.0, 0.0) if ce is None else floats(sc.val(ce), 3) if ce.get('value') is not None else
+                   tuple(float(ce.get(k, 0)) for k in 'xyz'))
         r = sc.prop(e, 'radius', 1.0)
         to_world = to_world @ Matrix.Translation(c) @ Matrix.Diagonal((r, r, r, 1.0))
     elif t == 'rectangle':
@@ -166,7 +259,7 @@ def add_shape(sc, e, i):
     b = next((c for c in e if c.tag in ('bsdf', 'ref')), None)
     if b is None:
         b = ET.fromstring('<bsdf type="diffuse"/>')  # Mitsuba's default for a shape without one
-    m = material(sc, b, f'm{i}')
+    m = material(sc, b, f'm{i}', t if t in ('sphere', 'rectangle') else 'mesh')
     emitter = next((c for c in e if c.tag == 'emitter'), None)
     if emitter is not None:
         if emitter.get('type') != 'area':

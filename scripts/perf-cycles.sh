@@ -12,4 +12,4 @@ if ! command -v blender >/dev/null; then
 fi
 source scripts/mitsuba-venv.sh
 .venv-mitsuba/bin/python scripts/perf_compare.py --renderer cycles --envgi build/bin/envgi --scenes scenes \
-  --scene-names buddha,teapot-glass,bunny-sunrise,cornell-box "$@"
+  --scene-names buddha,teapot-glass,bunny-sunrise,cornell-box,textured "$@"
