@@ -34,8 +34,9 @@ struct Bsdf {
   float fdrInt = 0.f;                    // plastic: diffuse Fresnel reflectance seen from inside
   float fdrExt = 0.f;                    // plastic: the same seen from outside
   float specularSamplingWeight = 0.5f;   // plastic: share of samples given to the coating
-  // Textures replacing the colours above at a hit (SceneView::bsdfAt); -1: none.
+  // Textures replacing the values above at a hit (SceneView::bsdfAt); -1: none.
   int reflectanceTexture = -1, specularReflectanceTexture = -1, specularTransmittanceTexture = -1;
+  int alphaTexture = -1;  // read as its luminance, as Mitsuba reads a colour texture as a float
 };
 
 struct BsdfSample {

@@ -648,14 +648,16 @@ class Loader {
     return int(scene_.bsdfs.size() - 1);
   }
 
-  // Where a texture for property `name` goes in b (the colours Mitsuba lets a texture give);
-  // null for a property envgi reads as a constant only.
+  // Where a texture for property `name` goes in b (the colours, and the roughness of the rough
+  // BSDFs); null for a property envgi reads as a constant only.
   static int* textureSlot(Bsdf& b, const std::string& name) {
     bool plastic = b.type == BsdfType::Plastic || b.type == BsdfType::RoughPlastic;
     if ((b.type == BsdfType::Diffuse && name == "reflectance") || (plastic && name == "diffuse_reflectance"))
       return &b.reflectanceTexture;
     if (b.type != BsdfType::Diffuse && name == "specular_reflectance") return &b.specularReflectanceTexture;
     if (bsdfTransmits(b) && name == "specular_transmittance") return &b.specularTransmittanceTexture;
+    bool rough = b.type == BsdfType::RoughConductor || b.type == BsdfType::RoughDielectric || b.type == BsdfType::RoughPlastic;
+    if (rough && name == "alpha") return &b.alphaTexture;
     return nullptr;
   }
 

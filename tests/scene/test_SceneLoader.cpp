@@ -206,7 +206,8 @@ TEST(SceneLoader, TexturesNestedReferencedAndOnEveryColourTheyReplace) {
     <shape type="sphere"><bsdf type="roughplastic"><ref id="checks" name="diffuse_reflectance"/>
       <ref id="checks" name="specular_reflectance"/></bsdf></shape>
     <shape type="sphere"><bsdf type="dielectric"><ref id="checks" name="specular_transmittance"/></bsdf></shape>
-    <shape type="sphere"><bsdf type="roughconductor"><ref id="checks" name="alpha"/></bsdf></shape>)"),
+    <shape type="sphere"><bsdf type="roughconductor"><ref id="checks" name="alpha"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="conductor"><ref id="checks" name="eta"/></bsdf></shape>)"),
             {}, s);
   ASSERT_EQ(s.textures.size(), 2u);
   const TextureView& checks = s.textures[0].params;
@@ -226,10 +227,12 @@ TEST(SceneLoader, TexturesNestedReferencedAndOnEveryColourTheyReplace) {
   EXPECT_EQ(bsdf(1).specularReflectanceTexture, 0);
   EXPECT_EQ(bsdf(2).specularTransmittanceTexture, 0);
   EXPECT_EQ(bsdf(2).reflectanceTexture, -1);
+  EXPECT_EQ(bsdf(3).alphaTexture, 0);
   // A texture for a property read as a constant warns and leaves it alone.
-  EXPECT_EQ(bsdf(3).reflectanceTexture, -1);
-  EXPECT_EQ(bsdf(3).specularReflectanceTexture, -1);
-  EXPECT_NEAR(bsdf(3).alpha, 0.1f, 1e-6f);
+  EXPECT_EQ(bsdf(4).reflectanceTexture, -1);
+  EXPECT_EQ(bsdf(4).specularReflectanceTexture, -1);
+  EXPECT_EQ(bsdf(4).alphaTexture, -1);
+  EXPECT_TRUE(bsdf(4).perfectMirror) << "eta keeps its default (material none)";
   // The view resolves them at a hit's uv: texel 1 of the bitmap is u in [0.5, 1).
   const SceneView& v = s.view();
   EXPECT_NEAR(v.bsdfAt(s.shapes[0].bsdf, Vec2f(0.75f, 0.5f)).reflectance.y, 0.5f, 1e-6f);
@@ -237,6 +240,9 @@ TEST(SceneLoader, TexturesNestedReferencedAndOnEveryColourTheyReplace) {
   // Checks at uv (0.1, 0.1): to_uv gives (0.9, 0.2), squares (1, 0): odd, color1.
   EXPECT_NEAR(v.bsdfAt(s.shapes[1].bsdf, Vec2f(0.1f, 0.1f)).reflectance.x, 0.2f, 1e-6f);
   EXPECT_NEAR(v.bsdfAt(s.shapes[1].bsdf, Vec2f(0.15f, 0.1f)).specularReflectance.x, 1.f, 1e-6f);  // (1.1, 0.2)
+  // A colour texture as roughness reads its luminance: color0 (1, 0, 0) is 0.2126.
+  EXPECT_NEAR(v.bsdfAt(s.shapes[3].bsdf, Vec2f(0.15f, 0.1f)).alpha, 0.2126f, 1e-4f);
+  EXPECT_NEAR(v.bsdfAt(s.shapes[3].bsdf, Vec2f(0.1f, 0.1f)).alpha, 0.2f, 1e-4f);
 }
 
 // uv as Mitsuba makes them: v flipped in OBJ and PLY files (unless flip_tex_coords is false),
