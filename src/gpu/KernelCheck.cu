@@ -1,4 +1,4 @@
-// Runs the host/device sampling code in a CUDA kernel and compares it with the CPU.
+// Runs the host/device sampling and texture code in CUDA kernels and compares it with the CPU.
 // Without a GPU it only proves that the code compiles for the device (exit 77 = skipped).
 #include <cuda_runtime.h>
 
@@ -21,6 +21,11 @@ struct CheckResult {
   float pdfEval;
   float mis;
 };
+
+// Coordinates over [-1.5, 2.5)^2: every wrap mode's folds, on host and device alike.
+ENVGI_INLINE Vec2f textureCheckUv(int i) {
+  return {-1.5f + 4.f * float(i % 97) / 97.f, -1.5f + 4.f * float((i / 97) % 89) / 89.f};
+}
 
 __global__ void envmapKernel(EnvironmentMapView env, int n, CheckResult* out) {
   int i = blockIdx.x * blockDim.x + threadIdx.x;
@@ -55,6 +60,13 @@ __global__ void bsdfCameraKernel(Camera cam, int n, float* out) {
   Ray r = cam.generateRay(float(i % cam.width) + 0.5f, float((i / cam.width) % cam.height) + 0.5f);
   Vec2f off = sampleFilter(FilterType(i % 3), Vec2f(rng.nextFloat(), rng.nextFloat()));
   out[i] = acc + r.d.z + off.x;
+}
+
+// Textures looked up on the device, for comparison with the same lookups on the host.
+__global__ void textureKernel(const TextureView* tex, int count, int n, Color* out) {
+  int i = blockIdx.x * blockDim.x + threadIdx.x;
+  if (i >= n) return;
+  out[i] = textureEval(tex[i % count], textureCheckUv(i));
 }
 
 // A brute-force sphere tracer: enough to instantiate the integrators in device code.
@@ -144,7 +156,42 @@ int main() try {
   cudaMemcpy(bres.data(), dB, sizeof(float) * n, cudaMemcpyDeviceToHost);
   int bad = 0;
   for (float v : bres) bad += !std::isfinite(v);
-  // The integrators on a two-sphere scene lit by the same map.
+  // Textures: a 5x3 bitmap with each wrap mode and filter, and a checkerboard.
+  std::vector<Color> texels;
+  for (int k = 0; k < 15; ++k) texels.push_back(Color(float(k % 5), float(k / 5), 0.1f * float(k)));
+  const Color* dTexels = arena.upload(texels.data(), texels.size(), "texels");
+  std::vector<TextureView> views;
+  for (TextureWrap w : {TextureWrap::Repeat, TextureWrap::Mirror, TextureWrap::Clamp})
+    for (bool bilinear : {true, false}) {
+      TextureView t;
+      t.texels = texels.data();
+      t.width = 5;
+      t.height = 3;
+      t.wrap = w;
+      t.bilinear = bilinear;
+      t.toUv[1] = 0.3f;  // a shear, so that to_uv counts too
+      views.push_back(t);
+    }
+  TextureView checks;
+  checks.type = TextureType::Checkerboard;
+  checks.toUv[0] = 3.f;
+  views.push_back(checks);
+  std::vector<TextureView> deviceViews = views;
+  for (TextureView& t : deviceViews)
+    if (t.texels) t.texels = dTexels;
+  const TextureView* dViews = arena.upload(deviceViews.data(), deviceViews.size(), "textures");
+  Color* dT = arena.allocate<Color>(size_t(n), "texture results");
+  textureKernel<<<(n + 255) / 256, 256>>>(dViews, int(views.size()), n, dT);
+  std::vector<Color> tres(n);
+  cudaMemcpy(tres.data(), dT, sizeof(Color) * n, cudaMemcpyDeviceToHost);
+  int textureMismatches = 0;
+  for (int i = 0; i < n; ++i) {
+    Color want = textureEval(views[size_t(i) % views.size()], textureCheckUv(i));
+    textureMismatches += length(want - tres[size_t(i)]) > 1e-5f * (1.f + length(want));
+  }
+  std::printf("envgi_cuda_check: %d texture lookups, %d differ from the CPU's\n", n, textureMismatches);
+  bad += textureMismatches;
+  // The integrators on a two-sphere scene lit by the same map, the ground textured.
   SceneView sv;
   SphereView spheres[2] = {{Vec3f(0.f, 0.f, -3.f), 1.f, 0, -1, false}, {Vec3f(0.f, -101.f, -3.f), 100.f, 1, -1, false}};
   Bsdf bsdfs[2];
@@ -153,7 +200,10 @@ int main() try {
   bsdfs[0].alpha = 0.2f;
   sv.spheres = arena.upload(spheres, 2, "spheres");
   sv.sphereCount = 2;
+  bsdfs[1].reflectanceTexture = int(views.size()) - 1;
+  bsdfs[0].alphaTexture = 0;
   sv.bsdfs = arena.upload(bsdfs, 2, "materials");
+  sv.textures = dViews;
   sv.hasEnvironment = true;
   sv.env = gpu::uploadEnvironment(arena, env.view());
   sv.camera = cam;
