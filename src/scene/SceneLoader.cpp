@@ -639,6 +639,16 @@ class Loader {
       }
       *slot = tex.first;
     }
+    if ((b.type == BsdfType::Plastic || b.type == BsdfType::RoughPlastic) &&
+        (b.reflectanceTexture >= 0 || b.specularReflectanceTexture >= 0)) {
+      // The coat's share of samples from the textures' mean colours, as Mitsuba's plastic does.
+      Bsdf means = b;
+      if (b.reflectanceTexture >= 0) means.reflectance = textureMean(scene_.textures[size_t(b.reflectanceTexture)]);
+      if (b.specularReflectanceTexture >= 0)
+        means.specularReflectance = textureMean(scene_.textures[size_t(b.specularReflectanceTexture)]);
+      finishPlastic(means);
+      b.specularSamplingWeight = means.specularSamplingWeight;
+    }
     for (pugi::xml_node c : n.children())
       if (c.type() == pugi::node_element && !isPropTag(c.name()) && std::string(c.name()) != "texture" &&
           std::string(c.name()) != "ref")
@@ -659,6 +669,15 @@ class Loader {
     bool rough = b.type == BsdfType::RoughConductor || b.type == BsdfType::RoughDielectric || b.type == BsdfType::RoughPlastic;
     if (rough && name == "alpha") return &b.alphaTexture;
     return nullptr;
+  }
+
+  static Color textureMean(const Texture& t) {
+    if (t.params.type == TextureType::Checkerboard) return (t.params.color0 + t.params.color1) * 0.5f;
+    double sum[3] = {0, 0, 0};
+    for (const Color& c : t.texels)
+      for (int k = 0; k < 3; ++k) sum[k] += c[k];
+    double n = double(std::max<size_t>(t.texels.size(), 1));
+    return Color(float(sum[0] / n), float(sum[1] / n), float(sum[2] / n));
   }
 
   // Mitsuba's bitmap and checkerboard textures; returns the index into scene_.textures.

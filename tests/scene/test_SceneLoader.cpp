@@ -225,6 +225,9 @@ TEST(SceneLoader, TexturesNestedReferencedAndOnEveryColourTheyReplace) {
   EXPECT_EQ(bsdf(0).reflectanceTexture, 1);
   EXPECT_EQ(bsdf(1).reflectanceTexture, 0);
   EXPECT_EQ(bsdf(1).specularReflectanceTexture, 0);
+  // The coat's sampling weight from the textures' means, as in Mitsuba: both are the checks'
+  // mean, so half (the untextured defaults would give 1 / (1 + 0.5)).
+  EXPECT_NEAR(bsdf(1).specularSamplingWeight, 0.5f, 1e-5f);
   EXPECT_EQ(bsdf(2).specularTransmittanceTexture, 0);
   EXPECT_EQ(bsdf(2).reflectanceTexture, -1);
   EXPECT_EQ(bsdf(3).alphaTexture, 0);
