@@ -56,6 +56,11 @@ ENVGI_INLINE float bsdfEtaSquared(const Bsdf& b, Vec3f wo, Vec3f wi) {
   return etap * etap;
 }
 
+ENVGI_INLINE bool bsdfHasTexture(const Bsdf& b) {
+  return b.reflectanceTexture >= 0 || b.specularReflectanceTexture >= 0 || b.specularTransmittanceTexture >= 0 ||
+         b.alphaTexture >= 0;
+}
+
 // True when every lobe is a delta: next-event estimation is pointless there.
 ENVGI_INLINE bool bsdfIsDelta(const Bsdf& b) {
   return b.type == BsdfType::Conductor || b.type == BsdfType::Dielectric || b.type == BsdfType::ThinDielectric;

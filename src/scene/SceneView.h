@@ -95,10 +95,14 @@ struct SceneView {
       Vec3f p = ray.o + ray.d * h.t;
       Vec3f n = normalize(p - s.center);
       si.p = s.center + n * s.radius;  // re-projected: removes the hit point's float error
-      // Mitsuba's sphere coordinates: u the azimuth about local z from local x, v the polar angle.
-      Vec3f l = s.axes.toLocal(n);
-      float phi = polyAtan2(l.y, l.x);
-      si.uv = Vec2f((phi < 0.f ? phi + 2.f * kPi : phi) * (0.5f * kInvPi), acosf(fminf(fmaxf(l.z, -1.f), 1.f)) * kInvPi);
+      // Mitsuba's sphere coordinates: u the azimuth about local z from local x, v the polar angle
+      // (two inverse trigonometric functions, so only where a texture reads them).
+      si.uv = Vec2f(0.f, 0.f);
+      if (bsdfHasTexture(bsdfs[s.bsdf])) {
+        Vec3f l = s.axes.toLocal(n);
+        float phi = polyAtan2(l.y, l.x);
+        si.uv = Vec2f((phi < 0.f ? phi + 2.f * kPi : phi) * (0.5f * kInvPi), acosf(fminf(fmaxf(l.z, -1.f), 1.f)) * kInvPi);
+      }
       if (s.flipNormals) n = -n;
       si.ng = n;
       si.shading = Frame::fromNormal(n);

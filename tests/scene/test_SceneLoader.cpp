@@ -249,7 +249,8 @@ TEST(SceneLoader, TexturesNestedReferencedAndOnEveryColourTheyReplace) {
 }
 
 // uv as Mitsuba makes them: v flipped in OBJ and PLY files (unless flip_tex_coords is false),
-// and on a sphere u the azimuth about its local z from local x, v the polar angle from +z.
+// and on a sphere u the azimuth about its local z from local x, v the polar angle from +z
+// (computed where a texture reads them: these spheres are textured).
 TEST(SceneLoader, SurfaceCoordinatesFollowMitsuba) {
   Fixture f;
   f.write("uv.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.25 0.125\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n");
@@ -257,8 +258,10 @@ TEST(SceneLoader, SurfaceCoordinatesFollowMitsuba) {
   loadScene(f.scene(std::string(kSensor) + R"(
     <shape type="obj"><string name="filename" value="uv.obj"/></shape>
     <shape type="obj"><string name="filename" value="uv.obj"/><boolean name="flip_tex_coords" value="false"/></shape>
-    <shape type="sphere"/>
-    <shape type="sphere"><transform name="to_world"><rotate z="1" angle="90"/><translate x="10"/></transform></shape>)"),
+    <bsdf type="diffuse" id="checks"><texture type="checkerboard" name="reflectance"/></bsdf>
+    <shape type="sphere"><ref id="checks"/></shape>
+    <shape type="sphere"><transform name="to_world"><rotate z="1" angle="90"/><translate x="10"/></transform>
+      <ref id="checks"/></shape>)"),
             {}, s);
   EXPECT_NEAR(s.meshes[0].uvs[0].y, 0.875f, 1e-6f);
   EXPECT_NEAR(s.meshes[1].uvs[0].y, 0.125f, 1e-6f);
