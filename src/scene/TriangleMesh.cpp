@@ -87,7 +87,9 @@ TriangleMesh makeDisk(int segments) {
   // v = 1, so that interpolating (u, v) over a triangle stays close to the exact coordinates.
   for (int i = 0; i <= segments; ++i) {
     float t = float(i) / float(segments), phi = 2.f * kPi * t;
-    m.positions.push_back({std::cos(phi), std::sin(phi), 0.f});
+    // The closing vertex is the first one's position exactly (cos and sin of a float 2 pi are
+    // not 1 and 0), so that the fan stays watertight at the seam.
+    m.positions.push_back(i < segments ? Vec3f(std::cos(phi), std::sin(phi), 0.f) : m.positions[0]);
     m.uvs.push_back({1.f, t});
   }
   for (int i = 0; i < segments; ++i) {

@@ -186,6 +186,10 @@ TEST(MeshIO, PrimitivesHaveMitsubasSurfaceCoordinates) {
   }
   TriangleMesh disk = makeDisk(128);
   ASSERT_EQ(disk.uvs.size(), disk.positions.size());
+  // The seam's last triangle ends on the first rim vertex's position, to the bit.
+  uint32_t closing = disk.indices[3 * (disk.triangleCount() - 1) + 2];
+  EXPECT_EQ(disk.positions[closing].x, disk.positions[disk.indices[1]].x);
+  EXPECT_EQ(disk.positions[closing].y, disk.positions[disk.indices[1]].y);
   for (size_t t = 0; t < disk.triangleCount(); t += 7) {
     uint32_t i0 = disk.indices[3 * t], i1 = disk.indices[3 * t + 1], i2 = disk.indices[3 * t + 2];
     for (Vec3f b : {Vec3f(0.2f, 0.4f, 0.4f), Vec3f(0.7f, 0.1f, 0.2f), Vec3f(0.05f, 0.9f, 0.05f)}) {
