@@ -21,6 +21,10 @@ enum class BsdfType : int {
   RoughPlastic,    // GGX coating over a diffuse base
 };
 
+// GGX roughness bounds: the scene format accepts alpha in (0, 4], and below kMinAlpha GGX
+// sampling is numerically a mirror, so smaller values (given or textured) are raised to it.
+constexpr float kMinAlpha = 1e-3f, kMaxAlpha = 4.f;
+
 struct Bsdf {
   BsdfType type = BsdfType::Diffuse;
   bool twoSided = false;

@@ -738,8 +738,8 @@ class Loader {
     std::string dist = getString(f, p, "distribution", "beckmann");
     if (dist != "ggx") warnOnce(fmt::format("{}: {} distribution '{}' is rendered as GGX", f->path, type, dist));
     b.alpha = getFloat(f, p, "alpha", 0.1f);
-    if (!(b.alpha > 0.f && b.alpha <= 4.f)) fail(f, n, "alpha must be in (0, 4]");
-    b.alpha = std::max(b.alpha, 1e-3f);  // below this GGX sampling is numerically a mirror
+    if (!(b.alpha > 0.f && b.alpha <= kMaxAlpha)) fail(f, n, "alpha must be in (0, 4]");
+    b.alpha = std::max(b.alpha, kMinAlpha);
     find(p, "sample_visible");
   }
 

@@ -121,8 +121,8 @@ struct SceneView {
       b.specularReflectance = textureEval(textures[b.specularReflectanceTexture], uv);
     if (b.specularTransmittanceTexture >= 0)
       b.specularTransmittance = textureEval(textures[b.specularTransmittanceTexture], uv);
-    // The loader's bounds on a constant alpha: below 1e-3 GGX sampling is numerically a mirror.
-    if (b.alphaTexture >= 0) b.alpha = fminf(fmaxf(luminance(textureEval(textures[b.alphaTexture], uv)), 1e-3f), 4.f);
+    if (b.alphaTexture >= 0)
+      b.alpha = fminf(fmaxf(luminance(textureEval(textures[b.alphaTexture], uv)), kMinAlpha), kMaxAlpha);
     return b;
   }
   ENVGI_HD Bsdf bsdfAt(const SurfaceInteraction& si) const { return bsdfAt(si.bsdf, si.uv); }
