@@ -148,8 +148,8 @@ def colour(sc, nt, b, name, default, kind):
     """A BSDF colour property as a node output: a constant, or Mitsuba's bitmap or checkerboard
     texture (nested or a <ref>) looked up at Mitsuba's (u, v)."""
     tex = next((c for c in b if c.get('name') == name and c.tag in ('texture', 'ref')), None)
-    rgb = nt.nodes.new('ShaderNodeRGB')
     if tex is None:
+        rgb = nt.nodes.new('ShaderNodeRGB')
         rgb.outputs[0].default_value = (*sc.prop(b, name, default), 1)
         return rgb.outputs[0]
     if tex.tag == 'ref':
