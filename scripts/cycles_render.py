@@ -200,6 +200,10 @@ def material(sc, b, name, kind):
                'conductor': {'specular_reflectance'}, 'roughconductor': {'specular_reflectance'}}.get(t, set())
     if textured - allowed:
         fail(f"bsdf '{t}' with a texture for {sorted(textured - allowed)} is not supported")
+    # Mitsuba's rough BSDFs default to Beckmann; Cycles' Principled BSDF (rough plastic here) has GGX only.
+    dist = sc.prop(b, 'distribution', 'beckmann')
+    if t == 'roughplastic' and dist != 'ggx':
+        fail("roughplastic needs distribution 'ggx' here: Cycles' Principled BSDF has no Beckmann")
     if t == 'diffuse':
         n = nt.nodes.new('ShaderNodeBsdfDiffuse')
         nt.links.new(colour(sc, nt, b, 'reflectance', (0.5,) * 3, kind), n.inputs['Color'])
@@ -214,7 +218,7 @@ def material(sc, b, name, kind):
         n.inputs['IOR'].default_value = sc.prop(b, 'int_ior', 1.5046) / sc.prop(b, 'ext_ior', 1.000277)
     elif t in ('conductor', 'roughconductor'):
         n = nt.nodes.new('ShaderNodeBsdfGlossy')
-        n.distribution = 'GGX' if t == 'roughconductor' else 'SHARP'
+        n.distribution = {'ggx': 'GGX', 'beckmann': 'BECKMANN'}[dist] if t == 'roughconductor' else 'SHARP'
         n.inputs['Roughness'].default_value = math.sqrt(sc.prop(b, 'alpha', 0.1)) if t == 'roughconductor' else 0.0
         mat = sc.prop(b, 'material', 'none')
         if mat not in CONDUCTOR_F0:

@@ -13,15 +13,15 @@ namespace envgi {
 enum class BsdfType : int {
   Diffuse = 0,
   Conductor,       // smooth; perfectMirror or complex Fresnel
-  RoughConductor,  // GGX
+  RoughConductor,  // microfacet (GGX or Beckmann)
   Dielectric,      // smooth glass
   ThinDielectric,  // thin sheet: reflection or straight transmission
-  RoughDielectric, // GGX glass (Walter et al. 2007)
+  RoughDielectric, // microfacet glass (Walter et al. 2007)
   Plastic,         // smooth dielectric coating over a diffuse base
-  RoughPlastic,    // GGX coating over a diffuse base
+  RoughPlastic,    // microfacet coating over a diffuse base
 };
 
-// GGX roughness bounds: the scene format accepts alpha in (0, 4], and below kMinAlpha GGX
+// Roughness bounds: the scene format accepts alpha in (0, 4], and below kMinAlpha microfacet
 // sampling is numerically a mirror, so smaller values (given or textured) are raised to it.
 constexpr float kMinAlpha = 1e-3f, kMaxAlpha = 4.f;
 
@@ -29,11 +29,12 @@ struct Bsdf {
   BsdfType type = BsdfType::Diffuse;
   bool twoSided = false;
   bool perfectMirror = false;            // conductor material "none"
+  MicrofacetType distribution = MicrofacetType::GGX;  // of the rough BSDFs
   Color reflectance{0.5f};               // diffuse (and plastic base) albedo
   Color specularReflectance{1.f};
   Color specularTransmittance{1.f};
   Color eta{0.f}, k{1.f};                // conductor complex index, per channel
-  float alpha = 0.1f;                    // GGX roughness
+  float alpha = 0.1f;                    // microfacet roughness
   float ior = 1.5046f;                   // interior / exterior index of refraction
   float fdrInt = 0.f;                    // plastic: diffuse Fresnel reflectance seen from inside
   float fdrExt = 0.f;                    // plastic: the same seen from outside
@@ -59,6 +60,8 @@ ENVGI_INLINE float bsdfEtaSquared(const Bsdf& b, Vec3f wo, Vec3f wi) {
   float etap = wo.z > 0.f ? b.ior : 1.f / b.ior;
   return etap * etap;
 }
+
+ENVGI_INLINE MicrofacetDistribution microfacet(const Bsdf& b) { return {b.alpha, b.distribution}; }
 
 ENVGI_INLINE bool bsdfHasTexture(const Bsdf& b) {
   return b.reflectanceTexture >= 0 || b.specularReflectanceTexture >= 0 || b.specularTransmittanceTexture >= 0 ||
@@ -124,7 +127,7 @@ struct RoughPlasticShared {
 ENVGI_INLINE RoughPlasticShared roughPlasticShared(const Bsdf& b, Vec3f wo, Vec3f wi) {
   RoughPlasticShared r;
   r.m = normalize(wo + wi);
-  GGX d{b.alpha};
+  MicrofacetDistribution d = microfacet(b);
   r.D = d.D(r.m);
   r.lambdaO = d.lambda(wo);
   r.fo = fresnelDielectric(wo.z, b.ior);
@@ -132,13 +135,13 @@ ENVGI_INLINE RoughPlasticShared roughPlasticShared(const Bsdf& b, Vec3f wo, Vec3
 }
 ENVGI_INLINE Color roughPlasticEval(const Bsdf& b, const RoughPlasticShared& r, Vec3f wo, Vec3f wi) {
   float F = fresnelDielectric(dot(wi, r.m), b.ior);
-  float G = 1.f / (1.f + r.lambdaO + GGX{b.alpha}.lambda(wi));  // height-correlated, GGX::G
+  float G = 1.f / (1.f + r.lambdaO + microfacet(b).lambda(wi));  // height-correlated, as G()
   Color spec = b.specularReflectance * (F * r.D * G / (4.f * wo.z));
   return spec + plasticDiffuse(b, r.fo, wi);
 }
 ENVGI_INLINE float roughPlasticPdf(const Bsdf& b, const RoughPlasticShared& r, Vec3f wo, Vec3f wi) {
   float ps = plasticSpecularProb(b, r.fo);
-  // GGX::visiblePdf(wo, m), with G1(wo) = 1 / (1 + lambda(wo)), over the half vector's Jacobian
+  // visiblePdf(wo, m), with G1(wo) = 1 / (1 + lambda(wo)), over the half vector's Jacobian
   // 4 |wo.m|; wo.z > 0 here, so |wo.z| is wo.z.
   float cosOM = std::fabs(dot(wo, r.m));
   float visible = 1.f / (1.f + r.lambdaO) * cosOM * r.D / wo.z;
@@ -156,7 +159,7 @@ ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
     case BsdfType::RoughConductor: {
       if (wo.z <= 0.f || wi.z <= 0.f) return Color(0.f);
       Vec3f m = normalize(wo + wi);
-      GGX d{b.alpha};
+      MicrofacetDistribution d = microfacet(b);
       Color F = b.perfectMirror ? Color(1.f) : fresnelConductor(dot(wi, m), b.eta, b.k);
       return b.specularReflectance * F * (d.D(m) * d.G(wo, wi) / (4.f * wo.z));
     }
@@ -164,7 +167,7 @@ ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
       Vec3f m;
       float etap;
       if (!detail::roughDielectricHalf(b, wo, wi, &m, &etap)) return Color(0.f);
-      GGX d{b.alpha};
+      MicrofacetDistribution d = microfacet(b);
       float F = fresnelDielectric(dot(wo, m), b.ior);
       float co = std::fabs(wo.z);
       if (wo.z * wi.z > 0.f) return b.specularReflectance * (d.D(m) * d.G(wo, wi) * F / (4.f * co));
@@ -195,13 +198,13 @@ ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
     case BsdfType::RoughConductor: {
       if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
       Vec3f m = normalize(wo + wi);
-      return GGX{b.alpha}.visiblePdf(wo, m) / (4.f * std::fabs(dot(wo, m)));
+      return microfacet(b).visiblePdf(wo, m) / (4.f * std::fabs(dot(wo, m)));
     }
     case BsdfType::RoughDielectric: {
       Vec3f m;
       float etap;
       if (!detail::roughDielectricHalf(b, wo, wi, &m, &etap)) return 0.f;
-      GGX d{b.alpha};
+      MicrofacetDistribution d = microfacet(b);
       float R = fresnelDielectric(dot(wo, m), b.ior), T = 1.f - R;
       if (wo.z * wi.z > 0.f) return d.visiblePdf(wo, m) / (4.f * std::fabs(dot(wo, m))) * R;
       float dwmdwi = std::fabs(dot(wi, m)) / sqr(dot(wi, m) + dot(wo, m) / etap);
@@ -277,7 +280,7 @@ ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSam
     }
     case BsdfType::RoughConductor: {
       if (wo.z <= 0.f) return false;
-      Vec3f m = GGX{b.alpha}.sampleVisible(wo, u);
+      Vec3f m = microfacet(b).sampleVisible(wo, u);
       s->wi = reflect(wo, m);
       if (s->wi.z <= 0.f) return false;
       ok = detail::finishSample(b, wo, s);
@@ -321,7 +324,7 @@ ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSam
     }
     case BsdfType::RoughDielectric: {
       if (wo.z == 0.f) return false;
-      GGX d{b.alpha};
+      MicrofacetDistribution d = microfacet(b);
       Vec3f m = d.sampleVisible(wo, u);
       float R = fresnelDielectric(dot(wo, m), b.ior);
       if (uc < R) {
@@ -353,7 +356,7 @@ ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSam
         break;
       }
       if (b.type == BsdfType::RoughPlastic && uc < ps) {
-        s->wi = reflect(wo, GGX{b.alpha}.sampleVisible(wo, u));
+        s->wi = reflect(wo, microfacet(b).sampleVisible(wo, u));
       } else {
         s->wi = sampleCosineHemisphere(u);
       }

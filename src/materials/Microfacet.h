@@ -1,26 +1,43 @@
-// Isotropic GGX (Trowbridge-Reitz) microfacet distribution with visible-normal sampling
-// (Heitz 2018). Directions are in the local shading frame, z = normal.
+// Isotropic microfacet distributions, GGX (Trowbridge-Reitz) and Beckmann, as Mitsuba 3's
+// `distribution` names them, with the Smith masking of each and visible-normal sampling
+// (GGX: Heitz 2018; Beckmann: Heitz and d'Eon 2014, whose slope CDF is inverted numerically).
+// Directions are in the local shading frame, z = normal.
 #pragma once
 
+#include <cstdint>
+
+#include "core/ErfInv.h"
 #include "core/Vec.h"
 
 namespace envgi {
 
-struct GGX {
+enum class MicrofacetType : uint8_t { GGX = 0, Beckmann = 1 };
+
+struct MicrofacetDistribution {
   float alpha;
+  MicrofacetType type = MicrofacetType::GGX;
 
   ENVGI_HD float D(Vec3f m) const {
     float cos2 = m.z * m.z;
     if (cos2 <= 0.f) return 0.f;
     float tan2 = (m.x * m.x + m.y * m.y) / cos2;
     float a2 = alpha * alpha;
+    if (type == MicrofacetType::Beckmann) return std::exp(-tan2 / a2) / (kPi * a2 * cos2 * cos2);
     float e = 1.f + tan2 / a2;
     return 1.f / (kPi * a2 * cos2 * cos2 * e * e);
   }
+  // Smith's lambda; G1 = 1 / (1 + lambda). Beckmann's is the exact form in erfc, which is what
+  // makes its visible normals (sampleVisible) exactly the distribution visiblePdf states.
   ENVGI_HD float lambda(Vec3f w) const {
     float cos2 = w.z * w.z;
     if (cos2 <= 0.f) return 0.f;
-    float tan2 = (w.x * w.x + w.y * w.y) / cos2;
+    float sin2 = w.x * w.x + w.y * w.y;
+    if (type == MicrofacetType::Beckmann) {
+      if (sin2 <= 0.f) return 0.f;
+      float a = std::sqrt(cos2 / sin2) / alpha;  // 1 / (alpha tan theta)
+      return fmaxf(0.f, 0.5f * (std::exp(-a * a) / (a * 1.7724538509f) - std::erfc(a)));
+    }
+    float tan2 = sin2 / cos2;
     return 0.5f * (std::sqrt(1.f + alpha * alpha * tan2) - 1.f);
   }
   ENVGI_HD float G1(Vec3f w) const { return 1.f / (1.f + lambda(w)); }
@@ -36,6 +53,11 @@ struct GGX {
 
   // Samples a visible normal for a view direction w (either hemisphere; flipped to +z).
   ENVGI_HD Vec3f sampleVisible(Vec3f w, Vec2f u) const {
+    return type == MicrofacetType::Beckmann ? sampleVisibleBeckmann(w, u) : sampleVisibleGgx(w, u);
+  }
+
+ private:
+  ENVGI_HD Vec3f sampleVisibleGgx(Vec3f w, Vec2f u) const {
     Vec3f wh = normalize(Vec3f(alpha * w.x, alpha * w.y, w.z));
     if (wh.z < 0.f) wh = -wh;
     Vec3f t1 = wh.z < 0.99999f ? normalize(cross(Vec3f(0.f, 0.f, 1.f), wh)) : Vec3f(1.f, 0.f, 0.f);
@@ -49,6 +71,48 @@ struct GGX {
     float pz = safeSqrt(1.f - px * px - py * py);
     Vec3f nh = t1 * px + t2 * py + wh * pz;
     return normalize(Vec3f(alpha * nh.x, alpha * nh.y, fmaxf(1e-6f, nh.z)));
+  }
+
+  // In the stretched frame (alpha = 1) and with w in the xz-plane at angle theta, the normal of
+  // slope (x, y) is (-x, -y, 1) / |.|, seen with weight (1 - x tan theta) where x < cot theta,
+  // and the slopes are Gaussian: y is a plain normal variate, x has the CDF
+  //   C(x) = (1 + erf x + tan theta e^(-x^2) / sqrt(pi)) / (the same at x = cot theta),
+  // solved for C(x) = u in b = erf x (bounded, monotone) by Newton steps kept in a bracket.
+  ENVGI_HD static float visibleSlopeX(float tanTheta, float u) {
+    if (tanTheta < 1e-5f) return erfInv(2.f * u - 1.f);
+    float cot = 1.f / tanTheta;
+    float k = tanTheta * 0.5641895835f;  // tan theta / sqrt(pi)
+    float c = std::erf(cot);
+    float norm = 1.f / (1.f + c + k * std::exp(-cot * cot));
+    float lo = -1.f, hi = c;
+    float b = -1.f + u * (1.f + c);  // exact at normal incidence
+    for (int i = 0; i < 24; ++i) {
+      if (!(b > lo && b < hi)) b = 0.5f * (lo + hi);
+      float x = erfInv(b);
+      float value = norm * (1.f + b + k * std::exp(-x * x)) - u;
+      if (std::fabs(value) < 1e-6f) break;
+      if (value > 0.f) hi = b;
+      else lo = b;
+      b -= value / (norm * (1.f - x * tanTheta));
+    }
+    return erfInv(b);
+  }
+
+  ENVGI_HD Vec3f sampleVisibleBeckmann(Vec3f w, Vec2f u) const {
+    if (w.z < 0.f) w = -w;
+    Vec3f wh = normalize(Vec3f(alpha * w.x, alpha * w.y, fmaxf(w.z, 1e-7f)));
+    float sinTheta = std::sqrt(wh.x * wh.x + wh.y * wh.y);
+    float cosPhi = 1.f, sinPhi = 0.f;
+    if (sinTheta > 0.f) {
+      cosPhi = wh.x / sinTheta;
+      sinPhi = wh.y / sinTheta;
+    }
+    float ux = clampf(u.x, 1e-6f, 1.f - 1e-6f), uy = clampf(u.y, 1e-6f, 1.f - 1e-6f);
+    float sx = visibleSlopeX(sinTheta / wh.z, ux);
+    float sy = erfInv(2.f * uy - 1.f);
+    // Back to w's azimuth, then unstretched.
+    float x = alpha * (cosPhi * sx - sinPhi * sy), y = alpha * (sinPhi * sx + cosPhi * sy);
+    return normalize(Vec3f(-x, -y, 1.f));
   }
 };
 

@@ -735,8 +735,11 @@ class Loader {
   }
 
   void roughness(const SourceFile* f, pugi::xml_node n, Props& p, Bsdf& b, const std::string& type) {
+    // Mitsuba's default, for all three rough BSDFs, is Beckmann.
     std::string dist = getString(f, p, "distribution", "beckmann");
-    if (dist != "ggx") warnOnce(fmt::format("{}: {} distribution '{}' is rendered as GGX", f->path, type, dist));
+    if (dist == "beckmann") b.distribution = MicrofacetType::Beckmann;
+    else if (dist == "ggx") b.distribution = MicrofacetType::GGX;
+    else fail(f, n, fmt::format("{} distribution must be beckmann or ggx, not '{}'", type, dist));
     b.alpha = getFloat(f, p, "alpha", 0.1f);
     if (!(b.alpha > 0.f && b.alpha <= kMaxAlpha)) fail(f, n, "alpha must be in (0, 4]");
     b.alpha = std::max(b.alpha, kMinAlpha);

@@ -78,7 +78,8 @@ struct Case {
 
 TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
   std::vector<Case> cases;
-  for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured"}) cases.push_back({sc, "path", "mis"});
+  for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured", "microfacets"})
+    cases.push_back({sc, "path", "mis"});
   for (std::string st : {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis", "product"})
     cases.push_back({"buddha", "direct", st});
   const int region = 8, regionsPerCase = (kRes / region) * (kRes / region);

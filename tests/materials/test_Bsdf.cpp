@@ -16,10 +16,11 @@ struct BsdfCase {
   float cosTheta;  // of wo; negative = from inside / below
 };
 
-Bsdf make(BsdfType t, float alpha, const char* metal = "none") {
+Bsdf make(BsdfType t, float alpha, const char* metal = "none", MicrofacetType dist = MicrofacetType::GGX) {
   Bsdf b;
   b.type = t;
   b.alpha = alpha;
+  b.distribution = dist;
   b.reflectance = Color(0.7f, 0.5f, 0.3f);
   if (t == BsdfType::Conductor || t == BsdfType::RoughConductor) conductorPreset(metal, &b.eta, &b.k, &b.perfectMirror);
   if (t == BsdfType::Plastic || t == BsdfType::RoughPlastic) {
@@ -41,6 +42,11 @@ std::vector<BsdfCase> cases() {
       out.push_back({"RoughPlastic" + cs + "a" + as, make(BsdfType::RoughPlastic, a), c});
       out.push_back({"RoughDielectric" + cs + "a" + as, make(BsdfType::RoughDielectric, a), c});
       out.push_back({"RoughDielectricInside" + cs + "a" + as, make(BsdfType::RoughDielectric, a), -c});
+      const MicrofacetType beck = MicrofacetType::Beckmann;
+      out.push_back({"BeckmannConductorAu" + cs + "a" + as, make(BsdfType::RoughConductor, a, "Au", beck), c});
+      out.push_back({"BeckmannPlastic" + cs + "a" + as, make(BsdfType::RoughPlastic, a, "none", beck), c});
+      out.push_back({"BeckmannDielectric" + cs + "a" + as, make(BsdfType::RoughDielectric, a, "none", beck), c});
+      out.push_back({"BeckmannDielectricInside" + cs + "a" + as, make(BsdfType::RoughDielectric, a, "none", beck), -c});
     }
   }
   Bsdf two = make(BsdfType::Diffuse, 0.1f);
@@ -85,9 +91,13 @@ INSTANTIATE_TEST_SUITE_P(All, BsdfChi2, ::testing::ValuesIn(cases()),
 
 TEST(Bsdf, NonNegativeAndReciprocal) {
   Pcg32 rng(5);
-  for (BsdfType t : {BsdfType::Diffuse, BsdfType::RoughConductor, BsdfType::RoughPlastic, BsdfType::Plastic,
-                     BsdfType::RoughDielectric}) {
-    Bsdf b = make(t, 0.3f, "Cu");
+  const MicrofacetType ggx = MicrofacetType::GGX, beck = MicrofacetType::Beckmann;
+  const std::pair<BsdfType, MicrofacetType> kinds[] = {
+      {BsdfType::Diffuse, ggx},         {BsdfType::RoughConductor, ggx}, {BsdfType::RoughPlastic, ggx},
+      {BsdfType::Plastic, ggx},         {BsdfType::RoughDielectric, ggx}, {BsdfType::RoughConductor, beck},
+      {BsdfType::RoughPlastic, beck},   {BsdfType::RoughDielectric, beck}};
+  for (auto [t, dist] : kinds) {
+    Bsdf b = make(t, 0.3f, "Cu", dist);
     for (int i = 0; i < 2000; ++i) {
       Vec3f a = sampleUniformSphere({rng.nextFloat(), rng.nextFloat()});
       Vec3f c = sampleUniformSphere({rng.nextFloat(), rng.nextFloat()});
@@ -172,18 +182,19 @@ TEST(Bsdf, EnergyConservation) {
     }
     Bsdf thin = make(BsdfType::ThinDielectric, 0.1f);
     EXPECT_NEAR(albedo(thin, wo), 1.0, 1e-6);
-    for (float a : {0.05f, 0.3f, 0.8f}) {
-      // Sampled albedo (mean weight) against a quadrature of eval(): single-scattering GGX
-      // loses energy (at alpha = 1 up to half), never gains it.
-      Bsdf rcb = make(BsdfType::RoughConductor, a);
-      double rc = albedo(rcb, wo), quad = hemisphereIntegral(rcb, wo);
-      EXPECT_LE(rc, 1.0 + 0.01) << "alpha " << a;
-      EXPECT_NEAR(rc, quad, 0.01 + 0.01 * quad) << "alpha " << a << " cos " << c;
-      EXPECT_LE(albedo(make(BsdfType::RoughPlastic, a), wo), 1.0 + 0.02);
-      Bsdf rd = make(BsdfType::RoughDielectric, a);
-      rd.ior = 1.f + 1e-4f;  // index-matched: transmission weight is not scaled
-      EXPECT_LE(albedo(rd, wo), 1.0 + 0.01);
-    }
+    for (MicrofacetType dist : {MicrofacetType::GGX, MicrofacetType::Beckmann})
+      for (float a : {0.05f, 0.3f, 0.8f}) {
+        // Sampled albedo (mean weight) against a quadrature of eval(): single-scattering
+        // microfacets lose energy (GGX at alpha = 1 up to half), never gain it.
+        Bsdf rcb = make(BsdfType::RoughConductor, a, "none", dist);
+        double rc = albedo(rcb, wo), quad = hemisphereIntegral(rcb, wo);
+        EXPECT_LE(rc, 1.0 + 0.01) << "alpha " << a;
+        EXPECT_NEAR(rc, quad, 0.01 + 0.01 * quad) << "alpha " << a << " cos " << c << " dist " << int(dist);
+        EXPECT_LE(albedo(make(BsdfType::RoughPlastic, a, "none", dist), wo), 1.0 + 0.02);
+        Bsdf rd = make(BsdfType::RoughDielectric, a, "none", dist);
+        rd.ior = 1.f + 1e-4f;  // index-matched: transmission weight is not scaled
+        EXPECT_LE(albedo(rd, wo), 1.0 + 0.01);
+      }
     Bsdf d = make(BsdfType::Diffuse, 0.1f);
     d.reflectance = Color(1.f);
     EXPECT_NEAR(albedo(d, wo), 1.0, 1e-5);

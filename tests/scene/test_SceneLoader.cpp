@@ -124,6 +124,10 @@ TEST(SceneLoader, ShapesBsdfsEmittersTransformsDefaults) {
   EXPECT_NEAR(s.bsdfs[size_t(s.shapes[4].bsdf)].ior, 1.333f / 1.000277f, 1e-4f);
   EXPECT_LT(s.meshes[3].normals[0].z, 0.f) << "flip_normals";
   EXPECT_EQ(s.bsdfs[size_t(s.shapes[6].bsdf)].type, BsdfType::RoughDielectric);
+  // Mitsuba's rough BSDFs are Beckmann unless the scene says ggx.
+  EXPECT_EQ(gold.distribution, MicrofacetType::GGX);
+  EXPECT_EQ(s.bsdfs[size_t(s.shapes[6].bsdf)].distribution, MicrofacetType::Beckmann);
+  EXPECT_EQ(s.bsdfs[size_t(s.shapes[7].bsdf)].distribution, MicrofacetType::Beckmann);
   EXPECT_EQ(s.bsdfs[size_t(s.shapes[8].bsdf)].type, BsdfType::Conductor);
   EXPECT_TRUE(s.bsdfs[size_t(s.shapes[8].bsdf)].perfectMirror);
 }
@@ -136,6 +140,8 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
   std::vector<Case> cases = {
       {"<shape type=\"teapot\"/>", "s.xml:2: unknown shape type 'teapot'"},
       {"<bsdf type=\"velvet\"/>", "unknown BSDF type 'velvet'"},
+      {"<bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"phong\"/></bsdf>",
+       "roughconductor distribution must be beckmann or ggx, not 'phong'"},
       {"<shape type=\"ply\"><string name=\"filename\" value=\"nope.ply\"/></shape>", "does not exist"},
       {"<shape type=\"sphere\"><float name=\"radius\" value=\"1.5x\"/></shape>", "'1.5x' is not a number"},
       {"<shape type=\"sphere\"><float name=\"radius\" valeu=\"1\"/></shape>", "unexpected attribute 'valeu'"},
