@@ -66,6 +66,9 @@ def bsdfs():
                         '<string name="distribution" value="ggx"/></bsdf>'))
     return out
 
+THINLENS = ('<sensor type="thinlens"><float name="aperture_radius" value="0.2"/>'
+            '<float name="focus_distance" value="6.1"/>')
+
 # Where envgi is known to differ from Mitsuba (docs/validation.md says why): by design, or open.
 DESIGN = {
     'roughplastic': 'envgi\'s rough plastic uses smooth Fresnel terms for its diffuse base, not Mitsuba\'s precomputed tables',
@@ -138,6 +141,14 @@ def main():
         configs.append(('furnace: ' + name, path, {}, 1, True))
     for s in args.scene_names.split(','):
         configs.append((f'scene: {s}', os.path.join(args.scenes, s + '.xml'), {'res': str(args.res), 'spp': str(args.spp)}, 4, False))
+    # Depth of field: the textured scene through a thin lens focused on the globe.
+    lens = open(os.path.join(args.scenes, 'textured.xml')).read()
+    lens = lens.replace('<sensor type="perspective">', THINLENS)
+    for d in ('envmaps', 'textures'):
+        lens = lens.replace(f'value="{d}/', f'value="{os.path.abspath(os.path.join(args.scenes, d))}/')
+    path = os.path.join(tmp, 'textured_thinlens.xml')
+    open(path, 'w').write(lens)
+    configs.append(('scene: textured thinlens', path, {'res': str(args.res), 'spp': str(args.spp)}, 4, False))
     configs = [c for c in configs if args.only in c[0]]
     total_regions = sum(c[3] * c[3] for c in configs)
     alpha = 1.0 - 0.99 ** (1.0 / total_regions)

@@ -1,7 +1,9 @@
-// Mitsuba's perspective sensor: looks along +z of its frame, +y up; to_world places it.
+// Mitsuba's perspective and thin-lens sensors: look along +z of their frame, +y up; to_world
+// places them.
 #pragma once
 
 #include "core/Transform.h"
+#include "sampling/Warp.h"
 #include "scene/Ray.h"
 
 namespace envgi {
@@ -14,16 +16,32 @@ struct Camera {
   float tanHalfX = 0.f, tanHalfY = 0.f;  // half extent of the image plane at distance 1
   float nearClip = 1e-2f, farClip = 1e4f;
   FilterType filter = FilterType::Gaussian;
+  // Thin lens (Mitsuba's `thinlens`); a pinhole when the radius is 0.
+  float apertureRadius = 0.f, focusDistance = 1e4f;
 
-  // A ray through film position (x, y) in pixels, (0,0) the top-left corner of the image.
-  ENVGI_HD Ray generateRay(float x, float y) const {
+  // Whether a camera sample needs a point on the lens (a 2D draw after the filter's).
+  ENVGI_HD bool hasLens() const { return apertureRadius > 0.f; }
+
+  // A ray through film position (x, y) in pixels, (0,0) the top-left corner of the image;
+  // `lens` picks the point on the aperture (unused for a pinhole).
+  ENVGI_HD Ray generateRay(float x, float y, Vec2f lens = Vec2f(0.5f, 0.5f)) const {
     float sx = 2.f * x / float(width) - 1.f, sy = 1.f - 2.f * y / float(height);
     // Camera-space +x is the image's left (lookat builds x = up x dir), so image right is -x.
     // On the plane z = 1: its length is 1 / cos of the angle to the axis, which turns the
     // near and far planes into distances along the ray without normalising twice.
     Vec3f d(-sx * tanHalfX, sy * tanHalfY, 1.f);
-    float len = length(d);
     Ray r;
+    if (hasLens()) {
+      // Every ray through the pixel's point on the plane in focus, from a point of the lens.
+      Vec2f a = sampleConcentricDisk(lens) * apertureRadius;
+      Vec3f dir = d * focusDistance - Vec3f(a.x, a.y, 0.f);
+      float invZ = length(dir) / dir.z;  // 1 / cos of dir's angle to the axis
+      r.d = normalize(toWorld.vector(dir));
+      r.o = toWorld.point(Vec3f(a.x, a.y, 0.f)) + r.d * (nearClip * invZ);
+      r.tMax = (farClip - nearClip) * invZ;
+      return r;
+    }
+    float len = length(d);
     r.d = normalize(toWorld.vector(d));
     r.o = toWorld.translation() + r.d * (nearClip * len);
     r.tMax = (farClip - nearClip) * len;

@@ -403,10 +403,8 @@ class Loader {
   void sensor(const SourceFile* f, pugi::xml_node n) {
     checkAttrs(f, n, {"type", "id", "name"});
     std::string type = attr(f, n, "type");
-    if (type == "thinlens")
-      warnOnce(fmt::format("{}: sensor 'thinlens' is rendered as 'perspective' (no depth of field)", f->path));
-    else if (type != "perspective")
-      fail(f, n, fmt::format("unknown sensor type '{}' (perspective)", type));
+    if (type != "perspective" && type != "thinlens")
+      fail(f, n, fmt::format("unknown sensor type '{}' (perspective, thinlens)", type));
     haveSensor_ = true;
     Props p = collectProps(f, n);
     Camera& cam = scene_.camera;
@@ -417,8 +415,16 @@ class Loader {
     cam.farClip = getFloat(f, p, "far_clip", 10000.f);
     if (!(cam.nearClip > 0.f && cam.farClip > cam.nearClip)) fail(f, n, "need 0 < near_clip < far_clip");
     cam.toWorld = getTransform(f, p, "to_world");
-    find(p, "aperture_radius");
-    find(p, "focus_distance");
+    cam.apertureRadius = 0.f;
+    cam.focusDistance = cam.farClip;
+    if (type == "thinlens") {
+      // Mitsuba requires the radius and focuses at far_clip unless told.
+      if (!find(p, "aperture_radius")) fail(f, n, "thinlens needs an 'aperture_radius'");
+      cam.apertureRadius = getFloat(f, p, "aperture_radius", 0.f);
+      cam.focusDistance = getFloat(f, p, "focus_distance", cam.farClip);
+      if (!(cam.apertureRadius >= 0.f && cam.apertureRadius < 1e30f)) fail(f, n, "aperture_radius must be >= 0");
+      if (!(cam.focusDistance > 0.f && cam.focusDistance < 1e30f)) fail(f, n, "focus_distance must be positive");
+    }
     warnUnused(f, p, "sensor");
     cam.width = 768;
     cam.height = 576;

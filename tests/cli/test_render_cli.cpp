@@ -2,6 +2,7 @@
 // interrupted render still writes the samples it finished.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <csignal>
 #include <filesystem>
@@ -233,6 +234,50 @@ TEST(CliRender, TexturedAlbedoFromTheCommandLine) {
           EXPECT_NEAR(sum[c] / n, wantC[c], 0.04 * wantC[c] + 0.01)
               << integ << ", quarter (" << qx << ", " << qy << "), channel " << c;
       }
+  }
+}
+
+// A thin lens seen through its analytic blur: a black-and-white step (a checkerboard edge on
+// a plane parallel to the lens, at depth D, under a constant sky of radiance 1) with the lens
+// focused at F. The rays of one film position then meet the plane on a uniform disk of radius
+// R = A |D - F| / F about the pinhole ray's hit, so a pixel shows the part of that disk on the
+// white side: g(-X / R), with g(s) = (acos s - s sqrt(1 - s^2)) / pi, X the pixel's offset
+// from the edge on the plane. A pinhole would show a sharp step.
+TEST(CliRender, ThinLensBlursAStepByItsCircleOfConfusion) {
+  TempDir d;
+  const double A = 0.25, D = 10.0, F = 5.0, R = A * std::fabs(D - F) / F;  // 8 pixels
+  std::ofstream(d.file("lens.xml")) << R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+  <sensor type="thinlens"><float name="fov" value="11.421186"/>
+    <float name="aperture_radius" value="0.25"/><float name="focus_distance" value="5"/>
+    <transform name="to_world"><lookat origin="0,0,0" target="0,0,-1" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="4"/><rfilter type="box"/></film>
+    <sampler type="independent"><integer name="sample_count" value="256"/></sampler></sensor>
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <shape type="rectangle"><transform name="to_world"><scale value="20"/><translate z="-10"/></transform>
+    <bsdf type="diffuse"><texture type="checkerboard" name="reflectance">
+      <rgb name="color0" value="1"/><rgb name="color1" value="0"/>
+      <transform name="to_uv"><translate y="0.25"/></transform></texture></bsdf></shape>
+</scene>)";
+  auto g = [](double s) {
+    s = std::clamp(s, -1.0, 1.0);
+    return (std::acos(s) - s * std::sqrt(1.0 - s * s)) / M_PI;
+  };
+  for (std::string integ : {"path", "direct"}) {
+    CliResult r = runCli("render " + d.file("lens.xml") + " -o " + d.file("l.exr") + " --integrator " + integ +
+                         " --seed 3 --no-progress");
+    ASSERT_EQ(r.code, 0) << r.output;
+    envgi::Image img = envgi::loadImage(d.file("l.exr"));
+    ASSERT_EQ(img.width, 64);
+    for (int x = 0; x < 64; ++x) {
+      double got = 0.0;
+      for (int y = 0; y < 4; ++y) got += img.at(x, y).y / 4.0;
+      // The plane spans [-1, 1] across the image (tan(fov / 2) D = 1); the white half is +x,
+      // the image's right. The box filter averages over the pixel.
+      double want = 0.0;
+      for (int k = 0; k < 32; ++k) want += g(-(-1.0 + (x + (k + 0.5) / 32.0) / 32.0) / R) / 32.0;
+      EXPECT_NEAR(got, want, 0.06) << integ << ", column " << x;  // 1024 samples: sigma <= 0.016
+    }
   }
 }
 

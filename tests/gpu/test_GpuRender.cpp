@@ -72,6 +72,7 @@ Image renderOnCpu(const Scene& s, const RenderOptions& o, RenderStats* st) {
 
 struct Case {
   std::string scene, integrator, strategy;
+  float aperture = 0.f;  // > 0: seen through a thin lens focused at 6.1
 };
 
 }  // namespace
@@ -80,6 +81,7 @@ TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
   std::vector<Case> cases;
   for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured", "microfacets"})
     cases.push_back({sc, "path", "mis"});
+  cases.push_back({"textured", "path", "mis", 0.2f});
   for (std::string st : {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis", "product"})
     cases.push_back({"buddha", "direct", st});
   const int region = 8, regionsPerCase = (kRes / region) * (kRes / region);
@@ -90,6 +92,8 @@ TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
     s.camera.width = s.camera.height = kRes;
     s.integrator.type = findIntegrator(c.integrator);
     s.integrator.env.strategy = c.strategy;
+    s.camera.apertureRadius = c.aperture;
+    s.camera.focusDistance = 6.1f;
     s.sampler.seed = 1;
     s.finalize();
     Result cpu = renderOn(false, s, 128);
@@ -102,8 +106,8 @@ TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
       mc += cpu.img.rgb[i];
       mg += gpu.img.rgb[i];
     }
-    std::printf("%-12s %-6s %-10s min p %.3g (alpha %.2g), image mean GPU/CPU %.4f, %.1f vs %.1f Mrays/s\n",
-                c.scene.c_str(), c.integrator.c_str(), c.strategy.c_str(), p, alpha, mg / mc,
+    std::printf("%-12s %-6s %-10s %s min p %.3g (alpha %.2g), image mean GPU/CPU %.4f, %.1f vs %.1f Mrays/s\n",
+                c.scene.c_str(), c.integrator.c_str(), c.strategy.c_str(), c.aperture > 0.f ? "lens" : "", p, alpha, mg / mc,
                 gpu.stats.raysPerSecond() / 1e6, cpu.stats.raysPerSecond() / 1e6);
     EXPECT_GT(p, alpha) << c.scene << " " << c.integrator << " " << c.strategy;
     EXPECT_EQ(gpu.stats.nonFiniteSamples, 0u);

@@ -33,3 +33,47 @@ TEST(Camera, RaysStartOnTheNearPlaneAndProjectBackToTheirPixel) {
     ASSERT_NEAR(py, y, 2e-3f);
   }
 }
+
+// A thin lens: rays for one film position leave points spread over the aperture disk (on the
+// lens plane, z = near along each ray) and all cross at that position's point of the plane in
+// focus, which projects back to the film position; a radius of 0 gives the pinhole's rays.
+TEST(Camera, ThinLensRaysMeetOnThePlaneInFocus) {
+  Camera c;
+  c.width = c.height = 128;
+  c.tanHalfX = c.tanHalfY = 0.4f;
+  c.nearClip = 0.01f;
+  c.farClip = 1000.f;
+  c.toWorld = lookAt(Vec3f(0.f, 1.f, 5.f), Vec3f(0.f, 0.5f, 0.f), Vec3f(0.f, 1.f, 0.f));
+  Camera pinhole = c;
+  c.apertureRadius = 0.2f;
+  c.focusDistance = 4.f;
+  ASSERT_TRUE(c.hasLens());
+  ASSERT_FALSE(pinhole.hasLens());
+  Pcg32 rng(4);
+  double meanR2 = 0.0;
+  const int n = 4000;
+  for (int i = 0; i < n; ++i) {
+    float x = rng.nextFloat() * 128.f, y = rng.nextFloat() * 128.f;
+    Vec2f lens(rng.nextFloat(), rng.nextFloat());
+    Ray r = c.generateRay(x, y, lens), p = pinhole.generateRay(x, y, lens);
+    ASSERT_NEAR(length(r.d), 1.f, 1e-6f);
+    Vec3f o = c.toWorld.inversePoint(r.o), d = c.toWorld.inverseVector(r.d);
+    // Back along the ray to the lens plane z = 0: a point within the aperture.
+    Vec3f onLens = o - d * (o.z / d.z);
+    ASSERT_LE(std::hypot(onLens.x, onLens.y), c.apertureRadius * 1.0001f);
+    meanR2 += double(onLens.x * onLens.x + onLens.y * onLens.y);
+    ASSERT_NEAR(o.z, c.nearClip, 1e-5f);
+    ASSERT_NEAR(c.toWorld.inversePoint(r.o + r.d * r.tMax).z, c.farClip, 5e-2f);
+    // On the plane in focus it meets the pinhole ray of the same film position.
+    Vec3f focus = onLens + d * ((c.focusDistance - onLens.z) / d.z);
+    Vec3f pd = c.toWorld.inverseVector(p.d);
+    Vec3f pinFocus = pd * (c.focusDistance / pd.z);
+    ASSERT_NEAR(length(focus - pinFocus), 0.f, 1e-4f);
+    float px, py;
+    ASSERT_TRUE(projectToFilm(c, c.toWorld.point(focus), &px, &py));
+    ASSERT_NEAR(px, x, 2e-3f);
+    ASSERT_NEAR(py, y, 2e-3f);
+  }
+  // Uniform over the disk: E[r^2] = R^2 / 2.
+  EXPECT_NEAR(meanR2 / n, 0.5 * 0.04, 0.02 * 0.04);
+}

@@ -81,6 +81,24 @@ TEST(SceneLoader, SensorFilmSamplerIntegrator) {
   // Image right is world +x for this camera (Mitsuba's convention).
   EXPECT_GT(s.camera.generateRay(60.f, 16.f).d.x, 0.f);
   EXPECT_GT(s.camera.generateRay(32.f, 2.f).d.y, 0.f);
+  EXPECT_FALSE(s.camera.hasLens());
+
+  // thinlens: Mitsuba's aperture_radius (required) and focus_distance (far_clip unless given).
+  const std::string persp = "type=\"perspective\">";
+  std::string lens = kSensor;
+  lens.replace(lens.find(persp), persp.size(), "type=\"thinlens\"><float name=\"aperture_radius\" value=\"0.1\"/>");
+  Scene t;
+  loadScene(f.scene(lens), {}, t);
+  EXPECT_NEAR(t.camera.apertureRadius, 0.1f, 1e-7f);
+  EXPECT_NEAR(t.camera.focusDistance, t.camera.farClip, 1e-3f);
+  std::string focused = lens;
+  focused.replace(focused.find("<float name=\"aperture_radius\""), 0, "<float name=\"focus_distance\" value=\"3.5\"/>");
+  Scene u;
+  loadScene(f.scene(focused), {}, u);
+  EXPECT_NEAR(u.camera.focusDistance, 3.5f, 1e-6f);
+  std::string noRadius = kSensor;
+  noRadius.replace(noRadius.find(persp), persp.size(), "type=\"thinlens\">");
+  EXPECT_NE(loadError(f.scene(noRadius)).find("thinlens needs an 'aperture_radius'"), std::string::npos);
 }
 
 TEST(SceneLoader, ShapesBsdfsEmittersTransformsDefaults) {
