@@ -202,6 +202,8 @@ def material(sc, b, name, kind):
         fail(f"bsdf '{t}' with a texture for {sorted(textured - allowed)} is not supported")
     # Mitsuba's rough BSDFs default to Beckmann; Cycles' Principled BSDF (rough plastic here) has GGX only.
     dist = sc.prop(b, 'distribution', 'beckmann')
+    if any(c.get('name') in ('alpha_u', 'alpha_v') for c in b):
+        fail(f"bsdf '{t}' with alpha_u / alpha_v (anisotropic) is not supported here")
     if t == 'roughplastic' and dist != 'ggx':
         fail("roughplastic needs distribution 'ggx' here: Cycles' Principled BSDF has no Beckmann")
     if t == 'diffuse':

@@ -19,6 +19,18 @@ struct Frame {
     f.n = n;
     return f;
   }
+  // The frame whose s is the tangent dpdu made orthogonal to n (Mitsuba's shading frame, which
+  // anisotropic BSDFs orient by); fromNormal where dpdu is zero or along n.
+  ENVGI_HD static Frame fromNormalAndTangent(Vec3f n, Vec3f dpdu) {
+    Vec3f s = dpdu - n * dot(n, dpdu);
+    float l2 = dot(s, s);
+    if (!(l2 > 1e-30f && l2 < 1e30f)) return fromNormal(n);
+    Frame f;
+    f.s = s * (1.f / std::sqrt(l2));
+    f.t = cross(n, f.s);
+    f.n = n;
+    return f;
+  }
   ENVGI_HD Vec3f toLocal(Vec3f v) const { return {dot(v, s), dot(v, t), dot(v, n)}; }
   ENVGI_HD Vec3f toWorld(Vec3f v) const { return s * v.x + t * v.y + n * v.z; }
 };

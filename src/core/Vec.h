@@ -21,6 +21,7 @@ struct Vec3f {
 };
 
 ENVGI_INLINE Vec2f operator+(Vec2f a, Vec2f b) { return {a.x + b.x, a.y + b.y}; }
+ENVGI_INLINE Vec2f operator-(Vec2f a, Vec2f b) { return {a.x - b.x, a.y - b.y}; }
 ENVGI_INLINE Vec2f operator*(Vec2f a, float s) { return {a.x * s, a.y * s}; }
 
 ENVGI_INLINE Vec3f operator+(Vec3f a, Vec3f b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }

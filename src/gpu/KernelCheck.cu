@@ -52,6 +52,7 @@ ENVGI_HD float bsdfCameraValue(const Camera& cam, int i) {
   b.alpha = 0.3f;
   b.twoSided = (i / 8) % 2 == 1;
   b.distribution = MicrofacetType((i / 16) % 2);
+  if ((i / 32) % 2 == 1) b.alphaV = 0.05f;  // anisotropic
   Vec3f wo = normalize(Vec3f(0.3f, 0.2f, (i % 3 == 0) ? -0.8f : 0.8f));
   BsdfSample bs;
   float acc = 0.f;

@@ -34,7 +34,8 @@ struct Bsdf {
   Color specularReflectance{1.f};
   Color specularTransmittance{1.f};
   Color eta{0.f}, k{1.f};                // conductor complex index, per channel
-  float alpha = 0.1f;                    // microfacet roughness
+  float alpha = 0.1f;                    // microfacet roughness (along the shading frame's s)
+  float alphaV = -1.f;                   // anisotropic: roughness along t (Mitsuba's alpha_v); < 0: alpha
   float ior = 1.5046f;                   // interior / exterior index of refraction
   float fdrInt = 0.f;                    // plastic: diffuse Fresnel reflectance seen from inside
   float fdrExt = 0.f;                    // plastic: the same seen from outside
@@ -61,7 +62,10 @@ ENVGI_INLINE float bsdfEtaSquared(const Bsdf& b, Vec3f wo, Vec3f wi) {
   return etap * etap;
 }
 
-ENVGI_INLINE MicrofacetDistribution microfacet(const Bsdf& b) { return {b.alpha, b.distribution}; }
+ENVGI_INLINE bool bsdfIsAnisotropic(const Bsdf& b) { return b.alphaV >= 0.f; }
+ENVGI_INLINE MicrofacetDistribution microfacet(const Bsdf& b) {
+  return {b.alpha, bsdfIsAnisotropic(b) ? b.alphaV : b.alpha, b.distribution};
+}
 
 ENVGI_INLINE bool bsdfHasTexture(const Bsdf& b) {
   return b.reflectanceTexture >= 0 || b.specularReflectanceTexture >= 0 || b.specularTransmittanceTexture >= 0 ||

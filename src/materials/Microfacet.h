@@ -1,7 +1,8 @@
-// Isotropic microfacet distributions, GGX (Trowbridge-Reitz) and Beckmann, as Mitsuba 3's
-// `distribution` names them, with the Smith masking of each and visible-normal sampling
-// (GGX: Heitz 2018; Beckmann: Heitz and d'Eon 2014, whose slope CDF is inverted numerically).
-// Directions are in the local shading frame, z = normal.
+// Microfacet distributions, GGX (Trowbridge-Reitz) and Beckmann, as Mitsuba 3's
+// `distribution` names them, isotropic or anisotropic (roughness alphaX along the frame's s,
+// alphaY along t), with the Smith masking of each and visible-normal sampling (GGX: Heitz
+// 2018; Beckmann: Heitz and d'Eon 2014, whose slope CDF is inverted numerically). Directions
+// are in the local shading frame, z = normal.
 #pragma once
 
 #include <cstdint>
@@ -14,16 +15,24 @@ namespace envgi {
 enum class MicrofacetType : uint8_t { GGX = 0, Beckmann = 1 };
 
 struct MicrofacetDistribution {
-  float alpha;
+  float alphaX, alphaY;
   MicrofacetType type = MicrofacetType::GGX;
 
   ENVGI_HD float D(Vec3f m) const {
     float cos2 = m.z * m.z;
     if (cos2 <= 0.f) return 0.f;
-    float tan2 = (m.x * m.x + m.y * m.y) / cos2;
-    float a2 = alpha * alpha;
-    if (type == MicrofacetType::Beckmann) return std::exp(-tan2 / a2) / (kPi * a2 * cos2 * cos2);
-    float e = 1.f + tan2 / a2;
+    // tan^2 of m over alpha^2 (over each axis' alpha^2 where they differ), and alphaX alphaY.
+    float t, a2;
+    if (alphaX == alphaY) {
+      float tan2 = (m.x * m.x + m.y * m.y) / cos2;
+      a2 = alphaX * alphaX;
+      t = tan2 / a2;
+    } else {
+      t = (sqr(m.x / alphaX) + sqr(m.y / alphaY)) / cos2;
+      a2 = alphaX * alphaY;
+    }
+    if (type == MicrofacetType::Beckmann) return std::exp(-t) / (kPi * a2 * cos2 * cos2);
+    float e = 1.f + t;
     return 1.f / (kPi * a2 * cos2 * cos2 * e * e);
   }
   // Smith's lambda; G1 = 1 / (1 + lambda). Beckmann's is the exact form in erfc, which is what
@@ -31,14 +40,16 @@ struct MicrofacetDistribution {
   ENVGI_HD float lambda(Vec3f w) const {
     float cos2 = w.z * w.z;
     if (cos2 <= 0.f) return 0.f;
-    float sin2 = w.x * w.x + w.y * w.y;
+    // alpha^2 tan^2 theta, with alpha the roughness along w's azimuth where the axes differ.
+    float a2tan2;
+    if (alphaX == alphaY) a2tan2 = alphaX * alphaX * ((w.x * w.x + w.y * w.y) / cos2);
+    else a2tan2 = (sqr(alphaX * w.x) + sqr(alphaY * w.y)) / cos2;
     if (type == MicrofacetType::Beckmann) {
-      if (sin2 <= 0.f) return 0.f;
-      float a = std::sqrt(cos2 / sin2) / alpha;  // 1 / (alpha tan theta)
+      if (a2tan2 <= 0.f) return 0.f;
+      float a = 1.f / std::sqrt(a2tan2);  // 1 / (alpha tan theta)
       return fmaxf(0.f, 0.5f * (std::exp(-a * a) / (a * 1.7724538509f) - std::erfc(a)));
     }
-    float tan2 = sin2 / cos2;
-    return 0.5f * (std::sqrt(1.f + alpha * alpha * tan2) - 1.f);
+    return 0.5f * (std::sqrt(1.f + a2tan2) - 1.f);
   }
   ENVGI_HD float G1(Vec3f w) const { return 1.f / (1.f + lambda(w)); }
   // Height-correlated masking-shadowing.
@@ -58,7 +69,7 @@ struct MicrofacetDistribution {
 
  private:
   ENVGI_HD Vec3f sampleVisibleGgx(Vec3f w, Vec2f u) const {
-    Vec3f wh = normalize(Vec3f(alpha * w.x, alpha * w.y, w.z));
+    Vec3f wh = normalize(Vec3f(alphaX * w.x, alphaY * w.y, w.z));
     if (wh.z < 0.f) wh = -wh;
     Vec3f t1 = wh.z < 0.99999f ? normalize(cross(Vec3f(0.f, 0.f, 1.f), wh)) : Vec3f(1.f, 0.f, 0.f);
     Vec3f t2 = cross(wh, t1);
@@ -70,7 +81,7 @@ struct MicrofacetDistribution {
     py = (1.f - s) * h + s * py;
     float pz = safeSqrt(1.f - px * px - py * py);
     Vec3f nh = t1 * px + t2 * py + wh * pz;
-    return normalize(Vec3f(alpha * nh.x, alpha * nh.y, fmaxf(1e-6f, nh.z)));
+    return normalize(Vec3f(alphaX * nh.x, alphaY * nh.y, fmaxf(1e-6f, nh.z)));
   }
 
   // In the stretched frame (alpha = 1) and with w in the xz-plane at angle theta, the normal of
@@ -100,7 +111,7 @@ struct MicrofacetDistribution {
 
   ENVGI_HD Vec3f sampleVisibleBeckmann(Vec3f w, Vec2f u) const {
     if (w.z < 0.f) w = -w;
-    Vec3f wh = normalize(Vec3f(alpha * w.x, alpha * w.y, fmaxf(w.z, 1e-7f)));
+    Vec3f wh = normalize(Vec3f(alphaX * w.x, alphaY * w.y, fmaxf(w.z, 1e-7f)));
     float sinTheta = std::sqrt(wh.x * wh.x + wh.y * wh.y);
     float cosPhi = 1.f, sinPhi = 0.f;
     if (sinTheta > 0.f) {
@@ -111,7 +122,7 @@ struct MicrofacetDistribution {
     float sx = visibleSlopeX(sinTheta / wh.z, ux);
     float sy = erfInv(2.f * uy - 1.f);
     // Back to w's azimuth, then unstretched.
-    float x = alpha * (cosPhi * sx - sinPhi * sy), y = alpha * (sinPhi * sx + cosPhi * sy);
+    float x = alphaX * (cosPhi * sx - sinPhi * sy), y = alphaY * (sinPhi * sx + cosPhi * sy);
     return normalize(Vec3f(-x, -y, 1.f));
   }
 };

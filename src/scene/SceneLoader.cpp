@@ -637,6 +637,7 @@ class Loader {
       fail(f, n, fmt::format("unknown BSDF type '{}'", type));
     }
     for (const auto& [name, tex] : textures) {
+      if (name == "alpha" && bsdfIsAnisotropic(b)) fail(f, tex.second, "give either alpha or alpha_u and alpha_v, not both");
       int* slot = textureSlot(b, name);
       if (!slot) {
         warnOnce(fmt::format("{}:{}: a texture for '{}' of bsdf '{}' is not supported; the property keeps its default",
@@ -746,9 +747,19 @@ class Loader {
     if (dist == "beckmann") b.distribution = MicrofacetType::Beckmann;
     else if (dist == "ggx") b.distribution = MicrofacetType::GGX;
     else fail(f, n, fmt::format("{} distribution must be beckmann or ggx, not '{}'", type, dist));
-    b.alpha = getFloat(f, p, "alpha", 0.1f);
-    if (!(b.alpha > 0.f && b.alpha <= kMaxAlpha)) fail(f, n, "alpha must be in (0, 4]");
-    b.alpha = std::max(b.alpha, kMinAlpha);
+    auto checked = [&](const char* name) {
+      float a = getFloat(f, p, name, 0.1f);
+      if (!(a > 0.f && a <= kMaxAlpha)) fail(f, n, fmt::format("{} must be in (0, 4]", name));
+      return std::max(a, kMinAlpha);
+    };
+    // Anisotropic conductors and dielectrics (Mitsuba's alpha_u, alpha_v: along dp/du, dp/dv).
+    if (type != "roughplastic" && (p.count("alpha_u") || p.count("alpha_v"))) {
+      if (p.count("alpha")) fail(f, n, "give either alpha or alpha_u and alpha_v, not both");
+      b.alpha = checked("alpha_u");
+      b.alphaV = checked("alpha_v");
+    } else {
+      b.alpha = checked("alpha");
+    }
     find(p, "sample_visible");
   }
 

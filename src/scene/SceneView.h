@@ -86,8 +86,16 @@ struct SceneView {
         if (dot(ns, ng) < 0.f) ng = -ng;  // geometric normal agrees with the mesh's own normals
       }
       si.ng = ng;
-      si.shading = Frame::fromNormal(ns);
       si.uv = m.uvs ? m.uvs[i0] * b0 + m.uvs[i1] * b1 + m.uvs[i2] * b2 : Vec2f(b1, b2);
+      si.shading = Frame::fromNormal(ns);
+      if (bsdfIsAnisotropic(bsdfs[m.bsdf])) {
+        // dp/du from the triangle's (u, v), the barycentric ones where the mesh has none.
+        Vec2f t0 = m.uvs ? m.uvs[i0] : Vec2f(0.f, 0.f), t1 = m.uvs ? m.uvs[i1] : Vec2f(1.f, 0.f),
+              t2 = m.uvs ? m.uvs[i2] : Vec2f(0.f, 1.f);
+        Vec2f d1 = t1 - t0, d2 = t2 - t0;
+        float det = d1.x * d2.y - d1.y * d2.x;
+        if (det != 0.f) si.shading = Frame::fromNormalAndTangent(ns, ((p1 - p0) * d2.y - (p2 - p0) * d1.y) / det);
+      }
       si.bsdf = m.bsdf;
       si.light = m.lightOffset >= 0 ? m.lightOffset + h.primId : -1;
     } else {
@@ -103,9 +111,15 @@ struct SceneView {
         float phi = polyAtan2(l.y, l.x);
         si.uv = Vec2f((phi < 0.f ? phi + 2.f * kPi : phi) * (0.5f * kInvPi), acosf(fminf(fmaxf(l.z, -1.f), 1.f)) * kInvPi);
       }
+      Vec3f radial = n;
       if (s.flipNormals) n = -n;
       si.ng = n;
       si.shading = Frame::fromNormal(n);
+      if (bsdfIsAnisotropic(bsdfs[s.bsdf])) {
+        // dp/du runs along the azimuth about the sphere's own z, as Mitsuba's.
+        Vec3f l = s.axes.toLocal(radial);
+        si.shading = Frame::fromNormalAndTangent(n, s.axes.toWorld(Vec3f(-l.y, l.x, 0.f)));
+      }
       si.bsdf = s.bsdf;
       si.light = s.light;
     }

@@ -79,7 +79,7 @@ struct Case {
 
 TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
   std::vector<Case> cases;
-  for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured", "microfacets"})
+  for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured", "microfacets", "brushed"})
     cases.push_back({sc, "path", "mis"});
   cases.push_back({"textured", "path", "mis", 0.2f});
   for (std::string st : {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis", "product"})

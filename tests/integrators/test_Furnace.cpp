@@ -108,6 +108,9 @@ TEST(Furnace, EveryBsdfMatchesMitsubaReference) {
     conductorPreset("Au", &b.eta, &b.k, &b.perfectMirror);
     return b;
   };
+  Bsdf anisoGgx = rough(BsdfType::RoughConductor, 0.05f, true), anisoBeckmann = rough(BsdfType::RoughConductor, 0.4f, true, MicrofacetType::Beckmann);
+  anisoGgx.alphaV = 0.5f;
+  anisoBeckmann.alphaV = 0.05f;
   Bsdf beckmannGold = gold(0.3f);
   beckmannGold.distribution = MicrofacetType::Beckmann;
   Bsdf chrome;
@@ -146,6 +149,9 @@ TEST(Furnace, EveryBsdfMatchesMitsubaReference) {
       {"Beckmann conductor 0.3", rough(BsdfType::RoughConductor, 0.3f, true, MicrofacetType::Beckmann), 0.9645, 0.015},
       {"Beckmann conductor 0.6", rough(BsdfType::RoughConductor, 0.6f, true, MicrofacetType::Beckmann), 0.8439, 0.015},
       {"Beckmann Au 0.3", beckmannGold, 0.7744, 0.015},
+      // Anisotropic (alpha_u along the sphere's azimuth, alpha_v along its meridians).
+      {"anisotropic GGX 0.05 / 0.5", anisoGgx, 0.8065, 0.015},
+      {"anisotropic Beckmann 0.4 / 0.05", anisoBeckmann, 0.9971, 0.015},
       {"Beckmann dielectric 0.5", rough(BsdfType::RoughDielectric, 0.5f, false, MicrofacetType::Beckmann), 0.7914,
        0.015},
       {"Cr", chrome, 0.6372, 0.005},

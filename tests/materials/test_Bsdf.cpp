@@ -48,6 +48,18 @@ std::vector<BsdfCase> cases() {
       out.push_back({"BeckmannDielectric" + cs + "a" + as, make(BsdfType::RoughDielectric, a, "none", beck), c});
       out.push_back({"BeckmannDielectricInside" + cs + "a" + as, make(BsdfType::RoughDielectric, a, "none", beck), -c});
     }
+    // Anisotropic: alpha 0.08 along s, 0.4 along t (Mitsuba's alpha_u, alpha_v).
+    for (MicrofacetType dist : {MicrofacetType::GGX, MicrofacetType::Beckmann}) {
+      std::string ds = dist == MicrofacetType::GGX ? "Ggx" : "Beckmann";
+      auto aniso = [&](BsdfType t, const char* metal) {
+        Bsdf b = make(t, 0.08f, metal, dist);
+        b.alphaV = 0.4f;
+        return b;
+      };
+      out.push_back({"Aniso" + ds + "ConductorAu" + cs, aniso(BsdfType::RoughConductor, "Au"), c});
+      out.push_back({"Aniso" + ds + "Dielectric" + cs, aniso(BsdfType::RoughDielectric, "none"), c});
+      out.push_back({"Aniso" + ds + "DielectricInside" + cs, aniso(BsdfType::RoughDielectric, "none"), -c});
+    }
   }
   Bsdf two = make(BsdfType::Diffuse, 0.1f);
   two.twoSided = true;

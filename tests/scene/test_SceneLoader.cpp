@@ -142,7 +142,9 @@ TEST(SceneLoader, ShapesBsdfsEmittersTransformsDefaults) {
   EXPECT_NEAR(s.bsdfs[size_t(s.shapes[4].bsdf)].ior, 1.333f / 1.000277f, 1e-4f);
   EXPECT_LT(s.meshes[3].normals[0].z, 0.f) << "flip_normals";
   EXPECT_EQ(s.bsdfs[size_t(s.shapes[6].bsdf)].type, BsdfType::RoughDielectric);
-  // Mitsuba's rough BSDFs are Beckmann unless the scene says ggx.
+  // Mitsuba's rough BSDFs are Beckmann unless the scene says ggx; isotropic unless given
+  // alpha_u and alpha_v.
+  EXPECT_FALSE(bsdfIsAnisotropic(gold));
   EXPECT_EQ(gold.distribution, MicrofacetType::GGX);
   EXPECT_EQ(s.bsdfs[size_t(s.shapes[6].bsdf)].distribution, MicrofacetType::Beckmann);
   EXPECT_EQ(s.bsdfs[size_t(s.shapes[7].bsdf)].distribution, MicrofacetType::Beckmann);
@@ -160,6 +162,10 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
       {"<bsdf type=\"velvet\"/>", "unknown BSDF type 'velvet'"},
       {"<bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"phong\"/></bsdf>",
        "roughconductor distribution must be beckmann or ggx, not 'phong'"},
+      {"<bsdf type=\"roughconductor\"><float name=\"alpha\" value=\"0.2\"/><float name=\"alpha_u\" value=\"0.1\"/></bsdf>",
+       "give either alpha or alpha_u and alpha_v, not both"},
+      {"<bsdf type=\"roughdielectric\"><float name=\"alpha_u\" value=\"0.1\"/><float name=\"alpha_v\" value=\"-1\"/></bsdf>",
+       "alpha_v must be in (0, 4]"},
       {"<shape type=\"ply\"><string name=\"filename\" value=\"nope.ply\"/></shape>", "does not exist"},
       {"<shape type=\"sphere\"><float name=\"radius\" value=\"1.5x\"/></shape>", "'1.5x' is not a number"},
       {"<shape type=\"sphere\"><float name=\"radius\" valeu=\"1\"/></shape>", "unexpected attribute 'valeu'"},
@@ -199,6 +205,28 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
                               std::string(kSensor)))
                 .find("PLY file"),
             std::string::npos);
+}
+
+// Mitsuba's alpha_u and alpha_v (conductors and dielectrics; rough plastic is isotropic only,
+// so there they are unknown properties, warned about).
+TEST(SceneLoader, AnisotropicRoughness) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <shape type="sphere"><bsdf type="roughconductor"><float name="alpha_u" value="0.05"/><float name="alpha_v" value="0.3"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="roughdielectric"><float name="alpha_v" value="0.2"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="roughplastic"><float name="alpha_u" value="0.2"/></bsdf></shape>)"),
+            {}, s);
+  const Bsdf &c = s.bsdfs[size_t(s.shapes[0].bsdf)], &d = s.bsdfs[size_t(s.shapes[1].bsdf)],
+             &p = s.bsdfs[size_t(s.shapes[2].bsdf)];
+  EXPECT_TRUE(bsdfIsAnisotropic(c));
+  EXPECT_NEAR(c.alpha, 0.05f, 1e-7f);
+  EXPECT_NEAR(c.alphaV, 0.3f, 1e-7f);
+  EXPECT_NEAR(microfacet(c).alphaY, 0.3f, 1e-7f);
+  EXPECT_NEAR(d.alpha, 0.1f, 1e-7f) << "alpha_u defaults to 0.1, as in Mitsuba";
+  EXPECT_NEAR(d.alphaV, 0.2f, 1e-7f);
+  EXPECT_FALSE(bsdfIsAnisotropic(p));
+  EXPECT_NEAR(p.alpha, 0.1f, 1e-7f);
 }
 
 TEST(SceneLoader, HarmlessUnsupportedElementsOnlyWarn) {
