@@ -19,6 +19,7 @@ struct MeshView {
   int triangleCount = 0;
   int bsdf = 0;
   int lightOffset = -1;  // index of triangle 0 in the light list, -1 when not emissive
+  bool anisotropic = false;  // its material is: hits then build their frame along dp/du
 };
 
 struct SphereView {
@@ -88,7 +89,7 @@ struct SceneView {
       si.ng = ng;
       si.uv = m.uvs ? m.uvs[i0] * b0 + m.uvs[i1] * b1 + m.uvs[i2] * b2 : Vec2f(b1, b2);
       si.shading = Frame::fromNormal(ns);
-      if (bsdfIsAnisotropic(bsdfs[m.bsdf])) {
+      if (m.anisotropic) {
         // dp/du from the triangle's (u, v), the barycentric ones where the mesh has none.
         Vec2f t0 = m.uvs ? m.uvs[i0] : Vec2f(0.f, 0.f), t1 = m.uvs ? m.uvs[i1] : Vec2f(1.f, 0.f),
               t2 = m.uvs ? m.uvs[i2] : Vec2f(0.f, 1.f);
