@@ -27,7 +27,8 @@ ENVGI_INLINE bool isDiffuseLike(const Bsdf& b, float glossyThreshold) {
     case BsdfType::RoughPlastic: return true;
     // Rough glass is followed like glass: its light comes mostly through it, which irradiance
     // on its surface cannot stand for.
-    case BsdfType::RoughConductor: return b.alpha >= glossyThreshold;
+    // An anisotropic one must be rough both ways: sharp along one axis, it still mirrors.
+    case BsdfType::RoughConductor: return fminf(b.alpha, microfacet(b).alphaY) >= glossyThreshold;
     case BsdfType::Conductor:
     case BsdfType::Dielectric:
     case BsdfType::ThinDielectric:

@@ -363,3 +363,22 @@ TEST(PhotonEmission, ConstantSkyDeliversPiLAToAPlane) {
   std::printf("arrived %.4f (expected %.4f)\n", arrived, expected);
   EXPECT_NEAR(arrived, expected, 0.02 * expected);
 }
+
+// Which materials a photon estimate stands in for: a rough conductor only where it is rough
+// both ways (an anisotropic one sharp along either axis is followed like a mirror).
+TEST(SpecularChain, AnisotropicConductorIsDiffuseLikeOnlyWhenRoughBothWays) {
+  Bsdf b;
+  b.type = BsdfType::RoughConductor;
+  b.alpha = 0.5f;
+  EXPECT_TRUE(isDiffuseLike(b, 0.3f));
+  b.alphaV = 0.05f;
+  EXPECT_FALSE(isDiffuseLike(b, 0.3f));
+  b.alpha = 0.05f;
+  b.alphaV = 0.5f;
+  EXPECT_FALSE(isDiffuseLike(b, 0.3f));
+  b.alpha = 0.4f;
+  EXPECT_TRUE(isDiffuseLike(b, 0.3f));
+  b.alpha = 0.1f;
+  b.alphaV = -1.f;
+  EXPECT_FALSE(isDiffuseLike(b, 0.3f));
+}
