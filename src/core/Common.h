@@ -7,9 +7,13 @@
 #if defined(__CUDACC__)
 #define ENVGI_HD __host__ __device__
 #define ENVGI_INLINE __host__ __device__ __forceinline__
+// Host and device, and one copy on the device: for rare, long paths that every kernel would
+// otherwise inline (Beckmann's sampling loop), which grows every GPU binary.
+#define ENVGI_HD_NOINLINE __host__ __device__ __noinline__
 #else
 #define ENVGI_HD
 #define ENVGI_INLINE inline
+#define ENVGI_HD_NOINLINE
 #endif
 
 namespace envgi {

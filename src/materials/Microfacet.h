@@ -44,11 +44,7 @@ struct MicrofacetDistribution {
     float a2tan2;
     if (alphaX == alphaY) a2tan2 = alphaX * alphaX * ((w.x * w.x + w.y * w.y) / cos2);
     else a2tan2 = (sqr(alphaX * w.x) + sqr(alphaY * w.y)) / cos2;
-    if (type == MicrofacetType::Beckmann) {
-      if (a2tan2 <= 0.f) return 0.f;
-      float a = 1.f / std::sqrt(a2tan2);  // 1 / (alpha tan theta)
-      return fmaxf(0.f, 0.5f * (std::exp(-a * a) / (a * 1.7724538509f) - std::erfc(a)));
-    }
+    if (type == MicrofacetType::Beckmann) return beckmannLambda(a2tan2);
     return 0.5f * (std::sqrt(1.f + a2tan2) - 1.f);
   }
   ENVGI_HD float G1(Vec3f w) const { return 1.f / (1.f + lambda(w)); }
@@ -68,6 +64,14 @@ struct MicrofacetDistribution {
   }
 
  private:
+  // Out of line on the device, as sampleVisibleBeckmann: erfc is long, and lambda is inlined
+  // into every BSDF evaluation of every kernel.
+  ENVGI_HD_NOINLINE static float beckmannLambda(float a2tan2) {
+    if (a2tan2 <= 0.f) return 0.f;
+    float a = 1.f / std::sqrt(a2tan2);  // 1 / (alpha tan theta)
+    return fmaxf(0.f, 0.5f * (std::exp(-a * a) / (a * 1.7724538509f) - std::erfc(a)));
+  }
+
   ENVGI_HD Vec3f sampleVisibleGgx(Vec3f w, Vec2f u) const {
     Vec3f wh = normalize(Vec3f(alphaX * w.x, alphaY * w.y, w.z));
     if (wh.z < 0.f) wh = -wh;
@@ -109,7 +113,7 @@ struct MicrofacetDistribution {
     return erfInv(b);
   }
 
-  ENVGI_HD Vec3f sampleVisibleBeckmann(Vec3f w, Vec2f u) const {
+  ENVGI_HD_NOINLINE Vec3f sampleVisibleBeckmann(Vec3f w, Vec2f u) const {
     if (w.z < 0.f) w = -w;
     Vec3f wh = normalize(Vec3f(alphaX * w.x, alphaY * w.y, fmaxf(w.z, 1e-7f)));
     float sinTheta = std::sqrt(wh.x * wh.x + wh.y * wh.y);
