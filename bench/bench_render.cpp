@@ -82,8 +82,7 @@ struct Fixture {
       for (int x = 0; x < cam.width; ++x)
         for (uint32_t s = 0; s < 4; ++s) {
           smp.start(uint64_t(y) * cam.width + x, s);
-          Vec2f off = sampleFilter(cam.filter, smp.get2D());
-          pathTrace(scene.view(), tr, cam.generateRay(x + 0.5f + off.x, y + 0.5f + off.y), smp, pp, &rays);
+          pathTrace(scene.view(), tr, sampleCameraRay(cam, smp, x, y), smp, pp, &rays);
         }
   }
 };

@@ -117,9 +117,7 @@ ENVGI_HD uint64_t sppmCameraStep(const SceneView& sc, const Tracer& tracer, cons
   smp.type = SamplerType::Independent;
   smp.seed = s.seed;
   smp.start(uint64_t(i), uint32_t(pass));
-  Vec2f off = sampleFilter(cam.filter, smp.get2D());
-  Vec2f lens = cam.hasLens() ? smp.get2D() : Vec2f(0.5f, 0.5f);
-  Ray ray = cam.generateRay(float(i % cam.width) + 0.5f + off.x, float(i / cam.width) + 0.5f + off.y, lens);
+  Ray ray = sampleCameraRay(cam, smp, i % cam.width, i / cam.width);
   Color L(0.f);
   uint64_t rays = 0;
   VisiblePoint vp = sppmCameraPath(sc, tracer, ray, smp, s.maxDepth, s.strategy, &L, &rays);

@@ -98,9 +98,7 @@ ENVGI_HD inline Sampler sequenceSampler(const SampleSequence& seq) {
 // camera ray. The same (pixel, sample) gives the same sample on any device.
 ENVGI_HD inline Ray startCameraSample(const Camera& cam, Sampler& smp, int x, int y, int s) {
   smp.start(uint64_t(y) * uint64_t(cam.width) + uint64_t(x), uint32_t(s));
-  Vec2f off = sampleFilter(cam.filter, smp.get2D());
-  Vec2f lens = cam.hasLens() ? smp.get2D() : Vec2f(0.5f, 0.5f);  // a pinhole keeps its sequence
-  return cam.generateRay(float(x) + 0.5f + off.x, float(y) + 0.5f + off.y, lens);
+  return sampleCameraRay(cam, smp, x, y);
 }
 
 // Whether a sample's radiance goes into the film; NaN, infinite or negative ones are counted

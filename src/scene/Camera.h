@@ -76,4 +76,13 @@ ENVGI_INLINE Vec2f sampleFilter(FilterType f, Vec2f u) {
   return {r * std::cos(phi), r * std::sin(phi)};
 }
 
+// A camera ray for pixel (x, y) from a sampler's next draws: the filter's offset, then the
+// point on the lens, which a pinhole does not draw (so its sequence stays as it was).
+template <class Smp>
+ENVGI_HD Ray sampleCameraRay(const Camera& cam, Smp& smp, int x, int y) {
+  Vec2f off = sampleFilter(cam.filter, smp.get2D());
+  Vec2f lens = cam.hasLens() ? smp.get2D() : Vec2f(0.5f, 0.5f);
+  return cam.generateRay(float(x) + 0.5f + off.x, float(y) + 0.5f + off.y, lens);
+}
+
 }  // namespace envgi
