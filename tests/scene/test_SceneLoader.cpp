@@ -99,6 +99,12 @@ TEST(SceneLoader, SensorFilmSamplerIntegrator) {
   std::string noRadius = kSensor;
   noRadius.replace(noRadius.find(persp), persp.size(), "type=\"thinlens\">");
   EXPECT_NE(loadError(f.scene(noRadius)).find("thinlens needs an 'aperture_radius'"), std::string::npos);
+  std::string negative = lens;
+  negative.replace(negative.find("value=\"0.1\""), 11, "value=\"-0.1\"");
+  EXPECT_NE(loadError(f.scene(negative)).find("aperture_radius must be >= 0"), std::string::npos);
+  std::string unfocused = focused;
+  unfocused.replace(unfocused.find("value=\"3.5\""), 11, "value=\"0\"");
+  EXPECT_NE(loadError(f.scene(unfocused)).find("focus_distance must be positive"), std::string::npos);
 }
 
 TEST(SceneLoader, ShapesBsdfsEmittersTransformsDefaults) {
