@@ -76,7 +76,8 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
     }
   }
   if (pp.maxDepth >= 0 && depth >= pp.maxDepth) return false;
-  const Bsdf bsdf = sc.bsdfAt(si);
+  Bsdf textured;
+  const Bsdf& bsdf = sc.bsdfAt(si, &textured);
   Vec3f woLocal = si.shading.toLocal(wo);
   Vec3f axis = envSamplingAxis(si, wo, bsdf);
 
