@@ -129,6 +129,11 @@ int main(int argc, char** argv) {
   std::string why;
   int gpus = gpu::deviceCount(&why);
   if (gpus == 0) std::printf("no CUDA device (%s): CPU figures only\n", why.c_str());
+  if (gpus > 0) {
+    gpu::KernelOccupancy o = gpu::pathKernelOccupancy(0);
+    std::printf("path kernel: %d registers a thread, %d blocks of %d threads an SM\n", o.registers, o.blocksPerSM,
+                o.threadsPerBlock);
+  }
   std::vector<Row> rows;
   std::vector<SppmRow> sppmRows;
   std::vector<std::pair<std::string, double>> mapRows;  // device, M photons emitted a second

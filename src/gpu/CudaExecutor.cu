@@ -60,6 +60,18 @@ void selectDevice(int gpu) {
                  deviceName(gpu), major, minor, major, minor);
 }
 
+KernelOccupancy pathKernelOccupancy(int gpu) {
+  selectDevice(gpu);
+  auto kernel = regenKernel<SampleIntegrator<BvhTracer>>;
+  cudaFuncAttributes a;
+  check(cudaFuncGetAttributes(&a, kernel), "reading the render kernel's attributes");
+  KernelOccupancy o;
+  o.registers = a.numRegs;
+  o.threadsPerBlock = kRegenBlock;
+  check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&o.blocksPerSM, kernel, kRegenBlock, 0), "sizing the render kernel");
+  return o;
+}
+
 std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene& scene, const Bvh& bvh, const KernelSettings& k, int gpu,
                                                bool keepVariance, size_t* deviceBytes) {
   selectDevice(gpu);

@@ -29,6 +29,9 @@ __global__ void passKernel(Integrator integ, Camera cam, SampleSequence seq, int
   if (pc.dropped) atomicAdd(dropped, (unsigned long long)pc.dropped);
 }
 
+// Threads a block of regenKernel.
+constexpr int kRegenBlock = 128;
+
 // The pass by path regeneration (PixelKernel.h's regeneratePaths): as many threads as the GPU
 // holds at once, each taking (pixel, sample) items from counters[2] as its paths end. A warp's
 // lanes that need work take consecutive items with one atomic.
@@ -138,7 +141,6 @@ class CudaPassExecutor final : public PassExecutor {
   Integrator integ_;
   FilmView film_;
   unsigned long long* counters_ = nullptr;  // rays, dropped samples, regeneration's next item
-  static constexpr int kRegenBlock = 128;
   int regenBlocks_ = 0;  // > 0: passes by path regeneration, this many blocks
 };
 

@@ -16,6 +16,8 @@ std::pair<int, int> computeCapability(int) { return {0, 0}; }
 
 bool hasMachineCodeFor(int, int) { return false; }
 
+KernelOccupancy pathKernelOccupancy(int) { return {}; }
+
 void selectDevice(int) { throw std::runtime_error("no CUDA device: this envgi was built without CUDA"); }
 
 std::unique_ptr<PassExecutor> makeCudaSppmExecutor(const Scene&, const Bvh&, const SppmParams&, const PhotonEmitter&, int,
