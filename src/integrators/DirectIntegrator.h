@@ -23,7 +23,7 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
                               Sampler& smp, EnvStrategy strategy, int emitterSamples, int bsdfSamples,
                               uint64_t* rayCount, bool skipDelta = false) {
   Color L(0.f);
-  Bsdf textured;
+  BsdfScratch textured;
   const Bsdf& bsdf = sc.bsdfAt(si, &textured);
   Vec3f woLocal = si.shading.toLocal(wo);
   Vec3f axis = envSamplingAxis(si, wo, bsdf);

@@ -48,7 +48,7 @@ ENVGI_HD Color gridGather(const SceneView& sc, const Tracer& tracer, Ray ray, Sa
     ++*rays;
     if (!tracer.intersect(ray, &h)) return Color(0.f);
     SurfaceInteraction si = sc.interaction(ray, h);
-    Bsdf textured;
+    BsdfScratch textured;
     const Bsdf& bsdf = sc.bsdfAt(si, &textured);
     if (depth == 0 && dot(si.ng, ray.d) > 0.f && !bsdf.twoSided && !bsdfTransmits(bsdf)) {
       *backFace = true;

@@ -76,7 +76,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
     }
   }
   if (pp.maxDepth >= 0 && depth >= pp.maxDepth) return false;
-  Bsdf textured;
+  BsdfScratch textured;
   const Bsdf& bsdf = sc.bsdfAt(si, &textured);
   Vec3f woLocal = si.shading.toLocal(wo);
   Vec3f axis = envSamplingAxis(si, wo, bsdf);

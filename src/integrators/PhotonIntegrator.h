@@ -26,7 +26,7 @@ Color photonTrace(const SceneView& sc, const Tracer& tracer, const Ray& ray, Sam
     // Final gather: indirect light from the global map one bounce away. Where a gather ray
     // meets a specular surface its light is left out (caustic paths are in the caustic map;
     // light bouncing diffusely and then through glass onto here is lost).
-    Bsdf textured;
+    BsdfScratch textured;
     const Bsdf& bsdf = sc.bsdfAt(si, &textured);
     Vec3f woLocal = si.shading.toLocal(wo);
     Color gather(0.f);

@@ -77,7 +77,7 @@ ENVGI_HD Color traceSpecularChain(const SceneView& sc, const Tracer& tracer, Ray
     SurfaceInteraction si = sc.interaction(ray, h);
     Vec3f wo = -ray.d;
     if (countEmission) L += beta * sc.emitted(si, wo);
-    Bsdf textured;
+    BsdfScratch textured;
     const Bsdf& bsdf = sc.bsdfAt(si, &textured);
     // Smooth plastic's coat is a mirror: follow it with its sampling probability (what it
     // reflects may be lit, not emitting), and estimate the base here otherwise.

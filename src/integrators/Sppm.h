@@ -42,7 +42,7 @@ ENVGI_HD VisiblePoint sppmCameraPath(const SceneView& sc, const Tracer& tracer, 
     SurfaceInteraction si = sc.interaction(ray, h);
     Vec3f wo = -ray.d;
     *Ld += beta * sc.emitted(si, wo);
-    Bsdf textured;
+    BsdfScratch textured;
     const Bsdf& bsdf = sc.bsdfAt(si, &textured);
     // Smooth plastic's coat is a mirror: follow it with its sampling probability (what it
     // reflects may be lit, not emitting), and make the visible point on the base otherwise.

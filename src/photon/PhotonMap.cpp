@@ -80,7 +80,7 @@ void PhotonMap::endIrradiance() {
 
 Color PhotonMap::estimate(const SceneView& sc, const SurfaceInteraction& si, Vec3f woWorld, const PhotonLookup& q) const {
   if (!index_ || q.k <= 0) return Color(0.f);
-  Bsdf textured;
+  BsdfScratch textured;
   const Bsdf& bsdf = sc.bsdfAt(si, &textured);
   Vec3f woLocal = si.shading.toLocal(woWorld);
   size_t k = size_t(q.k);

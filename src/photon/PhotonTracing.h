@@ -77,7 +77,7 @@ ENVGI_HD int tracePhoton(const SceneView& sc, const Tracer& tracer, Ray ray, Col
     Hit h;
     if (!tracer.intersect(ray, &h)) break;
     SurfaceInteraction si = sc.interaction(ray, h);
-    Bsdf textured;
+    BsdfScratch textured;
     const Bsdf& bsdf = sc.bsdfAt(si, &textured);
     Vec3f wi = -ray.d;
     if (!bsdfIsDelta(bsdf) && depth > 0) {

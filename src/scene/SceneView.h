@@ -1,6 +1,8 @@
 // The scene as plain data that kernels read: meshes, spheres, materials, lights, camera.
 #pragma once
 
+#include <new>
+
 #include "core/Atan2.h"
 #include "core/Frame.h"
 #include "envmap/EnvironmentMapView.h"
@@ -47,6 +49,12 @@ struct SurfaceInteraction {
   int bsdf = 0;
   int light = -1;
   float t = 0.f;
+};
+
+// Room for a textured material's copy at a hit, left unwritten where the material has no
+// texture (a Bsdf would store its defaults there at every hit).
+struct BsdfScratch {
+  alignas(Bsdf) unsigned char bytes[sizeof(Bsdf)];
 };
 
 struct SceneView {
@@ -144,11 +152,10 @@ struct SceneView {
   // The same, without a copy where the material has no texture: the scene's own entry, read a
   // field at a time where used. A copy kept whole through a bounce held ~40 more registers a
   // GPU thread, a third of the path kernel's occupancy. `scratch` holds a textured copy.
-  ENVGI_HD const Bsdf& bsdfAt(const SurfaceInteraction& si, Bsdf* scratch) const {
+  ENVGI_HD const Bsdf& bsdfAt(const SurfaceInteraction& si, BsdfScratch* scratch) const {
     const Bsdf& b = bsdfs[si.bsdf];
     if (!bsdfHasTexture(b)) return b;
-    *scratch = bsdfAt(si.bsdf, si.uv);
-    return *scratch;
+    return *new (scratch->bytes) Bsdf(bsdfAt(si.bsdf, si.uv));
   }
 
   // What interaction() reads for a triangle hit, asked for ahead (CPU only: a batch of hits
