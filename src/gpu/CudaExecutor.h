@@ -29,7 +29,7 @@ std::pair<int, int> computeCapability(int gpu);
 bool hasMachineCodeFor(int major, int minor);
 
 // The path/direct kernel's registers a thread and its resident blocks an SM on device `gpu`
-// (path regeneration's launch); {0, 0} without CUDA. Registers decide the GPU's occupancy: a
+// (path regeneration's launch); zeros without CUDA. Registers decide the GPU's occupancy: a
 // material copied whole through a bounce once took the kernel from 4 blocks an SM to 3.
 struct KernelOccupancy {
   int registers = 0, blocksPerSM = 0, threadsPerBlock = 0;
