@@ -51,6 +51,15 @@ __global__ void regenKernel(Integrator integ, Camera cam, SampleSequence seq, in
   if (pc.dropped) atomicAdd(counters + 1, (unsigned long long)pc.dropped);
 }
 
+// Blocks of kRegenBlock threads of regenKernel<Integrator> that one SM holds at once.
+template <class Integrator>
+int regenBlocksPerSM() {
+  int perSM = 0;
+  check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perSM, regenKernel<Integrator>, kRegenBlock, 0),
+        "sizing the render kernel");
+  return perSM;
+}
+
 template <class Integrator>
 class CudaPassExecutor final : public PassExecutor {
  public:
@@ -74,11 +83,9 @@ class CudaPassExecutor final : public PassExecutor {
       // drew 1.65x the samples a second on the Buddha and 1.45x on the dragon (docs/gpu.md).
       const char* e = std::getenv("ENVGI_GPU_REGEN");
       if (!(e && std::strcmp(e, "0") == 0)) {
-        int perSM = 0, sms = 0;
-        check(cudaOccupancyMaxActiveBlocksPerMultiprocessor(&perSM, regenKernel<Integrator>, kRegenBlock, 0),
-              "sizing the render kernel");
+        int sms = 0;
         check(cudaDeviceGetAttribute(&sms, cudaDevAttrMultiProcessorCount, gpu_), "sizing the render kernel");
-        regenBlocks_ = std::max(1, perSM * sms);
+        regenBlocks_ = std::max(1, regenBlocksPerSM<Integrator>() * sms);
       }
     }
   }

@@ -17,7 +17,7 @@ ENVGI_HD Color gatherHitRadiance(const SceneView& sc, const Tracer& tracer, cons
                                  const IrradianceCacheView& caustic, uint64_t* rays) {
   Vec3f ny = faceForward(gs.ng, -wi);
   return directLighting(sc, tracer, gs, -wi, smp, strategy, 1, 0, rays) +
-         diffuseAlbedo(sc.bsdfAt(gs)) * kInvPi * (global.irradiance(gs.p, ny) + caustic.irradiance(gs.p, ny));
+         diffuseAlbedo(sc.bsdfAt(gs.bsdf, gs.uv)) * kInvPi * (global.irradiance(gs.p, ny) + caustic.irradiance(gs.p, ny));
 }
 
 }  // namespace envgi

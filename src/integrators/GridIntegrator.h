@@ -26,7 +26,7 @@ ENVGI_HD Color gridTrace(const SceneView& sc, const Tracer& tracer, const Ray& r
   auto estimate = [&](const SurfaceInteraction& si, Vec3f wo, Sampler&, uint64_t*) {
     Vec3f n = faceForward(si.shading.n, wo);
     Color E = grid.irradiance(si.p, n) + causticIrradiance(si.p, faceForward(si.ng, wo));
-    return diffuseAlbedo(sc.bsdfAt(si)) * kInvPi * E;
+    return diffuseAlbedo(sc.bsdfAt(si.bsdf, si.uv)) * kInvPi * E;
   };
   return traceSpecularChain(sc, tracer, ray, smp, gp.chain, estimate, rays);
 }

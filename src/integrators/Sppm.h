@@ -73,7 +73,8 @@ ENVGI_HD VisiblePoint sppmCameraPath(const SceneView& sc, const Tracer& tracer, 
 
 // A photon's contribution f(wo, wi) beta_vp Phi at one visible point within its radius.
 ENVGI_INLINE Color sppmContribution(const SceneView& sc, const VisiblePoint& vp, Vec3f wi, Color power) {
-  const Bsdf b = sc.bsdfAt(vp.bsdf, vp.uv);
+  BsdfScratch textured;
+  const Bsdf& b = sc.bsdfAt(vp.bsdf, vp.uv, &textured);
   Vec3f wiLocal = vp.shading.toLocal(wi);
   float c = std::fabs(wiLocal.z);
   if (c <= 0.f) return Color(0.f);

@@ -231,7 +231,8 @@ TEST(Furnace, TexturedEnclosureGivesItsAnalyticRadiance) {
             h.primId = 0;
             r.d = normalize(r.d);
             r.o = Vec3f(0.f);
-            Color rho = v.bsdfAt(v.interaction(r, h)).reflectance;
+            SurfaceInteraction si = v.interaction(r, h);
+            Color rho = v.bsdfAt(si.bsdf, si.uv).reflectance;
             int sq = rho.x > 0.5f ? 0 : 1;
             square = square == -1 || square == sq ? sq : 2;
           }
