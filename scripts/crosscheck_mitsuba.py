@@ -67,6 +67,13 @@ def bsdfs():
         out.append((f'roughdielectric aniso 0.05 0.4 {d}',
                     f'<bsdf type="roughdielectric"><float name="int_ior" value="1.5"/><float name="alpha_u" value="0.05"/>'
                     f'<float name="alpha_v" value="0.4"/><string name="distribution" value="{d}"/></bsdf>'))
+    # Textured anisotropy: alpha_u and alpha_v from checkerboards of opposite phase.
+    checks = ('<texture type="checkerboard" name="{}"><rgb name="color0" value="{}"/><rgb name="color1" value="{}"/>'
+              '<transform name="to_uv"><scale x="8" y="4"/></transform></texture>')
+    for d in ('ggx', 'beckmann'):
+        out.append((f'roughconductor aniso textured {d}',
+                    '<bsdf type="roughconductor"><string name="material" value="Au"/>' + checks.format('alpha_u', 0.6, 0.05)
+                    + checks.format('alpha_v', 0.05, 0.6) + f'<string name="distribution" value="{d}"/></bsdf>'))
     for r in (0.5, 1.0):
         out.append((f'plastic d {r}', f'<bsdf type="plastic"><rgb name="diffuse_reflectance" value="{r}"/></bsdf>'))
         for a in (0.1, 0.3):

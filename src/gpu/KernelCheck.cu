@@ -229,7 +229,9 @@ int main() try {
   sv.spheres = arena.upload(spheres, 2, "spheres");
   sv.sphereCount = 2;
   bsdfs[1].reflectanceTexture = int(views.size()) - 1;
-  bsdfs[0].alphaTexture = 0;
+  bsdfs[0].alphaTexture = 0;  // anisotropic, both roughnesses textured
+  bsdfs[0].alphaV = 0.1f;
+  bsdfs[0].alphaVTexture = 0;
   sv.bsdfs = arena.upload(bsdfs, 2, "materials");
   sv.textures = dViews;
   sv.hasEnvironment = true;

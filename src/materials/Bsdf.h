@@ -42,7 +42,8 @@ struct Bsdf {
   float specularSamplingWeight = 0.5f;   // plastic: share of samples given to the coating
   // Textures replacing the values above at a hit (SceneView::bsdfAt); -1: none.
   int reflectanceTexture = -1, specularReflectanceTexture = -1, specularTransmittanceTexture = -1;
-  int alphaTexture = -1;  // read as its luminance, as Mitsuba reads a colour texture as a float
+  int alphaTexture = -1;   // alpha (alpha_u), read as its luminance, as Mitsuba reads a colour as a float
+  int alphaVTexture = -1;  // alphaV (alpha_v), the same way
 };
 
 struct BsdfSample {
@@ -69,7 +70,7 @@ ENVGI_INLINE MicrofacetDistribution microfacet(const Bsdf& b) {
 
 ENVGI_INLINE bool bsdfHasTexture(const Bsdf& b) {
   return b.reflectanceTexture >= 0 || b.specularReflectanceTexture >= 0 || b.specularTransmittanceTexture >= 0 ||
-         b.alphaTexture >= 0;
+         b.alphaTexture >= 0 || b.alphaVTexture >= 0;
 }
 
 // True when every lobe is a delta: next-event estimation is pointless there.

@@ -617,27 +617,26 @@ class Loader {
         b.perfectMirror = false;
       }
       b.specularReflectance = getColor(f, p, "specular_reflectance", Color(1.f));
-      if (type == "roughconductor") roughness(f, n, p, b, type);
+      if (type == "roughconductor") roughness(f, n, p, textures, b, type);
     } else if (type == "dielectric" || type == "thindielectric" || type == "roughdielectric") {
       b.type = type == "dielectric" ? BsdfType::Dielectric
                : type == "thindielectric" ? BsdfType::ThinDielectric : BsdfType::RoughDielectric;
       b.ior = getIor(f, p, "int_ior", 1.5046f) / getIor(f, p, "ext_ior", extIor);
       b.specularReflectance = getColor(f, p, "specular_reflectance", Color(1.f));
       b.specularTransmittance = getColor(f, p, "specular_transmittance", Color(1.f));
-      if (type == "roughdielectric") roughness(f, n, p, b, type);
+      if (type == "roughdielectric") roughness(f, n, p, textures, b, type);
     } else if (type == "plastic" || type == "roughplastic") {
       b.type = type == "plastic" ? BsdfType::Plastic : BsdfType::RoughPlastic;
       b.ior = getIor(f, p, "int_ior", 1.49f) / getIor(f, p, "ext_ior", extIor);
       b.reflectance = getColor(f, p, "diffuse_reflectance", Color(0.5f));
       b.specularReflectance = getColor(f, p, "specular_reflectance", Color(1.f));
       if (getBool(f, p, "nonlinear", false)) warnOnce(f->path + ": plastic 'nonlinear' is not supported (linear is used)");
-      if (type == "roughplastic") roughness(f, n, p, b, type);
+      if (type == "roughplastic") roughness(f, n, p, textures, b, type);
       finishPlastic(b);
     } else {
       fail(f, n, fmt::format("unknown BSDF type '{}'", type));
     }
     for (const auto& [name, tex] : textures) {
-      if (name == "alpha" && bsdfIsAnisotropic(b)) fail(f, tex.second, "give either alpha or alpha_u and alpha_v, not both");
       int* slot = textureSlot(b, name);
       if (!slot) {
         warnOnce(fmt::format("{}:{}: a texture for '{}' of bsdf '{}' is not supported; the property keeps its default",
@@ -675,6 +674,9 @@ class Loader {
     if (bsdfTransmits(b) && name == "specular_transmittance") return &b.specularTransmittanceTexture;
     bool rough = b.type == BsdfType::RoughConductor || b.type == BsdfType::RoughDielectric || b.type == BsdfType::RoughPlastic;
     if (rough && name == "alpha") return &b.alphaTexture;
+    // alpha_u is the anisotropic form's alpha; roughplastic has no anisotropic form (Mitsuba's).
+    if (rough && b.type != BsdfType::RoughPlastic && name == "alpha_u") return &b.alphaTexture;
+    if (rough && b.type != BsdfType::RoughPlastic && name == "alpha_v") return &b.alphaVTexture;
     return nullptr;
   }
 
@@ -741,7 +743,9 @@ class Loader {
     return int(scene_.textures.size() - 1);
   }
 
-  void roughness(const SourceFile* f, pugi::xml_node n, Props& p, Bsdf& b, const std::string& type) {
+  void roughness(const SourceFile* f, pugi::xml_node n, Props& p,
+                 const std::map<std::string, std::pair<int, pugi::xml_node>>& textures, Bsdf& b,
+                 const std::string& type) {
     // Mitsuba's default, for all three rough BSDFs, is Beckmann.
     std::string dist = getString(f, p, "distribution", "beckmann");
     if (dist == "beckmann") b.distribution = MicrofacetType::Beckmann;
@@ -752,9 +756,11 @@ class Loader {
       if (!(a > 0.f && a <= kMaxAlpha)) fail(f, n, fmt::format("{} must be in (0, 4]", name));
       return std::max(a, kMinAlpha);
     };
-    // Anisotropic conductors and dielectrics (Mitsuba's alpha_u, alpha_v: along dp/du, dp/dv).
-    if (type != "roughplastic" && (p.count("alpha_u") || p.count("alpha_v"))) {
-      if (p.count("alpha")) fail(f, n, "give either alpha or alpha_u and alpha_v, not both");
+    // Anisotropic conductors and dielectrics (Mitsuba's alpha_u, alpha_v: along dp/du, dp/dv),
+    // each a value or a texture (the texture then replaces the value at each hit).
+    auto given = [&](const char* name) { return p.count(name) > 0 || textures.count(name) > 0; };
+    if (type != "roughplastic" && (given("alpha_u") || given("alpha_v"))) {
+      if (given("alpha")) fail(f, n, "give either alpha or alpha_u and alpha_v, not both");
       b.alpha = checked("alpha_u");
       b.alphaV = checked("alpha_v");
     } else {

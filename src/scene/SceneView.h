@@ -146,6 +146,8 @@ struct SceneView {
       b.specularTransmittance = textureEval(textures[b.specularTransmittanceTexture], uv);
     if (b.alphaTexture >= 0)
       b.alpha = fminf(fmaxf(luminance(textureEval(textures[b.alphaTexture], uv)), kMinAlpha), kMaxAlpha);
+    if (b.alphaVTexture >= 0)
+      b.alphaV = fminf(fmaxf(luminance(textureEval(textures[b.alphaVTexture], uv)), kMinAlpha), kMaxAlpha);
     return b;
   }
   // The same, without a copy where the material has no texture: the scene's own entry, read a

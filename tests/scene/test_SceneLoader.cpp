@@ -235,6 +235,52 @@ TEST(SceneLoader, AnisotropicRoughness) {
   EXPECT_NEAR(p.alpha, 0.1f, 1e-7f);
 }
 
+// alpha_u and alpha_v as textures (Mitsuba's are textures too), each read as its luminance at
+// the hit, and a value beside a texture; alpha beside a textured alpha_u is still refused.
+TEST(SceneLoader, AnisotropicRoughnessTextured) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <texture type="checkerboard" id="checks"><rgb name="color0" value="0.3"/><rgb name="color1" value="0.05"/></texture>
+    <shape type="sphere"><bsdf type="roughconductor"><ref id="checks" name="alpha_u"/><float name="alpha_v" value="0.4"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="roughdielectric"><ref id="checks" name="alpha_v"/></bsdf></shape>)"),
+            {}, s);
+  const Bsdf &c = s.bsdfs[size_t(s.shapes[0].bsdf)], &d = s.bsdfs[size_t(s.shapes[1].bsdf)];
+  EXPECT_TRUE(bsdfIsAnisotropic(c));
+  EXPECT_TRUE(bsdfIsAnisotropic(d));
+  EXPECT_EQ(c.alphaTexture, 0);
+  EXPECT_EQ(c.alphaVTexture, -1);
+  EXPECT_EQ(d.alphaTexture, -1);
+  EXPECT_EQ(d.alphaVTexture, 0);
+  EXPECT_TRUE(bsdfHasTexture(d));
+  const SceneView& v = s.view();
+  // Checkerboard: color0 where u and v lie in the same half, color1 elsewhere.
+  Bsdf at = v.bsdfAt(s.shapes[0].bsdf, Vec2f(0.25f, 0.25f));
+  EXPECT_NEAR(at.alpha, 0.3f, 1e-5f);
+  EXPECT_NEAR(at.alphaV, 0.4f, 1e-7f);
+  EXPECT_NEAR(v.bsdfAt(s.shapes[0].bsdf, Vec2f(0.75f, 0.25f)).alpha, 0.05f, 1e-5f);
+  at = v.bsdfAt(s.shapes[1].bsdf, Vec2f(0.75f, 0.25f));
+  EXPECT_NEAR(at.alpha, 0.1f, 1e-7f) << "alpha_u keeps Mitsuba's default";
+  EXPECT_NEAR(at.alphaV, 0.05f, 1e-5f);
+  BsdfScratch scratch;
+  SurfaceInteraction si;
+  si.bsdf = s.shapes[1].bsdf;
+  si.uv = Vec2f(0.25f, 0.75f);
+  EXPECT_NEAR(v.bsdfAt(si, &scratch).alphaV, 0.05f, 1e-5f) << "the scratch form copies a textured alpha_v";
+
+  Scene bad;
+  try {
+    loadScene(f.scene(std::string(kSensor) + R"(
+      <shape type="sphere"><bsdf type="roughconductor"><float name="alpha" value="0.2"/>
+        <texture type="checkerboard" name="alpha_u"/></bsdf></shape>)"),
+              {}, bad);
+    FAIL() << "alpha beside a textured alpha_u loaded";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("give either alpha or alpha_u and alpha_v, not both"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(SceneLoader, HarmlessUnsupportedElementsOnlyWarn) {
   Fixture f;
   Scene s;
