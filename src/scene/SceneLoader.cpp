@@ -675,8 +675,9 @@ class Loader {
     bool rough = b.type == BsdfType::RoughConductor || b.type == BsdfType::RoughDielectric || b.type == BsdfType::RoughPlastic;
     if (rough && name == "alpha") return &b.alphaTexture;
     // alpha_u is the anisotropic form's alpha; roughplastic has no anisotropic form (Mitsuba's).
-    if (rough && b.type != BsdfType::RoughPlastic && name == "alpha_u") return &b.alphaTexture;
-    if (rough && b.type != BsdfType::RoughPlastic && name == "alpha_v") return &b.alphaVTexture;
+    bool anisotropicForm = b.type == BsdfType::RoughConductor || b.type == BsdfType::RoughDielectric;
+    if (anisotropicForm && name == "alpha_u") return &b.alphaTexture;
+    if (anisotropicForm && name == "alpha_v") return &b.alphaVTexture;
     return nullptr;
   }
 

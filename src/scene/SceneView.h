@@ -144,10 +144,10 @@ struct SceneView {
       b.specularReflectance = textureEval(textures[b.specularReflectanceTexture], uv);
     if (b.specularTransmittanceTexture >= 0)
       b.specularTransmittance = textureEval(textures[b.specularTransmittanceTexture], uv);
-    if (b.alphaTexture >= 0)
-      b.alpha = fminf(fmaxf(luminance(textureEval(textures[b.alphaTexture], uv)), kMinAlpha), kMaxAlpha);
-    if (b.alphaVTexture >= 0)
-      b.alphaV = fminf(fmaxf(luminance(textureEval(textures[b.alphaVTexture], uv)), kMinAlpha), kMaxAlpha);
+    // A roughness texture reads as its luminance, within the scene format's bounds (NaN: the lower).
+    auto roughness = [&](int t) { return fminf(fmaxf(luminance(textureEval(textures[t], uv)), kMinAlpha), kMaxAlpha); };
+    if (b.alphaTexture >= 0) b.alpha = roughness(b.alphaTexture);
+    if (b.alphaVTexture >= 0) b.alphaV = roughness(b.alphaVTexture);
     return b;
   }
   // The same, without a copy where the material has no texture: the scene's own entry, read a
