@@ -80,6 +80,11 @@ def bsdfs():
             out.append((f'roughplastic d {r} a {a}',
                         f'<bsdf type="roughplastic"><rgb name="diffuse_reflectance" value="{r}"/><float name="alpha" value="{a}"/>'
                         '<string name="distribution" value="ggx"/></bsdf>'))
+    # Mitsuba's default distribution, Beckmann, and a rougher GGX coat.
+    for r, a, d in ((1.0, 0.3, 'beckmann'), (0.5, 0.6, 'beckmann'), (1.0, 0.7, 'ggx')):
+        out.append((f'roughplastic d {r} a {a} {d}',
+                    f'<bsdf type="roughplastic"><rgb name="diffuse_reflectance" value="{r}"/><float name="alpha" value="{a}"/>'
+                    f'<string name="distribution" value="{d}"/></bsdf>'))
     return out
 
 THINLENS = ('<sensor type="thinlens"><float name="aperture_radius" value="0.2"/>'
@@ -87,11 +92,10 @@ THINLENS = ('<sensor type="thinlens"><float name="aperture_radius" value="0.2"/>
 
 # Where envgi is known to differ from Mitsuba (docs/validation.md says why): by design, or open.
 DESIGN = {
-    'roughplastic': 'envgi\'s rough plastic uses smooth Fresnel terms for its diffuse base, not Mitsuba\'s precomputed tables',
-    # The bundled scenes lit by Grace: rough-plastic objects (above), and the map's rows sit at
-    # v = j / (H - 1) in Mitsuba but at pixel centres in envgi, which shifts sharp features.
-    'buddha': 'open: env-map row placement (Mitsuba v = j/(H-1), envgi pixel centres); rough-plastic Buddha',
-    'teapot-glass': 'open: env-map row placement (Mitsuba v = j/(H-1), envgi pixel centres); rough-plastic teapot',
+    # The bundled scenes lit by Grace: the map's rows sit at v = j / (H - 1) in Mitsuba but at
+    # pixel centres in envgi, which shifts sharp features.
+    'buddha': 'open: env-map row placement (Mitsuba v = j/(H-1), envgi pixel centres)',
+    'teapot-glass': 'open: env-map row placement (Mitsuba v = j/(H-1), envgi pixel centres)',
     # Its floor alone (no spheres) under the studio map differs by -0.4% (z -10 at 8 x 128 spp),
     # the row placement; the spheres' distributions are checked by the Beckmann furnace rows.
     'microfacets': 'open: env-map row placement (Mitsuba v = j/(H-1), envgi pixel centres), on the floor',

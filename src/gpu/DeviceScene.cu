@@ -1,5 +1,7 @@
 #include "gpu/DeviceScene.h"
 
+#include <map>
+
 namespace envgi::gpu {
 
 EnvironmentMapView uploadEnvironment(DeviceArena& a, EnvironmentMapView v) {
@@ -52,7 +54,18 @@ DeviceScene::DeviceScene(const Scene& scene, const Bvh& hostBvh) {
   }
   view.meshes = arena.upload(meshes.data(), meshes.size(), "meshes");
   view.spheres = arena.upload(hv.spheres, size_t(hv.sphereCount), "spheres");
-  view.bsdfs = arena.upload(hv.bsdfs, scene.bsdfs.size(), "materials");
+  // Rough plastics point at their coat's tables on the host: upload each table once.
+  std::vector<Bsdf> bsdfs(hv.bsdfs, hv.bsdfs + scene.bsdfs.size());
+  std::map<const float*, const float*> coats;
+  for (Bsdf& b : bsdfs) {
+    const float* table = bsdfCoatTable(b);
+    if (b.coatNodes == 0 || !table) continue;
+    auto it = coats.find(table);
+    if (it == coats.end())
+      it = coats.emplace(table, arena.upload(table, size_t(b.coatNodes) * kCoatStride, "rough plastic tables")).first;
+    setBsdfCoatTable(b, it->second);
+  }
+  view.bsdfs = arena.upload(bsdfs.data(), bsdfs.size(), "materials");
   std::vector<TextureView> textures(hv.textures, hv.textures + scene.textures.size());
   for (TextureView& t : textures)
     if (t.texels) t.texels = arena.upload(t.texels, size_t(t.width) * size_t(t.height), "texture texels");

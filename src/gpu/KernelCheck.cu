@@ -9,6 +9,7 @@
 
 #include "envmap/EnvironmentMap.h"
 #include "gpu/DeviceScene.h"
+#include "materials/BsdfFactory.h"
 #include "integrators/DirectIntegrator.h"
 #include "integrators/PathIntegrator.h"
 #include "sampling/Mis.h"
@@ -47,7 +48,9 @@ __global__ void envmapKernel(EnvironmentMapView env, int n, CheckResult* out) {
 
 // Every BSDF (both microfacet distributions) evaluated and sampled, and camera rays generated:
 // run on the device and on the host, to be compared.
-ENVGI_HD float bsdfCameraValue(const Camera& cam, int i) {
+// coat: a rough plastic's tables over all roughnesses (device or host copy, as the caller
+// runs), which every other rough plastic case reads.
+ENVGI_HD float bsdfCameraValue(const Camera& cam, int i, const float* coat) {
   Pcg32 rng(uint64_t(i), 3u);
   Bsdf b;
   b.type = BsdfType(i % 8);
@@ -55,6 +58,10 @@ ENVGI_HD float bsdfCameraValue(const Camera& cam, int i) {
   b.twoSided = (i / 8) % 2 == 1;
   b.distribution = MicrofacetType((i / 16) % 2);
   if ((i / 32) % 2 == 1) b.alphaV = 0.05f;  // anisotropic
+  if (b.type == BsdfType::RoughPlastic && (i / 64) % 2 == 1) {
+    setBsdfCoatTable(b, coat);
+    b.coatNodes = kCoatAlphaNodes;
+  }
   Vec3f wo = normalize(Vec3f(0.3f, 0.2f, (i % 3 == 0) ? -0.8f : 0.8f));
   // Draws into named values: the order in which a call's arguments are evaluated is the
   // compiler's choice, and g++ and nvcc's device side choose differently.
@@ -68,9 +75,9 @@ ENVGI_HD float bsdfCameraValue(const Camera& cam, int i) {
   Vec2f off = sampleFilter(FilterType(i % 3), Vec2f(u[3], u[4]));
   return acc + r.d.z + off.x;
 }
-__global__ void bsdfCameraKernel(Camera cam, int n, float* out) {
+__global__ void bsdfCameraKernel(Camera cam, int n, const float* coat, float* out) {
   int i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < n) out[i] = bsdfCameraValue(cam, i);
+  if (i < n) out[i] = bsdfCameraValue(cam, i, coat);
 }
 
 // Textures looked up on the device, for comparison with the same lookups on the host.
@@ -170,14 +177,19 @@ int main() try {
   cam.tanHalfX = cam.tanHalfY = 0.5f;
   float* dB = nullptr;
   cudaMalloc(&dB, sizeof(float) * n);
-  bsdfCameraKernel<<<(n + 255) / 256, 256>>>(cam, n, dB);
+  int coatNodes = 0;
+  const float* coat = roughCoatTable(0.f, 1.49f, MicrofacetType::GGX, true, &coatNodes);
+  float* dCoat = nullptr;
+  cudaMalloc(&dCoat, sizeof(float) * coatNodes * kCoatStride);
+  cudaMemcpy(dCoat, coat, sizeof(float) * coatNodes * kCoatStride, cudaMemcpyHostToDevice);
+  bsdfCameraKernel<<<(n + 255) / 256, 256>>>(cam, n, dCoat, dB);
   checkLaunch("bsdfCameraKernel");
   std::vector<float> bres(n);
   cudaMemcpy(bres.data(), dB, sizeof(float) * n, cudaMemcpyDeviceToHost);
   int bad = 0, bsdfMismatches = 0;
   for (int i = 0; i < n; ++i) {
     bad += !std::isfinite(bres[i]);
-    float h = bsdfCameraValue(cam, i);
+    float h = bsdfCameraValue(cam, i, coat);
     // Device exp, log and erf differ from the host's by ulps, which a sample may amplify.
     if (std::fabs(h - bres[i]) > 1e-3f * fmaxf(1.f, std::fabs(h)) && ++bsdfMismatches <= 5)
       std::printf("envgi_cuda_check: BSDF/camera case %d (type %d): CPU %.7g, GPU %.7g\n", i, i % 8, h, bres[i]);
@@ -248,6 +260,7 @@ int main() try {
   std::printf("envgi_cuda_check: BSDF/camera/integrator kernels: %d non-finite results, %s\n", bad,
               cudaGetErrorString(err));
   cudaFree(dB);
+  cudaFree(dCoat);
   cudaFree(dC);
   cudaFree(dOut);
   if (bad > 0 || err != cudaSuccess) return 1;

@@ -45,7 +45,13 @@ ENVGI_INLINE Color diffuseAlbedo(const Bsdf& b) {
     case BsdfType::Plastic:
     case BsdfType::RoughPlastic: {
       // The base's albedo towards the normal under uniform light: light enters through the coat
-      // with 1 - Fdr (the coat's hemispherical Fresnel from outside) and leaves with 1 - F(0).
+      // with 1 - Fdr (the coat's hemispherical Fresnel from outside) and leaves with 1 - F(0);
+      // through a rough coat, with its tables' hemispherical and normal transmittances.
+      if (b.type == BsdfType::RoughPlastic && b.coatNodes > 0) {
+        CoatNode n = coatNode(bsdfCoatTable(b), b.coatNodes, b.alpha);
+        return b.reflectance * (coatTransmittance(n, 1.f) * coatDiffuseTransmittance(n) /
+                                ((1.f - coatInternalReflectance(n)) * b.ior * b.ior));
+      }
       float tOut = 1.f - fresnelDielectric(1.f, b.ior), tIn = 1.f - b.fdrExt;
       return b.reflectance * (tOut * tIn / ((1.f - b.fdrInt) * b.ior * b.ior));
     }

@@ -3,11 +3,14 @@
 #include <stdexcept>
 
 #include "envmap/CollapsedMap.h"
+#include "materials/BsdfFactory.h"
 
 namespace envgi {
 
 void Scene::finalize() {
   if (bsdfs.empty()) bsdfs.push_back(Bsdf{});
+  // A rough plastic whose alpha or ior changed since loading reads the tables of its new ones.
+  for (Bsdf& b : bsdfs) attachRoughCoat(b);
   // The collapsed map, for the points strategy: made here so every device reads the same lights.
   if (env && integrator.env.strategy == "points") {
     if (integrator.env.pointMethod == "mediancut") env->setPoints(collapseByMedianCut(*env, integrator.env.pointCount));

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "cli/CliRunner.h"
+#include "materials/BsdfFactory.h"
 #include "scene/SceneLoader.h"
 
 using namespace envgi;
@@ -279,6 +280,29 @@ TEST(SceneLoader, AnisotropicRoughnessTextured) {
     EXPECT_NE(std::string(e.what()).find("give either alpha or alpha_u and alpha_v, not both"), std::string::npos)
         << e.what();
   }
+}
+
+// A rough plastic reads its coat's tables (Mitsuba's roughplastic): those of its alpha, or those
+// over all roughnesses where alpha is a texture, read at the hit's roughness.
+TEST(SceneLoader, RoughPlasticGetsItsCoatTables) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <texture type="checkerboard" id="checks"><rgb name="color0" value="0.3"/><rgb name="color1" value="0.05"/></texture>
+    <shape type="sphere"><bsdf type="roughplastic"><float name="alpha" value="0.3"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="roughplastic"><ref id="checks" name="alpha"/></bsdf></shape>)"),
+            {}, s);
+  const Bsdf &plain = s.bsdfs[size_t(s.shapes[0].bsdf)], &textured = s.bsdfs[size_t(s.shapes[1].bsdf)];
+  int nodes = 0;
+  EXPECT_EQ(bsdfCoatTable(plain), roughCoatTable(0.3f, plain.ior, MicrofacetType::Beckmann, false, &nodes));
+  EXPECT_EQ(plain.coatNodes, 1);
+  ASSERT_NE(bsdfCoatTable(textured), nullptr);
+  EXPECT_EQ(textured.coatNodes, kCoatAlphaNodes);
+  // Where the texture says 0.3, the textured plastic is the plain one, to the tables' interpolation.
+  Bsdf at = s.view().bsdfAt(s.shapes[1].bsdf, Vec2f(0.25f, 0.25f));
+  EXPECT_NEAR(at.alpha, 0.3f, 1e-5f);
+  Vec3f wo = normalize(Vec3f(0.3f, 0.1f, 0.8f)), wi = normalize(Vec3f(-0.5f, 0.2f, 0.6f));
+  EXPECT_NEAR(bsdfEval(at, wo, wi).y, bsdfEval(plain, wo, wi).y, 0.01f * bsdfEval(plain, wo, wi).y);
 }
 
 TEST(SceneLoader, HarmlessUnsupportedElementsOnlyWarn) {
