@@ -85,6 +85,11 @@ def bsdfs():
         out.append((f'roughplastic d {r} a {a} {d}',
                     f'<bsdf type="roughplastic"><rgb name="diffuse_reflectance" value="{r}"/><float name="alpha" value="{a}"/>'
                     f'<string name="distribution" value="{d}"/></bsdf>'))
+    # Mitsuba's nonlinear plastics: a coloured base saturates under the coat.
+    for t, extra in (('plastic', ''), ('roughplastic', '<float name="alpha" value="0.3"/><string name="distribution" value="ggx"/>')):
+        out.append((f'{t} nonlinear d 0.8 0.5 0.2',
+                    f'<bsdf type="{t}"><rgb name="diffuse_reflectance" value="0.8, 0.5, 0.2"/>{extra}'
+                    '<boolean name="nonlinear" value="true"/></bsdf>'))
     return out
 
 THINLENS = ('<sensor type="thinlens"><float name="aperture_radius" value="0.2"/>'

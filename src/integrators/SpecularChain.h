@@ -49,11 +49,10 @@ ENVGI_INLINE Color diffuseAlbedo(const Bsdf& b) {
       // through a rough coat, with its tables' hemispherical and normal transmittances.
       if (b.type == BsdfType::RoughPlastic && b.coatNodes > 0) {
         CoatNode n = coatNode(bsdfCoatTable(b), b.coatNodes, b.alpha);
-        return b.reflectance * (coatTransmittance(n, 1.f) * coatDiffuseTransmittance(n) /
-                                ((1.f - coatInternalReflectance(n)) * b.ior * b.ior));
+        return detail::plasticBase(b, coatInternalReflectance(n), coatTransmittance(n, 1.f) * coatDiffuseTransmittance(n));
       }
       float tOut = 1.f - fresnelDielectric(1.f, b.ior), tIn = 1.f - b.fdrExt;
-      return b.reflectance * (tOut * tIn / ((1.f - b.fdrInt) * b.ior * b.ior));
+      return detail::plasticBase(b, b.fdrInt, tOut * tIn);
     }
     case BsdfType::RoughConductor:
       return b.specularReflectance * (b.perfectMirror ? Color(1.f) : fresnelConductor(1.f, b.eta, b.k));

@@ -31,6 +31,7 @@ struct Bsdf {
   BsdfType type = BsdfType::Diffuse;
   bool twoSided = false;
   bool perfectMirror = false;            // conductor material "none"
+  bool nonlinear = false;                // plastics: Mitsuba's `nonlinear`, the base's colour saturates under the coat
   MicrofacetType distribution = MicrofacetType::GGX;  // of the rough BSDFs
   Color reflectance{0.5f};               // diffuse (and plastic base) albedo
   Color specularReflectance{1.f};
@@ -105,11 +106,21 @@ ENVGI_INLINE float plasticSpecularProb(const Bsdf& b, float fo) {
   return ps + pd > 0.f ? ps / (ps + pd) : 0.f;
 }
 
-// Diffuse base under a coating (Mitsuba's plastic, linear mode); fo is the Fresnel
-// reflectance at wo, which the plastics' pdfs need too.
+// The base's albedo after its inter-reflections under a coat whose internal diffuse reflectance
+// is fdrInt, times num / ior^2: Mitsuba's linear form divides by 1 - Fdr_int alone; its
+// nonlinear one by 1 - albedo Fdr_int, per channel, so that a coloured base saturates.
+ENVGI_INLINE Color plasticBase(const Bsdf& b, float fdrInt, float num) {
+  if (!b.nonlinear) return b.reflectance * (num / ((1.f - fdrInt) * b.ior * b.ior));
+  const Color& r = b.reflectance;
+  return Color(r.x / (1.f - r.x * fdrInt), r.y / (1.f - r.y * fdrInt), r.z / (1.f - r.z * fdrInt)) *
+         (num / (b.ior * b.ior));
+}
+
+// Diffuse base under a coating (Mitsuba's plastic); fo is the Fresnel reflectance at wo, which
+// the plastics' pdfs need too.
 ENVGI_INLINE Color plasticDiffuse(const Bsdf& b, float fo, Vec3f wi) {
   float ti = 1.f - fresnelDielectric(wi.z, b.ior), to = 1.f - fo;
-  return b.reflectance * (kInvPi * wi.z * ti * to / ((1.f - b.fdrInt) * b.ior * b.ior));
+  return plasticBase(b, b.fdrInt, kInvPi * wi.z * ti * to);
 }
 ENVGI_INLINE Color plasticDiffuse(const Bsdf& b, Vec3f wo, Vec3f wi) {
   return plasticDiffuse(b, fresnelDielectric(wo.z, b.ior), wi);
@@ -164,12 +175,12 @@ ENVGI_INLINE RoughPlasticShared roughPlasticShared(const Bsdf& b, Vec3f wo, Vec3
   r.fo = roughCoatReflectance(b, wo.z);
   return r;
 }
-// The base seen through the rough coat, Mitsuba's linear form: t(wi) t(wo) / (1 - Fdr_int).
+// The base seen through the rough coat: t(wi) t(wo) times plasticBase with the rough Fdr_int.
 ENVGI_INLINE Color roughPlasticDiffuse(const Bsdf& b, float fo, Vec3f wi) {
   if (b.coatNodes == 0) return plasticDiffuse(b, fo, wi);
   CoatNode n = roughCoat(b);
   float ti = coatTransmittance(n, wi.z), to = 1.f - fo;
-  return b.reflectance * (kInvPi * wi.z * ti * to / ((1.f - coatInternalReflectance(n)) * b.ior * b.ior));
+  return plasticBase(b, coatInternalReflectance(n), kInvPi * wi.z * ti * to);
 }
 ENVGI_INLINE Color roughPlasticEval(const Bsdf& b, const RoughPlasticShared& r, Vec3f wo, Vec3f wi) {
   float F = fresnelDielectric(dot(wi, r.m), b.ior);

@@ -630,7 +630,7 @@ class Loader {
       b.ior = getIor(f, p, "int_ior", 1.49f) / getIor(f, p, "ext_ior", extIor);
       b.reflectance = getColor(f, p, "diffuse_reflectance", Color(0.5f));
       b.specularReflectance = getColor(f, p, "specular_reflectance", Color(1.f));
-      if (getBool(f, p, "nonlinear", false)) warnOnce(f->path + ": plastic 'nonlinear' is not supported (linear is used)");
+      b.nonlinear = getBool(f, p, "nonlinear", false);
       if (type == "roughplastic") roughness(f, n, p, textures, b, type);
       finishPlastic(b);
     } else {

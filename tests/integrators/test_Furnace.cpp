@@ -137,6 +137,10 @@ TEST(Furnace, EveryBsdfMatchesMitsubaReference) {
     finishPlastic(b);
     return b;
   };
+  // Mitsuba's `nonlinear` plastics: the base's albedo saturates under the coat (r / (1 - r Fdr)
+  // in place of r / (1 - Fdr)), 0.7188 linear against 0.5200 for the smooth one.
+  Bsdf nonlinear = plastic(0.7f), roughNonlinear = roughPlastic(0.7f, 0.3f, MicrofacetType::GGX);
+  nonlinear.nonlinear = roughNonlinear.nonlinear = true;
   Bsdf thin;
   thin.type = BsdfType::ThinDielectric;
   thin.ior = 1.5f;
@@ -175,6 +179,9 @@ TEST(Furnace, EveryBsdfMatchesMitsubaReference) {
       {"rough plastic 0.5 GGX 0.1", roughPlastic(0.5f, 0.1f, MicrofacetType::GGX), 0.4837, 0.015},
       {"rough plastic 1.0 GGX 0.7", roughPlastic(1.f, 0.7f, MicrofacetType::GGX), 0.4132, 0.015},
       {"rough plastic 1.0 Beckmann 0.3", roughPlastic(1.f, 0.3f, MicrofacetType::Beckmann), 0.8694, 0.015},
+      {"plastic 0.7", plastic(0.7f), 0.7188, 0.015},
+      {"nonlinear plastic 0.7", nonlinear, 0.5200, 0.015},
+      {"nonlinear rough plastic 0.7 GGX 0.3", roughNonlinear, 0.4156, 0.015},
   };
   for (const Case& c : cases) {
     double m = furnace(c.bsdf, 256);

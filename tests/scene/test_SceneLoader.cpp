@@ -283,16 +283,19 @@ TEST(SceneLoader, AnisotropicRoughnessTextured) {
 }
 
 // A rough plastic reads its coat's tables (Mitsuba's roughplastic): those of its alpha, or those
-// over all roughnesses where alpha is a texture, read at the hit's roughness.
+// over all roughnesses where alpha is a texture, read at the hit's roughness; and `nonlinear`.
 TEST(SceneLoader, RoughPlasticGetsItsCoatTables) {
   Fixture f;
   Scene s;
   loadScene(f.scene(std::string(kSensor) + R"(
     <texture type="checkerboard" id="checks"><rgb name="color0" value="0.3"/><rgb name="color1" value="0.05"/></texture>
     <shape type="sphere"><bsdf type="roughplastic"><float name="alpha" value="0.3"/></bsdf></shape>
-    <shape type="sphere"><bsdf type="roughplastic"><ref id="checks" name="alpha"/></bsdf></shape>)"),
+    <shape type="sphere"><bsdf type="roughplastic"><ref id="checks" name="alpha"/>
+      <boolean name="nonlinear" value="true"/></bsdf></shape>)"),
             {}, s);
   const Bsdf &plain = s.bsdfs[size_t(s.shapes[0].bsdf)], &textured = s.bsdfs[size_t(s.shapes[1].bsdf)];
+  EXPECT_FALSE(plain.nonlinear);
+  EXPECT_TRUE(textured.nonlinear);
   int nodes = 0;
   EXPECT_EQ(bsdfCoatTable(plain), roughCoatTable(0.3f, plain.ior, MicrofacetType::Beckmann, false, &nodes));
   EXPECT_EQ(plain.coatNodes, 1);
@@ -302,6 +305,7 @@ TEST(SceneLoader, RoughPlasticGetsItsCoatTables) {
   Bsdf at = s.view().bsdfAt(s.shapes[1].bsdf, Vec2f(0.25f, 0.25f));
   EXPECT_NEAR(at.alpha, 0.3f, 1e-5f);
   Vec3f wo = normalize(Vec3f(0.3f, 0.1f, 0.8f)), wi = normalize(Vec3f(-0.5f, 0.2f, 0.6f));
+  at.nonlinear = false;
   EXPECT_NEAR(bsdfEval(at, wo, wi).y, bsdfEval(plain, wo, wi).y, 0.01f * bsdfEval(plain, wo, wi).y);
 }
 
