@@ -3,6 +3,7 @@
 // at them whatever copies of scenes are made.
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cmath>
 #include <deque>
 #include <map>
@@ -62,21 +63,18 @@ float coatShare(const MicrofacetDistribution& d, Vec3f wi, Vec3f m, float eta, b
 
 // What the interface does with light arriving from wi (mu = wi.z > 0) at relative index eta:
 // the share reflected, or the share transmitted, each over visible microfacets and masked on
-// the way out (Mitsuba's eval_reflectance and eval_transmittance). The integral runs over
-// microfacet normals m drawn from D(m) cos(theta_m), by quadrature in that warp's own square
-// (u for theta_m, phi over half the circle: wi lies in the xz-plane, so the other half mirrors
-// it), where each m weighs G1(wi) max(0, wi.m) / (mu cos theta_m): the visible-normal density
-// over D cos.
+// the way out (what Mitsuba's eval_reflectance and eval_transmittance tabulate), by
+// Gauss-Legendre quadrature in the square of a warp onto microfacet normals. GGX: its visible
+// normals, where nothing is cut off and no density is divided out. Beckmann, whose
+// visible-normal warp is a Newton solve: D(m) cos(theta_m), with phi over half the circle (wi
+// lies in the xz-plane, so the other half mirrors it), each m weighed by the visible-normal
+// density over D cos, G1(wi) max(0, wi.m) / (mu cos theta_m).
 double coatIntegral(const MicrofacetDistribution& d, float mu, float eta, bool transmitted, const Quadrature& q) {
   const std::vector<double>&x = q.x, &w = q.w;
   const int n = int(x.size());
   Vec3f wi(std::sqrt(std::max(0.f, 1.f - mu * mu)), 0.f, mu);
-  float g1i = d.G1(wi);
-  float a2 = d.alphaX * d.alphaX;
   double sum = 0.0;
   if (d.type == MicrofacetType::GGX) {
-    // GGX's visible normals come in closed form, and in their square the integrand has no
-    // back-facing cut (Mitsuba's form): F G1(wo) or (1 - F) G1(wt), no density to divide by.
     for (int i = 0; i < n; ++i)
       for (int j = 0; j < n; ++j) {
         Vec3f m = d.sampleVisible(wi, Vec2f(float(x[size_t(i)]), float(x[size_t(j)])));
@@ -84,9 +82,10 @@ double coatIntegral(const MicrofacetDistribution& d, float mu, float eta, bool t
       }
     return sum;
   }
+  float g1i = d.G1(wi);
+  double a2 = double(d.alphaX) * double(d.alphaX);
   for (int i = 0; i < n; ++i) {
-    double u = x[size_t(i)];
-    double tan2 = d.type == MicrofacetType::Beckmann ? -double(a2) * std::log1p(-u) : double(a2) * u / (1.0 - u);
+    double tan2 = -a2 * std::log1p(-x[size_t(i)]);
     double cosM = 1.0 / std::sqrt(1.0 + tan2), sinM = std::sqrt(tan2) * cosM;
     for (int j = 0; j < n; ++j) {
       Vec3f m(float(sinM * q.cosPhi[size_t(j)]), float(sinM * q.sinPhi[size_t(j)]), float(cosM));
