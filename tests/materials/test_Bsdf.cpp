@@ -64,6 +64,14 @@ std::vector<BsdfCase> cases() {
   Bsdf two = make(BsdfType::Diffuse, 0.1f);
   two.twoSided = true;
   out.push_back({"TwoSidedDiffuseBack", two, -0.6f});
+  // A rough plastic whose alpha is textured reads its coat between roughness nodes; seen from
+  // behind as a two-sided one; and nonlinear.
+  Bsdf textured = make(BsdfType::RoughPlastic, 0.25f);
+  textured.alphaTexture = 0;
+  attachRoughCoat(textured);
+  textured.twoSided = true;
+  textured.nonlinear = true;
+  out.push_back({"RoughPlasticTexturedAlphaBack", textured, -0.4f});
   return out;
 }
 
