@@ -1,9 +1,11 @@
 // The rough plastic coat's tables (materials/RoughCoat.h), built on the host once per
 // (alpha, ior, distribution) and kept for the life of the process, so that a Bsdf can point
 // at them whatever copies of scenes are made.
+#include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <deque>
 #include <map>
@@ -140,7 +142,14 @@ const float* roughCoatTable(float alpha, float ior, MicrofacetType type, bool te
   if (it != cache.end()) return it->second->data();
   std::vector<float> alphas;
   for (int j = 0; j < *nodes; ++j) alphas.push_back(texturedAlpha ? coatNodeAlpha(j, *nodes) : alpha);
+  auto start = std::chrono::steady_clock::now();
   std::vector<float>& t = tables.emplace_back(buildTable(alphas, ior, type));
+  double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  // A textured alpha's 32 nodes take a few tenths of a second: say where the time went.
+  spdlog::log(seconds > 0.1 ? spdlog::level::info : spdlog::level::debug,
+              "rough plastic coat tables (ior {:.4g}, {}, {}): {} node{} in {:.2f} s", ior,
+              type == MicrofacetType::GGX ? "ggx" : "beckmann", texturedAlpha ? "textured alpha" : fmt::format("alpha {:.4g}", alpha),
+              *nodes, *nodes == 1 ? "" : "s", seconds);
   cache.emplace(key, &t);
   return t.data();
 }
