@@ -257,6 +257,13 @@ class Loader {
     if (ior <= 0.f) fail(f, x->node, "an index of refraction must be positive");
     return ior;
   }
+  // int_ior / ext_ior of a dielectric interface. Equal indices are no interface at all (the
+  // microfacet half vector of a straight transmission is then zero): refused, as Mitsuba does.
+  float interfaceIor(const SourceFile* f, pugi::xml_node n, Props& p, float intDefault, float extDefault) {
+    float in = getIor(f, p, "int_ior", intDefault), out = getIor(f, p, "ext_ior", extDefault);
+    if (in == out) fail(f, n, fmt::format("int_ior and ext_ior must differ (both are {})", in));
+    return in / out;
+  }
   Transform getTransform(const SourceFile* f, Props& p, const std::string& name) {
     Prop* x = find(p, name);
     if (!x) return Transform{};
@@ -621,13 +628,13 @@ class Loader {
     } else if (type == "dielectric" || type == "thindielectric" || type == "roughdielectric") {
       b.type = type == "dielectric" ? BsdfType::Dielectric
                : type == "thindielectric" ? BsdfType::ThinDielectric : BsdfType::RoughDielectric;
-      b.ior = getIor(f, p, "int_ior", 1.5046f) / getIor(f, p, "ext_ior", extIor);
+      b.ior = interfaceIor(f, n, p, 1.5046f, extIor);
       b.specularReflectance = getColor(f, p, "specular_reflectance", Color(1.f));
       b.specularTransmittance = getColor(f, p, "specular_transmittance", Color(1.f));
       if (type == "roughdielectric") roughness(f, n, p, textures, b, type);
     } else if (type == "plastic" || type == "roughplastic") {
       b.type = type == "plastic" ? BsdfType::Plastic : BsdfType::RoughPlastic;
-      b.ior = getIor(f, p, "int_ior", 1.49f) / getIor(f, p, "ext_ior", extIor);
+      b.ior = interfaceIor(f, n, p, 1.49f, extIor);
       b.reflectance = getColor(f, p, "diffuse_reflectance", Color(0.5f));
       b.specularReflectance = getColor(f, p, "specular_reflectance", Color(1.f));
       b.nonlinear = getBool(f, p, "nonlinear", false);
