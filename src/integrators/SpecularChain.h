@@ -48,7 +48,7 @@ ENVGI_INLINE Color diffuseAlbedo(const Bsdf& b) {
       // with 1 - Fdr (the coat's hemispherical Fresnel from outside) and leaves with 1 - F(0);
       // through a rough coat, with its tables' hemispherical and normal transmittances.
       if (b.type == BsdfType::RoughPlastic && b.coatNodes > 0) {
-        CoatNode n = coatNode(bsdfCoatTable(b), b.coatNodes, b.alpha);
+        CoatNode n = detail::roughCoat(b);
         return detail::plasticBase(b, coatInternalReflectance(n), coatTransmittance(n, 1.f) * coatDiffuseTransmittance(n));
       }
       float tOut = 1.f - fresnelDielectric(1.f, b.ior), tIn = 1.f - b.fdrExt;

@@ -153,18 +153,20 @@ ENVGI_INLINE void toFrontSide(const Bsdf& b, Vec3f* wo, Vec3f* wi) {
 // The rough coat's tables at this material's roughness (Mitsuba's roughplastic).
 ENVGI_INLINE CoatNode roughCoat(const Bsdf& b) { return coatNode(bsdfCoatTable(b), b.coatNodes, b.alpha); }
 
-// The share of light from wo (cos theta = c > 0) that the rough coat does not let through to
-// the base: the coat's lobe's share in sampling. The smooth coat's Fresnel without tables.
-ENVGI_INLINE float roughCoatReflectance(const Bsdf& b, float c) {
-  return b.coatNodes > 0 ? 1.f - coatTransmittance(roughCoat(b), c) : fresnelDielectric(c, b.ior);
+// The share of light from wo (cos theta = c > 0) that the rough coat (n: roughCoat(b)) does not
+// let through to the base: the coat's lobe's share in sampling. The smooth coat's Fresnel
+// without tables.
+ENVGI_INLINE float roughCoatReflectance(const Bsdf& b, const CoatNode& n, float c) {
+  return b.coatNodes > 0 ? 1.f - coatTransmittance(n, c) : fresnelDielectric(c, b.ior);
 }
 
 // What rough plastic's eval and pdf share for one pair of directions (both above the surface):
-// the half vector, D there, wo's Smith lambda and the coat's reflectance at wo. bsdfEvalPdf
-// computes them once for both.
+// the half vector, D there, wo's Smith lambda, the coat's tables at this roughness and its
+// reflectance at wo. bsdfEvalPdf computes them once for both.
 struct RoughPlasticShared {
   Vec3f m;
   float D, lambdaO, fo;
+  CoatNode coat;
 };
 ENVGI_INLINE RoughPlasticShared roughPlasticShared(const Bsdf& b, Vec3f wo, Vec3f wi) {
   RoughPlasticShared r;
@@ -172,21 +174,21 @@ ENVGI_INLINE RoughPlasticShared roughPlasticShared(const Bsdf& b, Vec3f wo, Vec3
   MicrofacetDistribution d = microfacet(b);
   r.D = d.D(r.m);
   r.lambdaO = d.lambda(wo);
-  r.fo = roughCoatReflectance(b, wo.z);
+  r.coat = roughCoat(b);
+  r.fo = roughCoatReflectance(b, r.coat, wo.z);
   return r;
 }
 // The base seen through the rough coat: t(wi) t(wo) times plasticBase with the rough Fdr_int.
-ENVGI_INLINE Color roughPlasticDiffuse(const Bsdf& b, float fo, Vec3f wi) {
-  if (b.coatNodes == 0) return plasticDiffuse(b, fo, wi);
-  CoatNode n = roughCoat(b);
-  float ti = coatTransmittance(n, wi.z), to = 1.f - fo;
-  return plasticBase(b, coatInternalReflectance(n), kInvPi * wi.z * ti * to);
+ENVGI_INLINE Color roughPlasticDiffuse(const Bsdf& b, const RoughPlasticShared& r, Vec3f wi) {
+  if (b.coatNodes == 0) return plasticDiffuse(b, r.fo, wi);
+  float ti = coatTransmittance(r.coat, wi.z), to = 1.f - r.fo;
+  return plasticBase(b, coatInternalReflectance(r.coat), kInvPi * wi.z * ti * to);
 }
 ENVGI_INLINE Color roughPlasticEval(const Bsdf& b, const RoughPlasticShared& r, Vec3f wo, Vec3f wi) {
   float F = fresnelDielectric(dot(wi, r.m), b.ior);
   float G = 1.f / (1.f + r.lambdaO + microfacet(b).lambda(wi));  // height-correlated, as G()
   Color spec = b.specularReflectance * (F * r.D * G / (4.f * wo.z));
-  return spec + roughPlasticDiffuse(b, r.fo, wi);
+  return spec + roughPlasticDiffuse(b, r, wi);
 }
 ENVGI_INLINE float roughPlasticPdf(const Bsdf& b, const RoughPlasticShared& r, Vec3f wo, Vec3f wi) {
   float ps = plasticSpecularProb(b, r.fo);
@@ -394,7 +396,8 @@ ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSam
     case BsdfType::Plastic:
     case BsdfType::RoughPlastic: {
       if (wo.z <= 0.f) return false;
-      float fo = b.type == BsdfType::Plastic ? fresnelDielectric(wo.z, b.ior) : detail::roughCoatReflectance(b, wo.z);
+      float fo = b.type == BsdfType::Plastic ? fresnelDielectric(wo.z, b.ior)
+                                             : detail::roughCoatReflectance(b, detail::roughCoat(b), wo.z);
       float ps = detail::plasticSpecularProb(b, fo);
       if (b.type == BsdfType::Plastic && uc < ps) {
         s->wi = Vec3f(-wo.x, -wo.y, wo.z);

@@ -652,7 +652,6 @@ class Loader {
       }
       *slot = tex.first;
     }
-    attachRoughCoat(b);  // a textured alpha needs the tables over all roughnesses
     if ((b.type == BsdfType::Plastic || b.type == BsdfType::RoughPlastic) &&
         (b.reflectanceTexture >= 0 || b.specularReflectanceTexture >= 0)) {
       // The coat's share of samples from the textures' mean colours, as Mitsuba's plastic does.
