@@ -7,7 +7,8 @@
 # is an envgi_bench_gpu built here for one variant (e.g. -DCMAKE_CUDA_ARCHITECTURES=90, one
 # build folder, a variant at a time), compressed to fit the carry limit. Each round runs every
 # variant once and prints its buddha rows and its path kernel's registers. Arguments after --
-# go to every run (default --no-cpu).
+# go to every run (default --no-cpu). ROWS (an extended regex) picks the lines printed from each
+# run's output (default: the buddha rows and the path kernel's registers).
 set -euo pipefail
 [[ $# -ge 3 ]] || { sed -n 2,10p "$0"; exit 2; }
 package=$1 rounds=$2
@@ -34,6 +35,6 @@ nvidia-smi --query-gpu=name,driver_version --format=csv,noheader || true
 for ((k = 1; k <= rounds; ++k)); do
   for name in "${names[@]}"; do
     out=$("$root/bin/ab_$name" "${args[@]}" 2>&1 || true)
-    echo "round $k $name: $(grep -E '^\| buddha|path kernel' <<<"$out" | tr '\n' ' ')"
+    echo "round $k $name: $(grep -E "${ROWS:-^\| buddha|path kernel}" <<<"$out" | tr '\n' ' ')"
   done
 done

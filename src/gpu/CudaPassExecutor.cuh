@@ -36,8 +36,9 @@ constexpr int kRegenBlock = 128;
 // holds at once, each taking (pixel, sample) items from counters[2] as its paths end. A warp's
 // lanes that need work take consecutive items with one atomic.
 template <class Integrator>
-__global__ void regenKernel(Integrator integ, Camera cam, SampleSequence seq, int s0, int s1, FilmView film,
-                            unsigned long long* counters) {
+__global__ void __launch_bounds__(kRegenBlock, kTracingThreadsPerSM / kRegenBlock)
+    regenKernel(Integrator integ, Camera cam, SampleSequence seq, int s0, int s1, FilmView film,
+                unsigned long long* counters) {
   namespace cg = cooperative_groups;
   auto fetch = [counters]() -> uint64_t {
     cg::coalesced_group g = cg::coalesced_threads();

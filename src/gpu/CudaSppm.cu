@@ -23,8 +23,9 @@ using Clock = std::chrono::steady_clock;
 constexpr int kThreads = 128;
 int blocksFor(size_t n) { return int((n + kThreads - 1) / kThreads); }
 
-__global__ void cameraKernel(const SceneView* sc, BvhTracer tracer, SppmParams s, SppmPixels px, int n, int pass,
-                             unsigned long long* rays) {
+__global__ void __launch_bounds__(kThreads, kTracingThreadsPerSM / kThreads)
+    cameraKernel(const SceneView* sc, BvhTracer tracer, SppmParams s, SppmPixels px, int n, int pass,
+                 unsigned long long* rays) {
   int i = int(blockIdx.x * blockDim.x + threadIdx.x);
   if (i >= n) return;
   atomicAdd(rays, (unsigned long long)sppmCameraStep(*sc, tracer, s, px, i, pass));
@@ -52,8 +53,9 @@ __global__ void bucketStartKernel(const int* sortedKeys, int n, int tableSize, i
   hashGridBucketStarts(sortedKeys, n, tableSize, i, start);
 }
 
-__global__ void photonKernel(const SceneView* sc, BvhTracer tracer, PhotonEmitter emitter, SppmParams s,
-                             SppmPixels px, HashGridView g, int pass, unsigned long long* hits) {
+__global__ void __launch_bounds__(kThreads, kTracingThreadsPerSM / kThreads)
+    photonKernel(const SceneView* sc, BvhTracer tracer, PhotonEmitter emitter, SppmParams s,
+                 SppmPixels px, HashGridView g, int pass, unsigned long long* hits) {
   uint64_t j = uint64_t(blockIdx.x) * blockDim.x + threadIdx.x;
   if (j >= s.photonsPerPass) return;
   uint32_t h = sppmPhotonStep(*sc, tracer, emitter, s, px, g, j, pass);
