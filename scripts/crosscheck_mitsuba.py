@@ -189,6 +189,13 @@ def main():
     variant('anisotropic sphere (brushed, alone)', 'brushed',
             lambda t: re.sub(r'<shape type="(rectangle|cube)">.*?</shape>', '', t, flags=re.S).replace(
                 '<integrator type="path">', '<integrator type="path"><boolean name="hide_emitters" value="true"/>'))
+    # Delta lights: the sun, point and area lights of sun-and-sky with the map's background
+    # hidden (the open row placement), and a point light added to the area-lit Cornell box.
+    variant('sun-and-sky (map hidden)', 'sun-and-sky',
+            lambda t: t.replace('<integrator type="path">', '<integrator type="path"><boolean name="hide_emitters" value="true"/>'))
+    variant('cornell-box with a point light', 'cornell-box',
+            lambda t: t.replace('</scene>', '<emitter type="point"><point name="position" x="0.4" y="1.2" z="0.6"/>'
+                                '<rgb name="intensity" value="0.8, 0.9, 1.2"/></emitter></scene>'))
     configs = [c for c in configs if args.only in c[0]]
     total_regions = sum(c[3] * c[3] for c in configs)
     alpha = 1.0 - 0.99 ** (1.0 / total_regions)

@@ -1,5 +1,5 @@
-// Next-event estimation: choosing the environment or an area light, and the densities a
-// BSDF-sampled direction would have had under that choice (for MIS).
+// Next-event estimation: choosing the environment, an area light or a delta light, and the
+// densities a BSDF-sampled direction would have had under that choice (for MIS).
 #pragma once
 
 #include "scene/SceneView.h"
@@ -12,7 +12,7 @@ struct LightSample {
   Color radiance;
   float pdf = 0.f;      // solid angle, selection included; a pmf for a delta light
   bool environment = false;
-  bool delta = false;   // a collapsed-map light: no MIS, BSDF sampling cannot find it
+  bool delta = false;   // a collapsed-map or delta light: no MIS, BSDF sampling cannot find it
 };
 
 // The cosine and product strategies sample about the shading normal on the side the viewer is
@@ -42,8 +42,7 @@ ENVGI_INLINE float areaLightPdf(const SceneView& sc, int light, Vec3f p, Vec3f l
   float dist2 = lengthSq(d);
   float cosL = std::fabs(dot(ln, d)) / std::sqrt(dist2);
   if (cosL <= 0.f) return 0.f;
-  float sel = 1.f - sc.envSelectProb();
-  return sel * sc.lightSelect.pmf(light) / sc.lights[light].area * dist2 / cosL;
+  return sc.areaSelectProb() * sc.lightSelect.pmf(light) / sc.lights[light].area * dist2 / cosL;
 }
 
 ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si, Vec3f axis, EnvStrategy strategy,
@@ -60,6 +59,19 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
     ls->delta = es.delta;
     return true;
   }
+  float pa = sc.areaSelectProb();
+  if (sc.deltaLightCount > 0 && !(uSel < pe + pa)) {
+    // One delta light, all alike; the kind's share of uSel picks it.
+    float pd = sc.deltaSelectProb();
+    int n = sc.deltaLightCount;
+    int i = int((uSel - pe - pa) / pd * float(n));
+    i = i < 0 ? 0 : (i < n ? i : n - 1);
+    ls->radiance = deltaLightIncident(sc.deltaLights[i], si.p, &ls->dir, &ls->dist);
+    ls->pdf = pd / float(n);
+    ls->environment = false;
+    ls->delta = true;
+    return !isBlack(ls->radiance);
+  }
   if (sc.lightCount == 0) return false;
   float pmf;
   Vec3f p, n;
@@ -74,7 +86,7 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
   ls->dir = d;
   ls->dist = dist;
   ls->radiance = lp.radiance;
-  ls->pdf = (1.f - pe) * pmf / lp.area * dist2 / cosL;
+  ls->pdf = pa * pmf / lp.area * dist2 / cosL;
   ls->environment = false;
   ls->delta = false;
   return ls->pdf > 0.f;

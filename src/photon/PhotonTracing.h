@@ -1,5 +1,5 @@
 // The paper's first pass (Section 3): photons leave the environment map (its Algorithm 1
-// density) and the area lights, bounce with Russian roulette by albedo through glass and
+// density), the area lights and the delta lights, bounce with Russian roulette by albedo through glass and
 // mirrors, and are handed to a store callback at every non-specular hit after the first.
 // Host/device: the store callback and the tracer are template parameters.
 #pragma once
@@ -21,9 +21,12 @@ struct PhotonEmitter {
   Vec3f center;        // of the scene's bounding sphere
   float radius = 1.f;
   float envProb = 1.f; // chance a photon leaves the environment rather than an area light
+  float deltaProb = 0.f;  // chance it leaves a delta light (the area lights have the rest)
 
-  // False when nothing in the scene emits (a black map and no area lights): no photons then.
-  ENVGI_HD bool emitsLight(const SceneView& sc) const { return envProb > 0.f || sc.lightCount > 0; }
+  // False when nothing in the scene emits (a black map and no area or delta lights): no photons.
+  ENVGI_HD bool emitsLight(const SceneView& sc) const {
+    return envProb > 0.f || sc.lightCount > 0 || deltaProb > 0.f;
+  }
 
   // Origin, direction and flux (times the photon count) of one emitted photon.
   ENVGI_HD bool emit(const SceneView& sc, Sampler& smp, Ray* ray, Color* power) const {
@@ -42,6 +45,28 @@ struct PhotonEmitter {
       *power = es.radiance * (kPi * radius * radius / (es.pdf * envProb));
       return true;
     }
+    float areaProb = 1.f - envProb - deltaProb;
+    if (deltaProb > 0.f && (sc.lightCount == 0 || !(uSel < envProb + areaProb))) {
+      // A delta light, all alike: a sun's photons cross a disk covering the bounding sphere
+      // along its direction, a point light's leave it uniformly over the sphere.
+      int m = sc.deltaLightCount;
+      int i = int((uSel - envProb - areaProb) / deltaProb * float(m));
+      const DeltaLight& l = sc.deltaLights[i < 0 ? 0 : (i < m ? i : m - 1)];
+      float pick = deltaProb / float(m);
+      ray->tMax = INFINITY;
+      if (l.point) {
+        ray->o = l.v;
+        ray->d = sampleUniformSphere(u1);
+        *power = l.value * (4.f * kPi / pick);
+      } else {
+        Frame f = Frame::fromNormal(l.v);
+        Vec2f d = sampleConcentricDisk(u2);
+        ray->o = center + (-l.v + f.s * d.x + f.t * d.y) * radius;
+        ray->d = l.v;
+        *power = l.value * (kPi * radius * radius / pick);
+      }
+      return !isBlack(*power);
+    }
     if (sc.lightCount == 0) return false;
     float pmf;
     Vec3f p, n;
@@ -52,7 +77,7 @@ struct PhotonEmitter {
     ray->d = normalize(dir);
     ray->tMax = INFINITY;
     // Le cos / (pdf_area pdf_dir) with pdf_dir = cos / pi.
-    *power = lp.radiance * (kPi * lp.area / (pmf * (1.f - envProb)));
+    *power = lp.radiance * (kPi * lp.area / (pmf * areaProb));
     return true;
   }
 };

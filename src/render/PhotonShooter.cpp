@@ -16,7 +16,16 @@ PhotonEmitter makePhotonEmitter(const Scene& scene) {
   double envPower = scene.env ? double(kPi) * e.radius * e.radius * scene.env->luminancePower() : 0.0;
   double areaPower = 0.0;
   for (int i = 0; i < sc.lightCount; ++i) areaPower += kPi * sc.lights[i].area * luminance(sc.lights[i].radiance);
-  e.envProb = envPower + areaPower > 0.0 ? float(envPower / (envPower + areaPower)) : 0.f;
+  // A delta light's power: a sun's irradiance over the bounding sphere's cross-section, a point
+  // light's intensity over the whole sphere of directions.
+  double deltaPower = 0.0;
+  for (int i = 0; i < sc.deltaLightCount; ++i) {
+    const DeltaLight& l = sc.deltaLights[i];
+    deltaPower += luminance(l.value) * (l.point ? 4.0 * kPi : double(kPi) * e.radius * e.radius);
+  }
+  double total = envPower + areaPower + deltaPower;
+  e.envProb = total > 0.0 ? float(envPower / total) : 0.f;
+  e.deltaProb = total > 0.0 ? float(deltaPower / total) : 0.f;
   return e;
 }
 

@@ -85,6 +85,8 @@ void Scene::finalize() {
   view_.lights = lights_.data();
   view_.lightCount = int(lights_.size());
   if (!lights_.empty()) view_.lightSelect = lightTable_.view();
+  view_.deltaLights = deltaLights.empty() ? nullptr : deltaLights.data();
+  view_.deltaLightCount = int(deltaLights.size());
   view_.hasEnvironment = env != nullptr;
   if (env) view_.env = env->view();
   view_.camera = camera;

@@ -513,6 +513,29 @@ class Loader {
     warnUnused(f, p, "sampler '" + type + "'");
   }
 
+  // Mitsuba's `directional` (irradiance, travelling along `direction` or to_world's +z) and
+  // `point` (intensity, at `position` or to_world's origin); giving both forms is an error there.
+  DeltaLight deltaLight(const SourceFile* f, pugi::xml_node n, const std::string& type, Props& p) {
+    const char* where = type == "point" ? "position" : "direction";
+    bool explicitForm = p.count(where) > 0, transformed = p.count("to_world") > 0;
+    if (explicitForm && transformed)
+      fail(f, n, fmt::format("a '{}' emitter takes '{}' or 'to_world', not both", type, where));
+    Transform t = getTransform(f, p, "to_world");
+    DeltaLight l;
+    l.point = type == "point";
+    if (l.point) {
+      l.v = explicitForm ? getPoint(f, p, "position", Vec3f(0.f)) : t.point(Vec3f(0.f));
+      l.value = getColor(f, p, "intensity", Color(1.f));
+    } else {
+      Vec3f d = explicitForm ? getPoint(f, p, "direction", Vec3f(0.f)) : t.vector(Vec3f(0.f, 0.f, 1.f));
+      if (!(lengthSq(d) > 0.f) || !std::isfinite(lengthSq(d)))
+        fail(f, n, "a 'directional' emitter needs a non-zero, finite direction");
+      l.v = normalize(d);
+      l.value = getColor(f, p, "irradiance", Color(1.f));
+    }
+    return l;
+  }
+
   // An area emitter marks its shape emissive; envmap and constant become the scene's environment.
   void emitter(const SourceFile* f, pugi::xml_node n, ShapeEntry* shape) {
     checkAttrs(f, n, {"type", "id", "name"});
@@ -553,6 +576,8 @@ class Loader {
         Color L = getColor(f, p, "radiance", Color(1.f));
         scene_.env = std::make_unique<EnvironmentMap>(EnvironmentMap::constant(L, o));
       }
+    } else if (type == "directional" || type == "point") {
+      scene_.deltaLights.push_back(deltaLight(f, n, type, p));
     } else {
       warnOnce(fmt::format("{}:{}: emitter type '{}' is not supported and was ignored", f->path,
                            f->lineOf(n.offset_debug()), type));

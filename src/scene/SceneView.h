@@ -9,6 +9,7 @@
 #include "materials/Bsdf.h"
 #include "materials/Texture.h"
 #include "scene/Camera.h"
+#include "scene/DeltaLight.h"
 #include "scene/Ray.h"
 
 namespace envgi {
@@ -67,16 +68,21 @@ struct SceneView {
   const LightPrim* lights = nullptr;
   int lightCount = 0;
   AliasTableView lightSelect;  // area lights by power
+  const DeltaLight* deltaLights = nullptr;
+  int deltaLightCount = 0;
   bool hasEnvironment = false;
   EnvironmentMapView env;
   Camera camera;
   Vec3f boundsMin, boundsMax;
 
-  // Probability of choosing the environment over the area lights in next-event estimation.
-  ENVGI_HD float envSelectProb() const {
-    if (!hasEnvironment) return 0.f;
-    return lightCount > 0 ? 0.5f : 1.f;
+  // Next-event estimation picks a kind of light, each kind the scene has alike (the map, the
+  // area lights, the delta lights), then a light of that kind: these are the kinds' chances.
+  ENVGI_HD float lightKinds() const {
+    return float(int(hasEnvironment) + int(lightCount > 0) + int(deltaLightCount > 0));
   }
+  ENVGI_HD float envSelectProb() const { return hasEnvironment ? 1.f / lightKinds() : 0.f; }
+  ENVGI_HD float areaSelectProb() const { return lightCount > 0 ? 1.f / lightKinds() : 0.f; }
+  ENVGI_HD float deltaSelectProb() const { return deltaLightCount > 0 ? 1.f / lightKinds() : 0.f; }
 
   ENVGI_HD SurfaceInteraction interaction(const Ray& ray, const Hit& h) const {
     SurfaceInteraction si;

@@ -79,7 +79,7 @@ struct Case {
 
 TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
   std::vector<Case> cases;
-  for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured", "microfacets", "brushed"})
+  for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured", "microfacets", "brushed", "sun-and-sky"})
     cases.push_back({sc, "path", "mis"});
   cases.push_back({"textured", "path", "mis", 0.2f});
   for (std::string st : {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis", "product"})
@@ -119,7 +119,7 @@ TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
 // paths, up to traversal rounding, FMA contraction and the order of the atomics' float sums;
 // so the image means and the 8x8-region means agree closely.
 TEST(GpuRender, SppmMatchesTheCpuDriver) {
-  for (std::string name : {"cornell-box", "teapot-glass", "buddha"}) {
+  for (std::string name : {"cornell-box", "teapot-glass", "buddha", "sun-and-sky"}) {
     Scene s;
     loadBundled(name, IntegratorType::Sppm, &s);
     s.integrator.sppm.photonCount = 200000;
@@ -146,7 +146,7 @@ TEST(GpuRender, SppmMatchesTheCpuDriver) {
 // rounding, so the counts, the stored power and its spatial histogram (8^3 cells over the
 // scene's bounds) agree closely.
 TEST(GpuRender, PhotonMapsMatchTheCpu) {
-  for (std::string name : {"cornell-box", "teapot-glass", "buddha"}) {
+  for (std::string name : {"cornell-box", "teapot-glass", "buddha", "sun-and-sky"}) {
     Scene s;
     loadScene(test::bundledScenesDir() + "/" + name + ".xml", {}, s);
     s.finalize();
@@ -197,7 +197,7 @@ TEST(GpuRender, PhotonMapsMatchTheCpu) {
 // The grid integrator on the GPU (photons, grid fill and camera passes) against the CPU's,
 // same seed: the same photons, gather rays and camera samples up to traversal rounding.
 TEST(GpuRender, GridMatchesTheCpu) {
-  for (std::string name : {"cornell-box", "teapot-glass", "buddha"}) {
+  for (std::string name : {"cornell-box", "teapot-glass", "buddha", "sun-and-sky"}) {
     Scene s;
     loadBundled(name, IntegratorType::Grid, &s);
     s.finalize();

@@ -47,7 +47,7 @@ struct SmallScene {
 }  // namespace
 
 TEST(PixelKernel, RegeneratedPathsAddTheSameSamplesAsRenderPixel) {
-  for (std::string name : {"teapot-glass", "buddha", "cornell-box", "bunny-sunrise"})
+  for (std::string name : {"teapot-glass", "buddha", "cornell-box", "bunny-sunrise", "sun-and-sky"})
     for (IntegratorType type : {IntegratorType::Path, IntegratorType::Direct}) {
       SmallScene small(name, type);
       const KernelSettings& k = small.k;
@@ -80,7 +80,7 @@ TEST(PixelKernel, RegeneratedPathsAddTheSameSamplesAsRenderPixel) {
 // adds the same samples in the same order, so the sums agree to the bit, over whole and partial
 // tiles (24 pixels in tiles of 16) and over two passes.
 TEST(PixelKernel, TileByBounceAddsTheSameSamplesAsRenderPixel) {
-  for (std::string name : {"teapot-glass", "buddha", "cornell-box", "bunny-sunrise"}) {
+  for (std::string name : {"teapot-glass", "buddha", "cornell-box", "bunny-sunrise", "sun-and-sky"}) {
     SmallScene small(name, IntegratorType::Path);
     const KernelSettings& k = small.k;
     SampleIntegrator<BvhTracer> integ = small.integrator();

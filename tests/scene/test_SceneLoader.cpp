@@ -316,13 +316,53 @@ TEST(SceneLoader, HarmlessUnsupportedElementsOnlyWarn) {
   Fixture f;
   Scene s;
   EXPECT_NO_THROW(loadScene(f.scene(std::string(kSensor) + R"(
-    <emitter type="point"/>
+    <emitter type="spot"/>
     <phase type="hg"/>
     <shape type="sphere"><float name="mystery" value="1"/></shape>
     <shape type="sphere"><emitter type="area"><texture type="checkerboard" name="radiance"/></emitter></shape>)"),
                             {}, s));
   EXPECT_EQ(s.shapes.size(), 2u);
   EXPECT_EQ(s.shapes[1].radiance.x, 1.f) << "an emitter's texture keeps the default radiance";
+}
+
+TEST(SceneLoader, DirectionalAndPointEmitters) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <emitter type="directional"><vector name="direction" x="0" y="-2" z="0"/><rgb name="irradiance" value="3, 2, 1"/></emitter>
+    <emitter type="directional"><transform name="to_world"><rotate x="1" angle="90"/></transform></emitter>
+    <emitter type="point"><point name="position" x="1" y="2" z="3"/><rgb name="intensity" value="5"/></emitter>
+    <emitter type="point"><transform name="to_world"><translate x="-1"/></transform></emitter>)"),
+            {}, s);
+  ASSERT_EQ(s.deltaLights.size(), 4u);
+  const DeltaLight &sun = s.deltaLights[0], &rotated = s.deltaLights[1], &bulb = s.deltaLights[2],
+                   &moved = s.deltaLights[3];
+  EXPECT_FALSE(sun.point);
+  EXPECT_NEAR(sun.v.y, -1.f, 1e-6f) << "the direction is normalised";
+  EXPECT_EQ(sun.value.x, 3.f);
+  // to_world's +z: rotated 90 degrees about x, (0, 0, 1) -> (0, -1, 0); irradiance defaults to 1.
+  EXPECT_NEAR(rotated.v.y, -1.f, 1e-6f);
+  EXPECT_NEAR(rotated.v.z, 0.f, 1e-6f);
+  EXPECT_EQ(rotated.value.y, 1.f);
+  EXPECT_TRUE(bulb.point);
+  EXPECT_EQ(bulb.v.z, 3.f);
+  EXPECT_EQ(bulb.value.y, 5.f);
+  EXPECT_EQ(moved.v.x, -1.f) << "to_world's origin";
+  s.finalize();
+  EXPECT_EQ(s.view().deltaLightCount, 4);
+  EXPECT_FLOAT_EQ(s.view().deltaSelectProb(), 1.f) << "the only kind of light";
+
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<emitter type="directional"><vector name="direction" x="0" y="0" z="0"/></emitter>)", "non-zero, finite direction"},
+      {R"(<emitter type="directional"><vector name="direction" x="0" y="1" z="0"/>
+          <transform name="to_world"><translate x="1"/></transform></emitter>)", "'direction' or 'to_world', not both"},
+      {R"(<emitter type="point"><rgb name="intensity" value="-1"/></emitter>)", "'intensity' must not be negative"},
+      {R"(<emitter type="directional"><vector name="direction" x="1e30" y="0" z="0"/></emitter>)", "non-zero, finite direction"},
+  };
+  for (const auto& [body, expect] : bad) {
+    std::string err = loadError(f.scene(std::string(body) + kSensor));
+    EXPECT_NE(err.find(expect), std::string::npos) << body << "\n got: " << err;
+  }
 }
 
 TEST(SceneLoader, TexturesNestedReferencedAndOnEveryColourTheyReplace) {

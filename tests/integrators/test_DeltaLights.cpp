@@ -1,0 +1,112 @@
+// Directional and point lights against their analytic answers: a diffuse floor of albedo rho lit
+// by a sun of irradiance E at angle theta reflects rho E cos(theta) / pi, and by a point light of
+// intensity I at height h straight above, rho I / (pi h^2); with a constant sky of radiance 1 as
+// well, rho more. Every integrator reaches delta lights only through next-event estimation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "photon/PhotonTracing.h"
+#include "render/PhotonShooter.h"
+#include "scene/NameTables.h"
+#include "support/TestScenes.h"
+
+using namespace envgi;
+
+namespace {
+
+constexpr float kRho = 0.5f;
+
+// The floor alone (half-size 10), seen from above through a 2-degree field, no environment.
+std::unique_ptr<Scene> litFloor() {
+  Bsdf floor;
+  floor.reflectance = Color(kRho);
+  Image grey(4, 2);
+  for (float& v : grey.rgb) v = 1.f;  // replaced below: a black one would warn
+  auto s = test::sphereOnFloor(floor, floor, 10.f, std::move(grey), Vec3f(0, 4, 3), Vec3f(0, 0, 0), 8, 2.f);
+  s->spheres.clear();
+  s->shapes.pop_back();
+  s->env.reset();
+  s->sampler.type = SamplerType::Sobol;
+  s->sampler.sampleCount = 16;
+  return s;
+}
+
+DeltaLight sun(float E, float thetaDeg) {
+  float t = thetaDeg * kPi / 180.f;
+  return {Vec3f(std::sin(t), -std::cos(t), 0.f), Color(E), false};
+}
+
+double meanRadiance(Scene& s, const std::string& integrator) {
+  s.integrator = IntegratorSettings{};
+  s.integrator.type = findIntegrator(integrator);
+  s.finalize();
+  EmbreeAccel accel(s);
+  RenderOptions o;
+  o.progress = false;
+  RenderStats st;
+  Image img = render(s, accel, o, &st);
+  EXPECT_EQ(st.nonFiniteSamples, 0u);
+  double sum = 0.0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) sum += img.at(x, y).y;
+  return sum / (img.width * img.height);
+}
+
+}  // namespace
+
+TEST(DeltaLights, SunAndPointLightGiveTheirAnalyticRadiance) {
+  for (const char* integrator : {"direct", "path", "photon", "sppm"}) {
+    auto s = litFloor();
+    s->deltaLights = {sun(2.f, 30.f)};
+    double expected = kRho / kPi * 2.0 * std::cos(30.0 * kPi / 180.0);
+    EXPECT_NEAR(meanRadiance(*s, integrator), expected, 0.01 * expected) << integrator << ", sun";
+    s->deltaLights = {{Vec3f(0.f, 2.f, 0.f), Color(4.f), true}};
+    expected = kRho / kPi * 4.0 / 4.0;
+    EXPECT_NEAR(meanRadiance(*s, integrator), expected, 0.01 * expected) << integrator << ", point light";
+  }
+}
+
+// A sky and a sun together: next-event estimation picks each kind half the time, and the two
+// halves must still add up (the area light's and the map's MIS pdfs carry the same choice).
+TEST(DeltaLights, SunUnderAConstantSkyAddsToTheSky) {
+  for (const char* integrator : {"direct", "path"}) {
+    auto s = litFloor();
+    s->env = std::make_unique<EnvironmentMap>(EnvironmentMap::constant(Color(1.f)));
+    s->deltaLights = {sun(2.f, 30.f)};
+    s->sampler.sampleCount = 256;
+    double expected = kRho + kRho / kPi * 2.0 * std::cos(30.0 * kPi / 180.0);
+    EXPECT_NEAR(meanRadiance(*s, integrator), expected, 0.02 * expected) << integrator;
+  }
+}
+
+// Photons from a sun of irradiance E at angle theta onto the floor's central 2 x 2 square carry
+// E cos(theta) 4; from a point light of intensity I at height h above its centre, I times the
+// square's solid angle 4 atan(1 / (h sqrt(2 + h^2))).
+TEST(DeltaLights, PhotonsCarryTheLightsPower) {
+  auto s = litFloor();
+  const float h = 2.f;
+  s->deltaLights = {sun(3.f, 30.f), {Vec3f(0.f, h, 0.f), Color(4.f), true}};
+  s->finalize();
+  PhotonEmitter em = makePhotonEmitter(*s);
+  ASSERT_TRUE(em.emitsLight(s->view()));
+  const int n = 1000000;
+  double arrived[2] = {0.0, 0.0};
+  Sampler smp;
+  for (int i = 0; i < n; ++i) {
+    smp.start(uint64_t(i), 0);
+    Ray r;
+    Color pw;
+    if (!em.emit(s->view(), smp, &r, &pw) || r.d.y >= 0.f) continue;
+    float t = -r.o.y / r.d.y;
+    Vec3f p = r.o + r.d * t;
+    bool isPoint = r.o.y == h && r.o.x == 0.f && r.o.z == 0.f;
+    if (t > 0.f && std::fabs(p.x) <= 1.f && std::fabs(p.z) <= 1.f) arrived[isPoint ? 1 : 0] += pw.y / n;
+  }
+  double fromSun = 3.0 * std::cos(30.0 * kPi / 180.0) * 4.0;
+  double fromPoint = 4.0 * 4.0 * std::atan(1.0 / (h * std::sqrt(2.0 + h * h)));
+  std::printf("arrived %.4f from the sun (expected %.4f), %.4f from the point light (expected %.4f)\n", arrived[0],
+              fromSun, arrived[1], fromPoint);
+  EXPECT_NEAR(arrived[0], fromSun, 0.03 * fromSun);
+  EXPECT_NEAR(arrived[1], fromPoint, 0.03 * fromPoint);
+}
