@@ -1,7 +1,8 @@
 // Directional and point lights against their analytic answers: a diffuse floor of albedo rho lit
 // by a sun of irradiance E at angle theta reflects rho E cos(theta) / pi, and by a point light of
 // intensity I at height h straight above, rho I / (pi h^2); with a constant sky of radiance 1 as
-// well, rho more. Every integrator reaches delta lights only through next-event estimation.
+// well, rho more. Every integrator (path, direct, and the photon mappers' direct light) reaches
+// delta lights only through next-event estimation.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -56,7 +57,7 @@ double meanRadiance(Scene& s, const std::string& integrator) {
 }  // namespace
 
 TEST(DeltaLights, SunAndPointLightGiveTheirAnalyticRadiance) {
-  for (const char* integrator : {"direct", "path", "photon", "sppm"}) {
+  for (const char* integrator : {"direct", "path", "photon", "sppm", "grid"}) {
     auto s = litFloor();
     s->deltaLights = {sun(2.f, 30.f)};
     double expected = kRho / kPi * 2.0 * std::cos(30.0 * kPi / 180.0);
