@@ -190,15 +190,19 @@ def main():
             lambda t: re.sub(r'<shape type="(rectangle|cube)">.*?</shape>', '', t, flags=re.S).replace(
                 '<integrator type="path">', '<integrator type="path"><boolean name="hide_emitters" value="true"/>'))
     # Delta lights: the sun, point and area lights of sun-and-sky with the map's background
-    # hidden (the open row placement), and a point light added to the area-lit Cornell box. The
+    # hidden (the open row placement), and a point light and a spot added to the area-lit
+    # Cornell box. The
     # box's paths stop at depth 3 there: its glass sphere's caustic fireflies put one region at
     # z 4.4 with 8 seeds (|z| <= 2.0 with 32).
     variant('sun-and-sky (map hidden)', 'sun-and-sky',
             lambda t: t.replace('<integrator type="path">', '<integrator type="path"><boolean name="hide_emitters" value="true"/>'))
-    variant('cornell-box with a point light, depth 3', 'cornell-box',
+    variant('cornell-box with a point light and a spot, depth 3', 'cornell-box',
             lambda t: t.replace('<default name="max_depth" value="10"/>', '<default name="max_depth" value="3"/>').replace(
                 '</scene>', '<emitter type="point"><point name="position" x="0.4" y="1.2" z="0.6"/>'
-                '<rgb name="intensity" value="0.8, 0.9, 1.2"/></emitter></scene>'))
+                '<rgb name="intensity" value="0.8, 0.9, 1.2"/></emitter>'
+                '<emitter type="spot"><transform name="to_world"><lookat origin="-0.5, 1.8, 0.8" target="-0.3, 0, -0.5" '
+                'up="0, 1, 0"/></transform><float name="cutoff_angle" value="25"/><rgb name="intensity" value="3, 2.5, 2"/>'
+                '</emitter></scene>'))
     configs = [c for c in configs if args.only in c[0]]
     total_regions = sum(c[3] * c[3] for c in configs)
     alpha = 1.0 - 0.99 ** (1.0 / total_regions)

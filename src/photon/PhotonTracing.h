@@ -48,13 +48,19 @@ struct PhotonEmitter {
     float areaProb = 1.f - envProb - deltaProb;
     if (deltaProb > 0.f && (sc.lightCount == 0 || !(uSel < envProb + areaProb))) {
       // A delta light, all alike: a sun's photons cross a disk covering the bounding sphere
-      // along its direction, a point light's leave it uniformly over the sphere.
+      // along its direction, a point light's leave it uniformly over the sphere, a spot's over
+      // its cone.
       int m = sc.deltaLightCount;
       int i = int((uSel - envProb - areaProb) / deltaProb * float(m));
       const DeltaLight& l = sc.deltaLights[i < 0 ? 0 : (i < m ? i : m - 1)];
       float pick = deltaProb / float(m);
       ray->tMax = INFINITY;
-      if (l.point) {
+      if (l.point && l.cosCutoff >= -1.f) {
+        // A spot: uniform over its cone, each photon carrying the falloff along its direction.
+        ray->o = l.v;
+        ray->d = Frame::fromNormal(l.axis).toWorld(sampleUniformCone(u1, l.cosCutoff));
+        *power = l.value * (spotFalloff(l, ray->d) / (uniformConePdf(l.cosCutoff) * pick));
+      } else if (l.point) {
         ray->o = l.v;
         ray->d = sampleUniformSphere(u1);
         *power = l.value * (4.f * kPi / pick);

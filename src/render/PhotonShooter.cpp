@@ -17,11 +17,13 @@ PhotonEmitter makePhotonEmitter(const Scene& scene) {
   double areaPower = 0.0;
   for (int i = 0; i < sc.lightCount; ++i) areaPower += kPi * sc.lights[i].area * luminance(sc.lights[i].radiance);
   // A delta light's power: a sun's irradiance over the bounding sphere's cross-section, a point
-  // light's intensity over the whole sphere of directions.
+  // light's intensity over the whole sphere of directions, a spot's over its cone (the falloff
+  // taken as full: a bound, which only shifts how photons are shared among the lights).
   double deltaPower = 0.0;
   for (int i = 0; i < sc.deltaLightCount; ++i) {
     const DeltaLight& l = sc.deltaLights[i];
-    deltaPower += luminance(l.value) * (l.point ? 4.0 * kPi : double(kPi) * e.radius * e.radius);
+    double solidAngle = l.cosCutoff >= -1.f ? 2.0 * kPi * (1.0 - l.cosCutoff) : 4.0 * kPi;
+    deltaPower += luminance(l.value) * (l.point ? solidAngle : double(kPi) * e.radius * e.radius);
   }
   double total = envPower + areaPower + deltaPower;
   e.envProb = total > 0.0 ? float(envPower / total) : 0.f;

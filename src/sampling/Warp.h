@@ -21,6 +21,15 @@ ENVGI_INLINE Vec3f sampleUniformHemisphere(Vec2f u) {
 }
 ENVGI_INLINE float uniformHemispherePdf() { return kInv2Pi; }
 
+// Uniform over the cap of directions within angle acos(cosMax) of +z (a spot light's cone).
+ENVGI_INLINE Vec3f sampleUniformCone(Vec2f u, float cosMax) {
+  float z = 1.f - u.x * (1.f - cosMax);
+  float r = safeSqrt(1.f - z * z);
+  float phi = 2.f * kPi * u.y;
+  return {r * std::cos(phi), r * std::sin(phi), z};
+}
+ENVGI_INLINE float uniformConePdf(float cosMax) { return 1.f / (2.f * kPi * (1.f - cosMax)); }
+
 // Shirley-Chiu concentric map: keeps strata compact, which stratified sequences rely on.
 ENVGI_INLINE Vec2f sampleConcentricDisk(Vec2f u) {
   float ox = 2.f * u.x - 1.f, oy = 2.f * u.y - 1.f;

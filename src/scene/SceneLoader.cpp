@@ -536,6 +536,29 @@ class Loader {
     return l;
   }
 
+  // Mitsuba's `spot`: at to_world's origin, shining along its +z, full `intensity` within
+  // `beam_width` degrees of the axis (3/4 of the cutoff unless given), none beyond `cutoff_angle`.
+  DeltaLight spotLight(const SourceFile* f, pugi::xml_node n, Props& p) {
+    Transform t = getTransform(f, p, "to_world");
+    DeltaLight l;
+    l.point = true;
+    l.v = t.point(Vec3f(0.f));
+    Vec3f axis = t.vector(Vec3f(0.f, 0.f, 1.f));
+    if (!(lengthSq(axis) > 0.f) || !std::isfinite(lengthSq(axis))) fail(f, n, "a 'spot' emitter's to_world loses its axis");
+    l.axis = normalize(axis);
+    l.value = getColor(f, p, "intensity", Color(1.f));
+    float cutoff = getFloat(f, p, "cutoff_angle", 20.f);
+    float beam = getFloat(f, p, "beam_width", cutoff * 0.75f);
+    if (!(cutoff > 0.f && cutoff <= 180.f)) fail(f, n, "cutoff_angle must be in (0, 180] degrees");
+    if (!(beam > 0.f && beam <= cutoff)) fail(f, n, "beam_width must be in (0, cutoff_angle] degrees");
+    l.cutoff = cutoff * kPi / 180.f;
+    float beamRad = beam * kPi / 180.f;
+    l.cosCutoff = std::cos(l.cutoff);
+    l.cosBeam = std::cos(beamRad);
+    l.invTransition = l.cutoff > beamRad ? 1.f / (l.cutoff - beamRad) : 0.f;
+    return l;
+  }
+
   // An area emitter marks its shape emissive; envmap and constant become the scene's environment.
   void emitter(const SourceFile* f, pugi::xml_node n, ShapeEntry* shape) {
     checkAttrs(f, n, {"type", "id", "name"});
@@ -578,6 +601,8 @@ class Loader {
       }
     } else if (type == "directional" || type == "point") {
       scene_.deltaLights.push_back(deltaLight(f, n, type, p));
+    } else if (type == "spot") {
+      scene_.deltaLights.push_back(spotLight(f, n, p));
     } else {
       warnOnce(fmt::format("{}:{}: emitter type '{}' is not supported and was ignored", f->path,
                            f->lineOf(n.offset_debug()), type));

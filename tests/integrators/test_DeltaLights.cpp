@@ -33,6 +33,17 @@ std::unique_ptr<Scene> litFloor() {
   return s;
 }
 
+// A spot as the loader makes one (degrees in, Mitsuba's parameters).
+DeltaLight spotLight(Vec3f at, Vec3f axis, float intensity, float cutoffDeg, float beamDeg) {
+  DeltaLight l{at, Color(intensity), true};
+  l.axis = normalize(axis);
+  l.cutoff = cutoffDeg * kPi / 180.f;
+  l.cosCutoff = std::cos(l.cutoff);
+  l.cosBeam = std::cos(beamDeg * kPi / 180.f);
+  l.invTransition = 1.f / (l.cutoff - beamDeg * kPi / 180.f);
+  return l;
+}
+
 DeltaLight sun(float E, float thetaDeg) {
   float t = thetaDeg * kPi / 180.f;
   return {Vec3f(std::sin(t), -std::cos(t), 0.f), Color(E), false};
@@ -65,7 +76,28 @@ TEST(DeltaLights, SunAndPointLightGiveTheirAnalyticRadiance) {
     s->deltaLights = {{Vec3f(0.f, 2.f, 0.f), Color(4.f), true}};
     expected = kRho / kPi * 4.0 / 4.0;
     EXPECT_NEAR(meanRadiance(*s, integrator), expected, 0.01 * expected) << integrator << ", point light";
+    // A spot aimed 25 degrees off the floor's centre, halfway through its falloff (beam 20,
+    // cutoff 30): half its intensity reaches the centre, at cos 25 from the light's height.
+    DeltaLight spot = spotLight(Vec3f(0.f, 2.f, 0.f), Vec3f(std::sin(0.4363323f), -std::cos(0.4363323f), 0.f), 4.f, 30.f, 20.f);
+    s->deltaLights = {spot};
+    EXPECT_NEAR(meanRadiance(*s, integrator), 0.5 * expected, 0.02 * expected) << integrator << ", spot";
   }
+}
+
+TEST(DeltaLights, SpotFalloffIsLinearInAngleFromBeamToCutoff) {
+  DeltaLight l = spotLight(Vec3f(0.f), Vec3f(0.f, 0.f, 1.f), 1.f, 30.f, 20.f);
+  auto at = [&](float deg) {
+    float t = deg * kPi / 180.f;
+    return spotFalloff(l, Vec3f(std::sin(t), 0.f, std::cos(t)));
+  };
+  EXPECT_EQ(at(0.f), 1.f);
+  EXPECT_EQ(at(19.9f), 1.f);
+  EXPECT_NEAR(at(25.f), 0.5f, 1e-3f);
+  EXPECT_NEAR(at(27.5f), 0.25f, 1e-3f);
+  EXPECT_EQ(at(30.1f), 0.f);
+  EXPECT_EQ(at(120.f), 0.f);
+  DeltaLight point{Vec3f(0.f), Color(1.f), true};
+  EXPECT_EQ(spotFalloff(point, Vec3f(0.f, 0.f, -1.f)), 1.f) << "a point light shines everywhere";
 }
 
 // A sky and a sun together: next-event estimation picks each kind half the time, and the two
@@ -110,4 +142,21 @@ TEST(DeltaLights, PhotonsCarryTheLightsPower) {
               fromSun, arrived[1], fromPoint);
   EXPECT_NEAR(arrived[0], fromSun, 0.03 * fromSun);
   EXPECT_NEAR(arrived[1], fromPoint, 0.03 * fromPoint);
+
+  // A spot in the point light's place, aimed down, whose beam (45 degrees) holds the whole square
+  // (35.3 degrees to its corners): the same power arrives, from photons drawn over its cone only.
+  s->deltaLights = {spotLight(Vec3f(0.f, h, 0.f), Vec3f(0.f, -1.f, 0.f), 4.f, 60.f, 45.f)};
+  s->finalize();
+  em = makePhotonEmitter(*s);
+  double fromSpot = 0.0;
+  for (int i = 0; i < n; ++i) {
+    smp.start(uint64_t(i), 0);
+    Ray r;
+    Color pw;
+    if (!em.emit(s->view(), smp, &r, &pw) || r.d.y >= 0.f) continue;
+    Vec3f p = r.o + r.d * (-r.o.y / r.d.y);
+    if (std::fabs(p.x) <= 1.f && std::fabs(p.z) <= 1.f) fromSpot += pw.y / n;
+  }
+  std::printf("arrived %.4f from the spot (expected %.4f)\n", fromSpot, fromPoint);
+  EXPECT_NEAR(fromSpot, fromPoint, 0.02 * fromPoint);
 }

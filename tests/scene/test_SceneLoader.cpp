@@ -316,7 +316,7 @@ TEST(SceneLoader, HarmlessUnsupportedElementsOnlyWarn) {
   Fixture f;
   Scene s;
   EXPECT_NO_THROW(loadScene(f.scene(std::string(kSensor) + R"(
-    <emitter type="spot"/>
+    <emitter type="projector"/>
     <phase type="hg"/>
     <shape type="sphere"><float name="mystery" value="1"/></shape>
     <shape type="sphere"><emitter type="area"><texture type="checkerboard" name="radiance"/></emitter></shape>)"),
@@ -352,7 +352,26 @@ TEST(SceneLoader, DirectionalAndPointEmitters) {
   EXPECT_EQ(s.view().deltaLightCount, 4);
   EXPECT_FLOAT_EQ(s.view().deltaSelectProb(), 1.f) << "the only kind of light";
 
+  Scene spots;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <emitter type="spot"><transform name="to_world"><lookat origin="0, 2, 0" target="0, 0, 0" up="1, 0, 0"/></transform>
+      <float name="cutoff_angle" value="30"/><rgb name="intensity" value="7"/></emitter>
+    <emitter type="spot"/>)"),
+            {}, spots);
+  ASSERT_EQ(spots.deltaLights.size(), 2u);
+  const DeltaLight& spot = spots.deltaLights[0];
+  EXPECT_TRUE(spot.point);
+  EXPECT_NEAR(spot.v.y, 2.f, 1e-6f);
+  EXPECT_NEAR(spot.axis.y, -1.f, 1e-6f) << "lookat's +z points at the target";
+  EXPECT_EQ(spot.value.x, 7.f);
+  EXPECT_NEAR(spot.cosCutoff, std::cos(30.f * kPi / 180.f), 1e-6f);
+  EXPECT_NEAR(spot.cosBeam, std::cos(22.5f * kPi / 180.f), 1e-6f) << "beam_width defaults to 3/4 of the cutoff";
+  EXPECT_NEAR(spots.deltaLights[1].cosCutoff, std::cos(20.f * kPi / 180.f), 1e-6f) << "cutoff_angle defaults to 20";
+
   const std::pair<const char*, const char*> bad[] = {
+      {R"(<emitter type="spot"><float name="cutoff_angle" value="20"/><float name="beam_width" value="25"/></emitter>)",
+       "beam_width must be in (0, cutoff_angle]"},
+      {R"(<emitter type="spot"><float name="cutoff_angle" value="0"/></emitter>)", "cutoff_angle must be in (0, 180]"},
       {R"(<emitter type="directional"><vector name="direction" x="0" y="0" z="0"/></emitter>)", "non-zero, finite direction"},
       {R"(<emitter type="directional"><vector name="direction" x="0" y="1" z="0"/>
           <transform name="to_world"><translate x="1"/></transform></emitter>)", "'direction' or 'to_world', not both"},
