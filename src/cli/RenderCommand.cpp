@@ -69,7 +69,7 @@ void runRender(const RenderArgs& a) {
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   spdlog::info("scene {}: {} triangles, {} spheres, {} area-light primitives{}{}, {:.1f} MB of geometry, loaded in {:.2f} s",
                a.scene, scene.triangleCount(), scene.spheres.size(), scene.lightCount(),
-               scene.deltaLights.empty() ? "" : fmt::format(", {} directional/point lights", scene.deltaLights.size()),
+               scene.deltaLights.empty() ? "" : fmt::format(", {} directional/point/spot lights", scene.deltaLights.size()),
                scene.env ? ", environment map" : "", scene.geometryBytes() / 1e6, loadSeconds);
 
   SaveOptions so;

@@ -211,6 +211,10 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
   k.direct.bsdfSamples = is.direct.bsdfSamples >= 0 ? is.direct.bsdfSamples : sn.bsdfSamples;
   if (k.type == SampleIntegratorType::Direct && k.direct.emitterSamples + k.direct.bsdfSamples == 0)
     throw std::runtime_error("direct integrator: no samples");
+  if (k.type == SampleIntegratorType::Direct && k.direct.emitterSamples == 0 && !scene.deltaLights.empty())
+    spdlog::warn("direct integrator without emitter samples: the {} directional, point or spot light(s) add nothing "
+                 "(only emitter samples reach them)",
+                 scene.deltaLights.size());
   // A compensated map density is zero where L is below its mean: only with BSDF samples beside
   // it does every direction get covered (Karlik et al. 2019).
   bool compensated = scene.env && scene.env->options().misCompensation;

@@ -172,6 +172,21 @@ TEST(CliPhotons, DrawsPhotonsAndRejectsBadInput) {
   EXPECT_FALSE(fs::exists(d.file("q.png")));
 }
 
+// Delta lights are reached by emitter samples only: BSDF samples alone leave them out, and the
+// log says so.
+TEST(CliRender, DeltaLightsWithoutEmitterSamplesAreReported) {
+  TempDir d;
+  std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/sun-and-sky.xml";
+  CliResult r = runCli("render " + scene + " -o " + d.file("s.exr") + " --integrator direct --strategy bsdf --spp 1 "
+                       "-D res=16 --no-progress");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("the 2 directional, point or spot light(s) add nothing"), std::string::npos) << r.output;
+  CliResult path = runCli("render " + scene + " -o " + d.file("p.exr") + " --spp 1 -D res=16 --no-progress");
+  ASSERT_EQ(path.code, 0) << path.output;
+  EXPECT_NE(path.output.find("2 directional/point/spot lights"), std::string::npos) << path.output;
+  EXPECT_EQ(path.output.find("add nothing"), std::string::npos) << path.output;
+}
+
 TEST(CliRender, PhotonSppmAndGridIntegrators) {
   TempDir d;
   std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml";
