@@ -1,6 +1,7 @@
 // The paper's first pass (Section 3): photons leave the environment map (its Algorithm 1
-// density), the area lights and the delta lights, bounce with Russian roulette by albedo through glass and
-// mirrors, and are handed to a store callback at every non-specular hit after the first.
+// density), the area lights and the delta lights, bounce with Russian roulette by albedo
+// through glass and mirrors, and are handed to a store callback at every non-specular hit
+// after the first.
 // Host/device: the store callback and the tracer are template parameters.
 #pragma once
 
