@@ -64,9 +64,8 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
     // One delta light, all alike; the kind's share of uSel picks it.
     float pd = sc.deltaSelectProb();
     int n = sc.deltaLightCount;
-    int i = int((uSel - pe - pa) / pd * float(n));
-    i = i < 0 ? 0 : (i < n ? i : n - 1);
-    ls->radiance = deltaLightIncident(sc.deltaLights[i], si.p, &ls->dir, &ls->dist);
+    const DeltaLight& l = sc.deltaLights[uniformLightIndex((uSel - pe - pa) / pd, n)];
+    ls->radiance = deltaLightIncident(l, si.p, &ls->dir, &ls->dist);
     ls->pdf = pd / float(n);
     ls->environment = false;
     ls->delta = true;

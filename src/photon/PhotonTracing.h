@@ -52,11 +52,10 @@ struct PhotonEmitter {
       // along its direction, a point light's leave it uniformly over the sphere, a spot's over
       // its cone.
       int m = sc.deltaLightCount;
-      int i = int((uSel - envProb - areaProb) / deltaProb * float(m));
-      const DeltaLight& l = sc.deltaLights[i < 0 ? 0 : (i < m ? i : m - 1)];
+      const DeltaLight& l = sc.deltaLights[uniformLightIndex((uSel - envProb - areaProb) / deltaProb, m)];
       float pick = deltaProb / float(m);
       ray->tMax = INFINITY;
-      if (l.point && l.cosCutoff >= -1.f) {
+      if (isSpot(l)) {
         // A spot: uniform over its cone, each photon carrying the falloff along its direction.
         ray->o = l.v;
         ray->d = Frame::fromNormal(l.axis).toWorld(sampleUniformCone(u1, l.cosCutoff));

@@ -22,7 +22,7 @@ PhotonEmitter makePhotonEmitter(const Scene& scene) {
   double deltaPower = 0.0;
   for (int i = 0; i < sc.deltaLightCount; ++i) {
     const DeltaLight& l = sc.deltaLights[i];
-    double solidAngle = l.cosCutoff >= -1.f ? 2.0 * kPi * (1.0 - l.cosCutoff) : 4.0 * kPi;
+    double solidAngle = isSpot(l) ? 2.0 * kPi * (1.0 - l.cosCutoff) : 4.0 * kPi;
     deltaPower += luminance(l.value) * (l.point ? solidAngle : double(kPi) * e.radius * e.radius);
   }
   double total = envPower + areaPower + deltaPower;

@@ -18,10 +18,18 @@ struct DeltaLight {
   float cosCutoff = -2.f, cosBeam = -2.f, cutoff = 0.f, invTransition = 0.f;
 };
 
+ENVGI_HD inline bool isSpot(const DeltaLight& l) { return l.point && l.cosCutoff >= -1.f; }
+
+// Light n of n alike for r in [0, 1): the index next-event estimation and photon emission pick.
+ENVGI_HD inline int uniformLightIndex(float r, int n) {
+  int i = int(r * float(n));
+  return i < 0 ? 0 : (i < n ? i : n - 1);
+}
+
 // A spot's intensity towards unit direction d (from the light) over its peak: Mitsuba's falloff,
 // 1 inside the beam, linear in angle down to 0 at the cutoff; 1 everywhere for a point light.
 ENVGI_HD inline float spotFalloff(const DeltaLight& l, Vec3f d) {
-  if (l.cosCutoff < -1.f) return 1.f;
+  if (!isSpot(l)) return 1.f;
   float c = dot(d, l.axis);
   if (!(c > l.cosCutoff)) return 0.f;
   if (c >= l.cosBeam) return 1.f;

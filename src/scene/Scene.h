@@ -50,7 +50,7 @@ class Scene {
   std::vector<Bsdf> bsdfs;
   std::vector<Texture> textures;
   std::unique_ptr<EnvironmentMap> env;
-  std::vector<DeltaLight> deltaLights;  // `directional` and `point` emitters
+  std::vector<DeltaLight> deltaLights;  // `directional`, `point` and `spot` emitters
   Camera camera;
   IntegratorSettings integrator;
   SamplerSettings sampler;

@@ -513,6 +513,12 @@ class Loader {
     warnUnused(f, p, "sampler '" + type + "'");
   }
 
+  // A light's direction as a unit vector; zero, or so long that its length overflows, is an error.
+  Vec3f unitDirection(const SourceFile* f, pugi::xml_node n, Vec3f d, const char* what) {
+    if (!(lengthSq(d) > 0.f) || !std::isfinite(lengthSq(d))) fail(f, n, what);
+    return normalize(d);
+  }
+
   // Mitsuba's `directional` (irradiance, travelling along `direction` or to_world's +z) and
   // `point` (intensity, at `position` or to_world's origin); giving both forms is an error there.
   DeltaLight deltaLight(const SourceFile* f, pugi::xml_node n, const std::string& type, Props& p) {
@@ -528,9 +534,7 @@ class Loader {
       l.value = getColor(f, p, "intensity", Color(1.f));
     } else {
       Vec3f d = explicitForm ? getPoint(f, p, "direction", Vec3f(0.f)) : t.vector(Vec3f(0.f, 0.f, 1.f));
-      if (!(lengthSq(d) > 0.f) || !std::isfinite(lengthSq(d)))
-        fail(f, n, "a 'directional' emitter needs a non-zero, finite direction");
-      l.v = normalize(d);
+      l.v = unitDirection(f, n, d, "a 'directional' emitter needs a non-zero, finite direction");
       l.value = getColor(f, p, "irradiance", Color(1.f));
     }
     return l;
@@ -543,9 +547,7 @@ class Loader {
     DeltaLight l;
     l.point = true;
     l.v = t.point(Vec3f(0.f));
-    Vec3f axis = t.vector(Vec3f(0.f, 0.f, 1.f));
-    if (!(lengthSq(axis) > 0.f) || !std::isfinite(lengthSq(axis))) fail(f, n, "a 'spot' emitter's to_world loses its axis");
-    l.axis = normalize(axis);
+    l.axis = unitDirection(f, n, t.vector(Vec3f(0.f, 0.f, 1.f)), "a 'spot' emitter's to_world loses its axis");
     l.value = getColor(f, p, "intensity", Color(1.f));
     float cutoff = getFloat(f, p, "cutoff_angle", 20.f);
     float beam = getFloat(f, p, "beam_width", cutoff * 0.75f);

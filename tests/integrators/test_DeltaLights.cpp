@@ -81,6 +81,10 @@ TEST(DeltaLights, SunAndPointLightGiveTheirAnalyticRadiance) {
     DeltaLight spot = spotLight(Vec3f(0.f, 2.f, 0.f), Vec3f(std::sin(0.4363323f), -std::cos(0.4363323f), 0.f), 4.f, 30.f, 20.f);
     s->deltaLights = {spot};
     EXPECT_NEAR(meanRadiance(*s, integrator), 0.5 * expected, 0.02 * expected) << integrator << ", spot";
+    // Sun and point light together: each picked half the time, their radiances add.
+    s->deltaLights = {sun(2.f, 30.f), {Vec3f(0.f, 2.f, 0.f), Color(4.f), true}};
+    expected = kRho / kPi * (2.0 * std::cos(30.0 * kPi / 180.0) + 1.0);
+    EXPECT_NEAR(meanRadiance(*s, integrator), expected, 0.02 * expected) << integrator << ", sun and point light";
   }
 }
 

@@ -372,6 +372,8 @@ TEST(SceneLoader, DirectionalAndPointEmitters) {
       {R"(<emitter type="spot"><float name="cutoff_angle" value="20"/><float name="beam_width" value="25"/></emitter>)",
        "beam_width must be in (0, cutoff_angle]"},
       {R"(<emitter type="spot"><float name="cutoff_angle" value="0"/></emitter>)", "cutoff_angle must be in (0, 180]"},
+      {R"(<emitter type="spot"><transform name="to_world"><scale value="1e20"/></transform></emitter>)",
+       "'spot' emitter's to_world loses its axis"},
       {R"(<emitter type="directional"><vector name="direction" x="0" y="0" z="0"/></emitter>)", "non-zero, finite direction"},
       {R"(<emitter type="directional"><vector name="direction" x="0" y="1" z="0"/>
           <transform name="to_world"><translate x="1"/></transform></emitter>)", "'direction' or 'to_world', not both"},
