@@ -9,6 +9,7 @@
 #include "cli/Commands.h"
 #include "core/Files.h"
 #include "envmap/EnvironmentMap.h"
+#include "envmap/LightProbe.h"
 #include "sampling/Sampler.h"
 #include "scene/NameTables.h"
 
@@ -128,6 +129,25 @@ void runPlot(const SampleArgs& a, float exposure) {
   spdlog::info("wrote {} with {} {} samples", a.out, samples.size(), a.strategy);
 }
 
+struct ConvertArgs {
+  std::string probe, out, layout = "angular";
+  int width = 0, samples = 0;
+};
+
+void runConvert(const ConvertArgs& a) {
+  ProbeLayout layout = parseProbeLayout(a.layout);
+  Image probe = loadImage(a.probe);
+  ProbeConversion c;
+  c.width = a.width;
+  c.samplesPerSide = a.samples;
+  size_t invalid = 0;
+  Image map = probeToLatLong(probe, layout, c, &invalid);
+  if (invalid > 0) spdlog::warn("{}: {} NaN, infinite or negative channel values read as 0", a.probe, invalid);
+  saveImage(map, a.out);
+  spdlog::info("wrote {} ({}x{} lat-long) from the {} {} ({}x{})", a.out, map.width, map.height, a.layout, a.probe,
+               probe.width, probe.height);
+}
+
 }  // namespace
 
 void addEnvmapCommands(CLI::App& app) {
@@ -152,6 +172,17 @@ void addEnvmapCommands(CLI::App& app) {
   plot->add_option("-o,--output", pa->out, "Image (.png)")->required();
   plot->add_option("--exposure", *exposure, "Exposure in stops (default: automatic)")->check(finiteNumber());
   plot->callback([pa, exposure] { runPlot(*pa, *exposure); });
+
+  auto ca = std::make_shared<ConvertArgs>();
+  CLI::App* convert = env->add_subcommand(
+      "convert", "Resample a light probe (angular map or mirror ball) to a lat-long map, forward in its centre column");
+  convert->add_option("probe", ca->probe, "Square probe image (.hdr, .exr, .pfm)")->required();
+  convert->add_option("-o,--output", ca->out, "Lat-long map (.exr, .hdr, .pfm)")->required();
+  convert->add_option("--layout", ca->layout, "angular (Debevec's gallery; the default) or mirrorball");
+  convert->add_option("--width", ca->width, "Map width, even (default: twice the probe's)")->check(atLeast(2));
+  convert->add_option("--samples", ca->samples, "n: n x n lookups a map pixel (default: enough for the probe's detail)")
+      ->check(atLeast(1));
+  convert->callback([ca] { runConvert(*ca); });
 }
 
 }  // namespace envgi::cli

@@ -1,4 +1,5 @@
 #include "envmap/EnvironmentMap.h"
+#include "envmap/LightProbe.h"
 
 #include <spdlog/spdlog.h>
 
@@ -44,8 +45,26 @@ EnvironmentMap EnvironmentMap::load(const std::string& path, const EnvironmentMa
     throw std::runtime_error("environment map '" + path + "' is too small (" + std::to_string(img.width) + "x" +
                              std::to_string(img.height) + ")");
   if (img.width != 2 * img.height)
-    spdlog::warn("environment map '{}' is {}x{}, not 2:1; it is still read as lat-long", path, img.width, img.height);
+    spdlog::warn("environment map '{}' is {}x{}, not 2:1; it is still read as lat-long{}", path, img.width, img.height,
+                 img.width == img.height ? " (a light probe? the envmap's 'layout' reads angular maps and mirror balls)" : "");
   return EnvironmentMap(std::move(img), opts, path);
+}
+
+EnvironmentMap EnvironmentMap::loadProbe(const std::string& path, ProbeLayout layout, const EnvironmentMapOptions& opts) {
+  Image probe = loadImage(path);
+  size_t invalid = 0;
+  Image map;
+  try {
+    map = probeToLatLong(probe, layout, {}, &invalid);
+  } catch (const std::runtime_error& e) {
+    throw std::runtime_error("light probe '" + path + "': " + e.what());
+  }
+  if (invalid > 0)
+    spdlog::warn("light probe '{}': {} NaN, infinite or negative channel values replaced with 0", path, invalid);
+  spdlog::info("light probe '{}' ({}, {}x{}) resampled to a {}x{} lat-long map", path,
+               layout == ProbeLayout::Angular ? "angular map" : "mirror ball", probe.width, probe.height, map.width,
+               map.height);
+  return EnvironmentMap(std::move(map), opts, path);
 }
 
 EnvironmentMap EnvironmentMap::constant(Color radiance, const EnvironmentMapOptions& opts) {

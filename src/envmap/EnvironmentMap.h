@@ -9,6 +9,8 @@
 
 namespace envgi {
 
+enum class ProbeLayout;  // envmap/LightProbe.h, kept out of the device code's includes
+
 struct EnvironmentMapOptions {
   float scale = 1.f;
   Transform toWorld;
@@ -31,6 +33,9 @@ class EnvironmentMap {
  public:
   // Throws std::runtime_error for an unreadable file or a negative scale.
   static EnvironmentMap load(const std::string& path, const EnvironmentMapOptions& opts = {});
+  // A square light probe (angular map or mirror ball), resampled to a lat-long map at twice its
+  // width (probeToLatLong); throws as probeToLatLong and load() do.
+  static EnvironmentMap loadProbe(const std::string& path, ProbeLayout layout, const EnvironmentMapOptions& opts = {});
   // A map of constant radiance (small, so that the sin-theta weighting still applies).
   static EnvironmentMap constant(Color radiance, const EnvironmentMapOptions& opts = {});
 

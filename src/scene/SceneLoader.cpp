@@ -10,6 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "envmap/LightProbe.h"
 #include "image/Image.h"
 #include "materials/BsdfFactory.h"
 #include "scene/NameTables.h"
@@ -592,8 +593,14 @@ class Loader {
         std::string filter = getString(f, p, "filter_type", "bilinear");
         if (filter != "bilinear" && filter != "nearest") fail(f, n, "filter_type must be bilinear or nearest");
         o.bilinear = filter == "bilinear";
+        // envgi's own: a square light probe, resampled to lat-long as it is read.
+        std::string layout = getString(f, p, "layout", "latlong");
+        if (layout != "latlong" && layout != "angular" && layout != "mirrorball")
+          fail(f, n, "layout must be latlong, angular or mirrorball, not '" + layout + "'");
         try {
-          scene_.env = std::make_unique<EnvironmentMap>(EnvironmentMap::load(path.string(), o));
+          scene_.env = std::make_unique<EnvironmentMap>(
+              layout == "latlong" ? EnvironmentMap::load(path.string(), o)
+                                  : EnvironmentMap::loadProbe(path.string(), parseProbeLayout(layout), o));
         } catch (const std::runtime_error& e) {
           rethrowAt(f, n, e);
         }

@@ -93,6 +93,33 @@ TEST(CliEnvmap, PlotWritesPng) {
   EXPECT_GT(fs::file_size(out), 1000u);
 }
 
+TEST(CliEnvmap, ConvertMakesALatLongMapOfAProbe) {
+  TempDir d;
+  std::string probe = std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/uffizi_probe_128.exr", out = d.file("uffizi.exr");
+  CliResult r = runCli("envmap convert " + probe + " --width 64 -o " + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("wrote " + out + " (64x32 lat-long) from the angular"), std::string::npos) << r.output;
+  CliResult info = runCli("envmap info " + out);
+  ASSERT_EQ(info.code, 0) << info.output;
+  EXPECT_NE(info.output.find("size:           64 x 32"), std::string::npos) << info.output;
+
+  // A lat-long map given as a probe, an unknown layout, an odd width: one line each, no file.
+  std::string never = d.file("never.exr");
+  CliResult latlong = runCli("envmap convert " + bundledMap() + " -o " + never);
+  EXPECT_NE(latlong.code, 0);
+  EXPECT_NE(latlong.output.find("envgi: error: a light probe is a square image, not 1024x512 (this looks like a lat-long"),
+            std::string::npos)
+      << latlong.output;
+  CliResult layout = runCli("envmap convert " + probe + " --layout cubemap -o " + never);
+  EXPECT_NE(layout.output.find("unknown light-probe layout 'cubemap' (angular, mirrorball)"), std::string::npos)
+      << layout.output;
+  CliResult odd = runCli("envmap convert " + probe + " --width 33 -o " + never);
+  EXPECT_NE(odd.output.find("even and at least 2, not 33"), std::string::npos) << odd.output;
+  EXPECT_NE(layout.code, 0);
+  EXPECT_NE(odd.code, 0);
+  EXPECT_FALSE(fs::exists(never));
+}
+
 TEST(CliEnvmap, ErrorsAreOneLineAndLeaveNoFile) {
   TempDir d;
   std::string out = d.file("never.csv");

@@ -187,6 +187,18 @@ TEST(CliRender, DeltaLightsWithoutEmitterSamplesAreReported) {
   EXPECT_EQ(path.output.find("add nothing"), std::string::npos) << path.output;
 }
 
+// The bundled probe scene: an angular map read through the envmap's layout, and the log says so.
+TEST(CliRender, AngularProbeSceneRenders) {
+  TempDir d;
+  std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/uffizi-probe.xml", out = d.file("u.exr");
+  CliResult r = runCli("render " + scene + " -o " + out + " --spp 2 -D res=16 --no-progress");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("(angular map, 128x128) resampled to a 256x128 lat-long map"), std::string::npos) << r.output;
+  CliResult c = runCli("compare " + out + " " + out);
+  ASSERT_EQ(c.code, 0) << c.output;
+  EXPECT_EQ(c.output.find("nan"), std::string::npos) << c.output;
+}
+
 TEST(CliRender, PhotonSppmAndGridIntegrators) {
   TempDir d;
   std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml";

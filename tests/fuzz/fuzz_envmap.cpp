@@ -1,7 +1,7 @@
 // libFuzzer target: the map's sampling structures on small adversarial maps (1 to 16 pixels a
 // side; zeros, denormals, 1e30, NaN and negative texels; bilinear or not; MIS compensation;
-// turned), drawn from with every strategy at fuzzed (u1, u2) and normals, the zero normal
-// included. What is checked: no read outside a table (AddressSanitizer); every draw and
+// turned; or resampled from the image as a light probe), drawn from with every strategy at
+// fuzzed (u1, u2) and normals, the zero normal included. What is checked: no read outside a table (AddressSanitizer); every draw and
 // density finite, non-negative, with a unit direction; and a draw's density equal to pdf() of
 // its direction, away from pixel edges and the poles.
 #include <cmath>
@@ -11,6 +11,7 @@
 
 #include "envmap/CollapsedMap.h"
 #include "envmap/EnvironmentMap.h"
+#include "envmap/LightProbe.h"
 #include "fuzz/FuzzInput.h"
 
 using namespace envgi;
@@ -64,6 +65,19 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   opts.adaptiveLeaves = 1 + in.next() % 64;
   if (flags & 4) opts.toWorld = rotate(Vec3f(0.3f, 1.f, -0.2f), 37.f);
   opts.scale = flags & 8 ? 1e-3f : 2.f;
+  if (flags & 16) {
+    // The map as a light probe's resampling: a square image converts, any other is refused.
+    ProbeLayout layout = flags & 32 ? ProbeLayout::MirrorBall : ProbeLayout::Angular;
+    ProbeConversion c{2 * (1 + in.next() % 8), in.next() % 3};
+    bool square = w == h && w >= 2;
+    try {
+      img = probeToLatLong(img, layout, c);
+      check(square, "a probe that is not square was converted");
+      for (float v : img.rgb) check(std::isfinite(v) && v >= 0.f, "a probe's lat-long texel is negative or not finite");
+    } catch (const std::runtime_error&) {
+      check(!square, "a square probe was refused");
+    }
+  }
   try {
     EnvironmentMap map(std::move(img), opts);
     map.setPoints(collapseByMedianCut(map, 1 + in.next() % 8));

@@ -6,6 +6,7 @@
 #include <fstream>
 
 #include "cli/CliRunner.h"
+#include "envmap/LightProbe.h"
 #include "materials/BsdfFactory.h"
 #include "scene/SceneLoader.h"
 
@@ -183,6 +184,10 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
       {"<integrator type=\"bdpt\"/>", "unknown integrator 'bdpt' (path, direct, photon, sppm, grid)"},
       {"<integrator type=\"direct\"><string name=\"strategy\" value=\"magic\"/></integrator>", "unknown strategy 'magic'"},
       {"<emitter type=\"envmap\"><string name=\"filename\" value=\"missing.exr\"/></emitter>", "cannot open image"},
+      {"<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/><string name=\"layout\" value=\"cube\"/></emitter>",
+       "layout must be latlong, angular or mirrorball, not 'cube'"},
+      {"<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/><string name=\"layout\" value=\"angular\"/></emitter>",
+       "a light probe is a square image, not 8x4"},
       {"<shape type=\"sphere\"><float name=\"radius\" value=\"$undefined\"/></shape>", "undefined parameter '$undefined'"},
       {"<shape type=\"sphere\"", "XML error"},
       {"<widget/>", "unknown element <widget>"},
@@ -516,4 +521,28 @@ TEST(SceneLoader, TextureErrorsNameTheLineAndTheProblem) {
     std::string err = loadError(f.scene(c.body + std::string(kSensor)));
     EXPECT_NE(err.find(c.expect), std::string::npos) << "for " << c.body << "\n got: " << err;
   }
+}
+
+TEST(SceneLoader, EnvmapReadsALightProbe) {
+  // layout="angular" resamples the square probe to lat-long as it is read; the default reads the
+  // file as lat-long.
+  Fixture f;
+  Image probe(16, 16);
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) probe.set(x, y, Color(float(x), float(y), 1.f));
+  saveImage(probe, f.dir.file("probe.exr"));
+  for (const char* layout : {"angular", "mirrorball"}) {
+    Scene s;
+    loadScene(f.scene(std::string(kSensor) + R"(<emitter type="envmap"><string name="filename" value="probe.exr"/>
+      <string name="layout" value=")" + layout + R"("/></emitter>)"),
+              {}, s);
+    ASSERT_TRUE(s.env);
+    Image expect = probeToLatLong(probe, parseProbeLayout(layout));
+    EXPECT_EQ(s.env->image().width, 32);
+    EXPECT_EQ(s.env->image().rgb, expect.rgb) << layout;
+  }
+  Scene plain;
+  loadScene(f.scene(std::string(kSensor) + R"(<emitter type="envmap"><string name="filename" value="probe.exr"/></emitter>)"), {},
+            plain);
+  EXPECT_EQ(plain.env->image().width, 16) << "without a layout the file is the lat-long map";
 }
