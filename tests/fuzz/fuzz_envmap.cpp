@@ -72,6 +72,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     bool square = w == h && w >= 2;
     try {
       img = probeToLatLong(img, layout, c);
+      w = img.width, h = img.height;  // the pixel edges the density check stays away from
       check(square, "a probe that is not square was converted");
       for (float v : img.rgb) check(std::isfinite(v) && v >= 0.f, "a probe's lat-long texel is negative or not finite");
     } catch (const std::runtime_error&) {
