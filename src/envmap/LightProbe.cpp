@@ -20,7 +20,8 @@ Vec2f probeDiskPoint(ProbeLayout layout, Vec3f d) {
   float theta = std::atan2(side, -d.z);
   float rho = layout == ProbeLayout::Angular ? theta * kInvPi : std::sin(0.5f * theta);
   if (!(side > 0.f)) return {0.f, d.z > 0.f ? rho : 0.f};  // straight back: any point of the rim
-  return {d.x / side * rho, d.y / side * rho};
+  float across = layout == ProbeLayout::MirrorBall ? -1.f : 1.f;  // the ball mirrors left and right
+  return {across * d.x / side * rho, d.y / side * rho};
 }
 
 Vec3f probeDiskDirection(ProbeLayout layout, Vec2f p) {
@@ -28,7 +29,8 @@ Vec3f probeDiskDirection(ProbeLayout layout, Vec2f p) {
   float theta = layout == ProbeLayout::Angular ? rho * kPi : 2.f * std::asin(rho);
   float s = std::sin(theta);
   if (!(rho > 0.f)) return {0.f, 0.f, -1.f};
-  return {p.x / rho * s, p.y / rho * s, -std::cos(theta)};
+  float across = layout == ProbeLayout::MirrorBall ? -1.f : 1.f;
+  return {across * p.x / rho * s, p.y / rho * s, -std::cos(theta)};
 }
 
 namespace {

@@ -1,11 +1,13 @@
 // Light probes in the two square layouts of Debevec's Light Probe Image Gallery (the paper's
 // reference [17]), resampled to the lat-long maps the renderer reads.
 //
-// Both layouts put the probe's forward direction (-Z in its frame, +Y up, +X right) at the
-// image centre and the backward one on the rim; a direction at angle theta from forward lands at
-// radius rho(theta) on the unit disk, along its (x, y) component:
-//   angular map (Debevec's gallery):  rho = theta / pi
-//   mirror ball (a photograph of a chrome ball): rho = sin(theta / 2)
+// Both layouts put the probe's forward direction (-Z in its frame, +Y up) at the image centre
+// and the backward one on the rim; a direction at angle theta from forward lands at radius
+// rho(theta) on the unit disk, along its (x, y) component:
+//   angular map (Debevec's gallery, +X on the right):  rho = theta / pi
+//   mirror ball (a photograph of a chrome ball, taken looking along +Z, whose centre reflects
+//   -Z back at the camera): rho = sin(theta / 2), and the ball mirrors left and right: +X is
+//   on the image's left, where the camera's own left is (Blender's mirror-ball projection too)
 // The lat-long map made from a probe has the forward direction in its centre column, as
 // HDRShop's and OpenImageIO's conversions do; with envgi's (Mitsuba's) lat-long convention the
 // centre column faces +Z, so the probe's frame is the map's turned 180 degrees about +Y.

@@ -2,12 +2,14 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 
 #include "cli/CliRunner.h"
+#include "image/Image.h"
 
 using namespace envgi::test;
 namespace fs = std::filesystem;
@@ -118,6 +120,48 @@ TEST(CliEnvmap, ConvertMakesALatLongMapOfAProbe) {
   EXPECT_NE(layout.code, 0);
   EXPECT_NE(odd.code, 0);
   EXPECT_FALSE(fs::exists(never));
+}
+
+// The mirror-ball layout against physics: envgi renders a chrome sphere in a lat-long map,
+// seen from far along +Z (nearly orthographic, the ball filling the frame); that picture,
+// converted as a mirror ball, must give the map back. The converted map faces the ball's centre,
+// -Z, in its centre column, where the original has +Z: half a turn apart. Mirrored left and
+// right it would not match.
+TEST(CliEnvmap, AChromeSpheresPictureConvertsBackToItsMap) {
+  TempDir d;
+  std::string map = std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/uffizi_probe_128_latlong_256x128.hdr";
+  std::ofstream(d.file("ball.xml")) << R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+  <sensor type="perspective"><float name="fov" value="0.11459"/>
+    <transform name="to_world"><lookat origin="0,0,-1000" target="0,0,0" up="0,1,0"/></transform>
+    <sampler type="sobol"><integer name="sample_count" value="16"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="128"/><integer name="height" value="128"/><rfilter type="box"/></film>
+  </sensor>
+  <emitter type="envmap"><string name="filename" value=")" + map + R"("/></emitter>
+  <shape type="sphere"><float name="radius" value="1"/><bsdf type="conductor"/></shape>
+</scene>)";
+  CliResult r = runCli("render " + d.file("ball.xml") + " -o " + d.file("ball.exr") + " --no-progress");
+  ASSERT_EQ(r.code, 0) << r.output;
+  CliResult c = runCli("envmap convert " + d.file("ball.exr") + " --layout mirrorball --width 256 -o " + d.file("back.exr"));
+  ASSERT_EQ(c.code, 0) << c.output;
+  envgi::Image orig = envgi::loadImage(map), back = envgi::loadImage(d.file("back.exr"));
+  ASSERT_EQ(back.width, orig.width);
+  ASSERT_EQ(back.height, orig.height);
+  // Correlation over the hemisphere that faces the camera (the ball's rim squeezes the other),
+  // away from the poles; `mirrored` reads the original with its columns reversed.
+  auto correlation = [&](bool mirrored) {
+    double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0, n = 0;
+    for (int y = 20; y < 108; ++y)
+      for (int x = 64; x < 192; ++x) {
+        int ox = (x + 128) % 256;
+        if (mirrored) ox = 255 - ox;
+        double a = envgi::luminance(back.at(x, y)), b = envgi::luminance(orig.at(ox, y));
+        sa += a, sb += b, saa += a * a, sbb += b * b, sab += a * b, n += 1;
+      }
+    return (sab - sa * sb / n) / std::sqrt((saa - sa * sa / n) * (sbb - sb * sb / n));
+  };
+  EXPECT_GT(correlation(false), 0.995);
+  EXPECT_LT(correlation(true), 0.99);
 }
 
 TEST(CliEnvmap, ErrorsAreOneLineAndLeaveNoFile) {

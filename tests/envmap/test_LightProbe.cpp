@@ -33,14 +33,16 @@ Vec3f probeDirAt(const Image& map, int x, int y) {
 }  // namespace
 
 TEST(LightProbe, DiskPointsOfTheAxes) {
-  // Forward in the centre, up at the top, +X on the right; 90 degrees off forward lands at half
-  // the radius on an angular map and at sin 45 on a mirror ball; backward on the rim.
+  // Forward in the centre, up at the top, +X on the right of an angular map and on the left of
+  // a mirror ball; 90 degrees off forward lands at half the radius on an angular map and at
+  // sin 45 on a mirror ball; backward on the rim.
   for (ProbeLayout l : {ProbeLayout::Angular, ProbeLayout::MirrorBall}) {
     float side = l == ProbeLayout::Angular ? 0.5f : std::sqrt(0.5f);
+    float across = l == ProbeLayout::Angular ? side : -side;
     Vec2f c = probeDiskPoint(l, {0, 0, -1}), r = probeDiskPoint(l, {1, 0, 0}), u = probeDiskPoint(l, {0, 1, 0});
     EXPECT_NEAR(c.x, 0.f, 1e-7f);
     EXPECT_NEAR(c.y, 0.f, 1e-7f);
-    EXPECT_NEAR(r.x, side, 1e-6f);
+    EXPECT_NEAR(r.x, across, 1e-6f);
     EXPECT_NEAR(r.y, 0.f, 1e-7f);
     EXPECT_NEAR(u.x, 0.f, 1e-7f);
     EXPECT_NEAR(u.y, side, 1e-6f);
