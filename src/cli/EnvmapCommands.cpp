@@ -21,12 +21,18 @@ int parseStrategyName(const std::string& name) { return int(findStrategy(name, t
 namespace {
 
 struct SampleArgs {
-  std::string map, out, strategy = "importance", sampler = "independent";
+  std::string map, out, strategy = "importance", sampler = "independent", layout = "latlong";
   int count = 1000;
   std::vector<float> normal{0.f, 1.f, 0.f};  // cosine and product sample about it (map frame)
   uint32_t seed = 0;
   bool misCompensation = false;
 };
+
+// --layout: what the map and the statistics are of when the file is a light probe.
+void addLayoutOption(CLI::App* c, std::string& layout) {
+  c->add_option("--layout", layout, "latlong (the default), or a light probe resampled first: angular, mirrorball")
+      ->check(CLI::IsMember({"latlong", "angular", "mirrorball"}));
+}
 
 std::vector<EnvSample> drawSamples(const EnvironmentMap& env, const SampleArgs& a) {
   if (a.count <= 0) throw std::runtime_error("--count must be positive");
@@ -49,6 +55,7 @@ std::vector<EnvSample> drawSamples(const EnvironmentMap& env, const SampleArgs& 
 
 void addSampleOptions(CLI::App* c, SampleArgs& a) {
   c->add_option("map", a.map, "Lat-long map (.hdr, .exr, .pfm)")->required();
+  addLayoutOption(c, a.layout);
   c->add_option("--count,-n", a.count, "Number of samples")->check(atLeast(1));
   c->add_option("--strategy,-s", a.strategy, strategyNameList(true) + " (cosine and product about --normal)");
   c->add_option("--normal", a.normal, "x,y,z: the surface normal, in the map's frame, for cosine and product (default 0,1,0)")
@@ -59,14 +66,19 @@ void addSampleOptions(CLI::App* c, SampleArgs& a) {
   c->add_flag("--mis-compensation", a.misCompensation, "Sample max(L - mean, 0) (Karlik et al. 2019)");
 }
 
+// The map as the scene's envmap reads it: a lat-long file, or a light probe resampled.
+EnvironmentMap loadMap(const std::string& path, const std::string& layout, const EnvironmentMapOptions& opts = {}) {
+  return layout == "latlong" ? EnvironmentMap::load(path, opts) : EnvironmentMap::loadProbe(path, parseProbeLayout(layout), opts);
+}
+
 EnvironmentMapOptions mapOptions(const SampleArgs& a) {
   EnvironmentMapOptions o;
   o.misCompensation = a.misCompensation;
   return o;
 }
 
-void runInfo(const std::string& path) {
-  EnvironmentMap env = EnvironmentMap::load(path);
+void runInfo(const std::string& path, const std::string& layout) {
+  EnvironmentMap env = loadMap(path, layout);
   EnvironmentMapStats s = env.stats();
   fmt::print("map:            {}\n", path);
   fmt::print("size:           {} x {}\n", s.width, s.height);
@@ -81,7 +93,7 @@ void runInfo(const std::string& path) {
 }
 
 void runSamples(const SampleArgs& a) {
-  EnvironmentMap env = EnvironmentMap::load(a.map, mapOptions(a));
+  EnvironmentMap env = loadMap(a.map, a.layout, mapOptions(a));
   std::vector<EnvSample> samples = drawSamples(env, a);
   std::string csv = "u,v,x,y,z,pdf\n";
   csv.reserve(samples.size() * 80);
@@ -95,7 +107,7 @@ void runSamples(const SampleArgs& a) {
 }
 
 void runPlot(const SampleArgs& a, float exposure) {
-  EnvironmentMap env = EnvironmentMap::load(a.map, mapOptions(a));
+  EnvironmentMap env = loadMap(a.map, a.layout, mapOptions(a));
   std::vector<EnvSample> samples = drawSamples(env, a);
   Image img = env.image();
   SaveOptions so;
@@ -154,10 +166,11 @@ void addEnvmapCommands(CLI::App& app) {
   CLI::App* env = app.add_subcommand("envmap", "Inspect and sample environment maps");
   env->require_subcommand(1);
 
-  auto path = std::make_shared<std::string>();
+  auto path = std::make_shared<std::string>(), layout = std::make_shared<std::string>("latlong");
   CLI::App* info = env->add_subcommand("info", "Size, channel ranges, power and luminance statistics");
   info->add_option("map", *path, "Lat-long map")->required();
-  info->callback([path] { runInfo(*path); });
+  addLayoutOption(info, *layout);
+  info->callback([path, layout] { runInfo(*path, *layout); });
 
   auto sa = std::make_shared<SampleArgs>();
   CLI::App* samples = env->add_subcommand("samples", "Write samples as CSV: u,v,x,y,z,pdf (map frame, solid angle)");

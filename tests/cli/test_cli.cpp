@@ -104,6 +104,13 @@ TEST(CliEnvmap, ConvertMakesALatLongMapOfAProbe) {
   CliResult info = runCli("envmap info " + out);
   ASSERT_EQ(info.code, 0) << info.output;
   EXPECT_NE(info.output.find("size:           64 x 32"), std::string::npos) << info.output;
+  // The other envmap commands read a probe as the scene does, through --layout.
+  CliResult probeInfo = runCli("envmap info " + probe + " --layout angular");
+  ASSERT_EQ(probeInfo.code, 0) << probeInfo.output;
+  EXPECT_NE(probeInfo.output.find("size:           256 x 128"), std::string::npos) << probeInfo.output;
+  CliResult plot = runCli("envmap plot " + probe + " --layout mirrorball -n 50 -o " + d.file("p.png"));
+  ASSERT_EQ(plot.code, 0) << plot.output;
+  EXPECT_TRUE(fs::exists(d.file("p.png")));
 
   // A lat-long map given as a probe, an unknown layout, an odd width: one line each, no file.
   std::string never = d.file("never.exr");
