@@ -65,16 +65,24 @@ Color bilinearInDisk(const Image& img, const std::vector<float>& rgb, float x, f
 
 Image probeToLatLong(const Image& probe, ProbeLayout layout, const ProbeConversion& opts, size_t* invalid) {
   if (probe.width != probe.height || probe.width < 2)
-    throw std::runtime_error("a light probe is a square image, not " + std::to_string(probe.width) + "x" +
-                             std::to_string(probe.height) + (probe.width == 2 * probe.height ? " (this looks like a lat-long map already)" : ""));
-  int width = opts.width > 0 ? opts.width : 2 * probe.width;
-  if (width < 2 || width % 2 != 0)
-    throw std::runtime_error("the lat-long width must be even and at least 2, not " + std::to_string(width));
+    throw std::runtime_error("a light probe is a square image of at least 2x2, not " + std::to_string(probe.width) + "x" +
+                             std::to_string(probe.height) +
+                             (probe.width == 2 * probe.height ? " (this looks like a lat-long map already)" : ""));
+  // Bounds that keep a mistyped option from asking for gigabytes or hours.
+  int width = opts.width > 0 ? opts.width : std::min(2 * probe.width, kMaxProbeMapWidth);
+  if (width < 2 || width % 2 != 0 || width > kMaxProbeMapWidth)
+    throw std::runtime_error("the lat-long width must be even, from 2 to " + std::to_string(kMaxProbeMapWidth) +
+                             ", not " + std::to_string(width));
+  if (opts.samplesPerSide > kMaxProbeSamplesPerSide)
+    throw std::runtime_error("at most " + std::to_string(kMaxProbeSamplesPerSide) + " x " +
+                             std::to_string(kMaxProbeSamplesPerSide) + " lookups a map pixel, not " +
+                             std::to_string(opts.samplesPerSide));
   int height = width / 2;
   // Probe pixels across one map pixel: the probe spans pi from its centre to its rim in width / 2
   // pixels, linearly for the angular map; a mirror ball spreads the centre by pi / 2 more.
   float perPixel = float(probe.width) / float(height) * (layout == ProbeLayout::Angular ? 0.5f : 0.25f * kPi);
-  int n = opts.samplesPerSide > 0 ? opts.samplesPerSide : std::max(1, int(std::ceil(perPixel - 1e-3f)));
+  int n = opts.samplesPerSide > 0 ? opts.samplesPerSide
+                                  : std::clamp(int(std::ceil(perPixel - 1e-3f)), 1, kMaxProbeSamplesPerSide);
 
   std::vector<float> rgb = probe.rgb;
   size_t bad = 0;

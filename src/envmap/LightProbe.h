@@ -33,6 +33,9 @@ Vec3f probeDiskDirection(ProbeLayout layout, Vec2f p);
 // A lat-long map direction (envgi's convention, EnvironmentMapView::uvToDir) in the probe's frame.
 inline Vec3f latLongToProbeFrame(Vec3f mapDir) { return {-mapDir.x, mapDir.y, -mapDir.z}; }
 
+constexpr int kMaxProbeMapWidth = 32768;     // a 32768 x 16384 map: 6 GB of floats
+constexpr int kMaxProbeSamplesPerSide = 64;
+
 struct ProbeConversion {
   int width = 0;           // of the lat-long map (height = width / 2); 0: twice the probe's width
   int samplesPerSide = 0;  // n x n bilinear lookups averaged per map pixel; 0: enough that each
@@ -40,7 +43,8 @@ struct ProbeConversion {
 };
 
 // Resamples a square probe image to a lat-long map. Throws std::runtime_error for an image that
-// is not square or smaller than 2 x 2, or a width that is odd or below 2; NaN, infinite and
+// is not square or smaller than 2 x 2, a width that is odd or outside [2, kMaxProbeMapWidth],
+// or more than kMaxProbeSamplesPerSide lookups a side; NaN, infinite and
 // negative values count as black (EnvironmentMap warns about them the same way), and *invalid,
 // where given, receives how many there were.
 Image probeToLatLong(const Image& probe, ProbeLayout layout, const ProbeConversion& opts = {},

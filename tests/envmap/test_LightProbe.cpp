@@ -159,9 +159,14 @@ TEST(LightProbe, BadProbesAreErrors) {
     }
     return std::string("no error");
   };
-  EXPECT_NE(message(Image(64, 32)).find("square image, not 64x32 (this looks like a lat-long map"), std::string::npos);
-  EXPECT_NE(message(Image(1, 1)).find("square image, not 1x1"), std::string::npos);
-  EXPECT_NE(message(Image(8, 8), {13, 0}).find("even and at least 2, not 13"), std::string::npos);
+  EXPECT_NE(message(Image(64, 32)).find("square image of at least 2x2, not 64x32 (this looks like a lat-long map"),
+            std::string::npos);
+  EXPECT_NE(message(Image(1, 1)).find("square image of at least 2x2, not 1x1"), std::string::npos);
+  EXPECT_NE(message(Image(8, 8), {13, 0}).find("must be even, from 2 to 32768, not 13"), std::string::npos);
+  // Mistyped sizes are refused before anything is allocated or looped over.
+  EXPECT_NE(message(Image(8, 8), {2000000000, 0}).find("not 2000000000"), std::string::npos);
+  EXPECT_NE(message(Image(8, 8), {16, 100000}).find("at most 64 x 64 lookups a map pixel, not 100000"),
+            std::string::npos);
   EXPECT_THROW(parseProbeLayout("cubemap"), std::runtime_error);
 
   Image nan = probeOf(ProbeLayout::Angular, 16, [](Vec3f) { return Color(1.f); });

@@ -187,7 +187,7 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
       {"<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/><string name=\"layout\" value=\"cube\"/></emitter>",
        "layout must be latlong, angular or mirrorball, not 'cube'"},
       {"<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/><string name=\"layout\" value=\"angular\"/></emitter>",
-       "a light probe is a square image, not 8x4"},
+       "a light probe is a square image of at least 2x2, not 8x4"},
       {"<shape type=\"sphere\"><float name=\"radius\" value=\"$undefined\"/></shape>", "undefined parameter '$undefined'"},
       {"<shape type=\"sphere\"", "XML error"},
       {"<widget/>", "unknown element <widget>"},
