@@ -1,8 +1,8 @@
 // libFuzzer target: scene XML (loadScene), then a render of what loaded, cut down to at most
 // 16x16 pixels, 1 sample, depth 8 and a few thousand photons so that every integrator runs in
-// milliseconds. Beside the input lie a small PLY, OBJ and HDR map (fuzz-m.ply, fuzz-m.obj,
-// fuzz-e.hdr, in the dictionary), so that shapes from files and the envmap emitter are reached
-// through the XML. The rendered image must be finite: the renderer drops non-finite samples.
+// milliseconds. Beside the input lie a small PLY, OBJ, HDR map and square HDR probe (fuzz-m.ply,
+// fuzz-m.obj, fuzz-e.hdr, fuzz-p.hdr, in the dictionary), so that shapes from files and the
+// envmap emitter, lat-long or probe, are reached through the XML. The rendered image must be finite: the renderer drops non-finite samples.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -28,6 +28,9 @@ void writeAssets(const std::filesystem::path& dir) {
   envgi::Image map(16, 8);
   for (size_t i = 0; i < map.rgb.size(); ++i) map.rgb[i] = float(i % 7) * 0.25f;
   envgi::saveImage(map, (dir / "fuzz-e.hdr").string());
+  envgi::Image probe(8, 8);  // square: a light probe for the envmap's layout
+  for (size_t i = 0; i < probe.rgb.size(); ++i) probe.rgb[i] = float(i % 5) * 0.3f;
+  envgi::saveImage(probe, (dir / "fuzz-p.hdr").string());
 }
 
 // Every number in the text between 1e-3 and 1e4 in magnitude (or 0), and no inf or nan: a scene
