@@ -30,8 +30,8 @@ struct SampleArgs {
 
 // --layout: what the map and the statistics are of when the file is a light probe.
 void addLayoutOption(CLI::App* c, std::string& layout) {
-  c->add_option("--layout", layout, "latlong (the default), or a light probe resampled first: angular, mirrorball")
-      ->check(CLI::IsMember({"latlong", "angular", "mirrorball"}));
+  c->add_option("--layout", layout, "latlong (the default), or a light probe resampled first: angular, mirrorball, cross")
+      ->check(CLI::IsMember({"latlong", "angular", "mirrorball", "cross"}));
 }
 
 std::vector<EnvSample> drawSamples(const EnvironmentMap& env, const SampleArgs& a) {
@@ -188,11 +188,13 @@ void addEnvmapCommands(CLI::App& app) {
 
   auto ca = std::make_shared<ConvertArgs>();
   CLI::App* convert = env->add_subcommand(
-      "convert", "Resample a light probe (angular map or mirror ball) to a lat-long map, forward in its centre column");
-  convert->add_option("probe", ca->probe, "Square probe image (.hdr, .exr, .pfm)")->required();
+      "convert", "Resample a light probe (angular map, mirror ball, cube cross) to a lat-long map, forward in its centre column");
+  convert->add_option("probe", ca->probe, "Probe image (.hdr, .exr, .pfm)")->required();
   convert->add_option("-o,--output", ca->out, "Lat-long map (.exr, .hdr, .pfm)")->required();
-  convert->add_option("--layout", ca->layout, "angular (Debevec's gallery; the default) or mirrorball");
-  convert->add_option("--width", ca->width, "Map width, even (default: twice the probe's)")->check(atLeast(2));
+  convert->add_option("--layout", ca->layout,
+                      "angular (Debevec's gallery; the default), mirrorball, or cross (a cube cross, 3N x 4N or 4N x 3N)");
+  convert->add_option("--width", ca->width, "Map width, even (default: twice a disk's width, four times a cube face's)")
+      ->check(atLeast(2));
   convert->add_option("--samples", ca->samples, "n: n x n lookups a map pixel (default: enough for the probe's detail)")
       ->check(atLeast(1));
   convert->callback([ca] { runConvert(*ca); });

@@ -46,7 +46,7 @@ EnvironmentMap EnvironmentMap::load(const std::string& path, const EnvironmentMa
                              std::to_string(img.height) + ")");
   if (img.width != 2 * img.height)
     spdlog::warn("environment map '{}' is {}x{}, not 2:1; it is still read as lat-long{}", path, img.width, img.height,
-                 img.width == img.height ? " (a light probe? the envmap's 'layout' reads angular maps and mirror balls)" : "");
+                 img.width == img.height ? " (a light probe? the envmap's 'layout' reads angular maps, mirror balls and cube crosses)" : "");
   return EnvironmentMap(std::move(img), opts, path);
 }
 
@@ -61,9 +61,8 @@ EnvironmentMap EnvironmentMap::loadProbe(const std::string& path, ProbeLayout la
   }
   if (invalid > 0)
     spdlog::warn("light probe '{}': {} NaN, infinite or negative channel values replaced with 0", path, invalid);
-  spdlog::info("light probe '{}' ({}, {}x{}) resampled to a {}x{} lat-long map", path,
-               layout == ProbeLayout::Angular ? "angular map" : "mirror ball", probe.width, probe.height, map.width,
-               map.height);
+  spdlog::info("light probe '{}' ({}, {}x{}) resampled to a {}x{} lat-long map", path, probeLayoutName(layout),
+               probe.width, probe.height, map.width, map.height);
   return EnvironmentMap(std::move(map), opts, path);
 }
 

@@ -11,7 +11,50 @@ namespace envgi {
 ProbeLayout parseProbeLayout(const std::string& name) {
   if (name == "angular") return ProbeLayout::Angular;
   if (name == "mirrorball") return ProbeLayout::MirrorBall;
-  throw std::runtime_error("unknown light-probe layout '" + name + "' (angular, mirrorball)");
+  if (name == "cross") return ProbeLayout::Cross;
+  throw std::runtime_error("unknown light-probe layout '" + name + "' (angular, mirrorball, cross)");
+}
+
+const char* probeLayoutName(ProbeLayout layout) {
+  switch (layout) {
+    case ProbeLayout::Angular: return "angular map";
+    case ProbeLayout::MirrorBall: return "mirror ball";
+    case ProbeLayout::Cross: return "cube cross";
+  }
+  return "?";
+}
+
+CubeFacePoint cubeFacePoint(Vec3f d, bool upright) {
+  float ax = std::fabs(d.x), ay = std::fabs(d.y), az = std::fabs(d.z);
+  if (az >= ax && az >= ay) {
+    if (d.z < 0.f) return {5, {d.x / az, d.y / az}};
+    return upright ? CubeFacePoint{4, {-d.x / az, d.y / az}} : CubeFacePoint{4, {d.x / az, -d.y / az}};
+  }
+  if (ax >= ay) return d.x > 0.f ? CubeFacePoint{0, {d.z / ax, d.y / ax}} : CubeFacePoint{1, {-d.z / ax, d.y / ax}};
+  return d.y > 0.f ? CubeFacePoint{2, {d.x / ay, d.z / ay}} : CubeFacePoint{3, {d.x / ay, -d.z / ay}};
+}
+
+Vec3f cubeFaceDirection(int face, Vec2f st, bool upright) {
+  float s = st.x, t = st.y;
+  Vec3f d;
+  switch (face) {
+    case 0: d = {1.f, t, s}; break;
+    case 1: d = {-1.f, t, -s}; break;
+    case 2: d = {s, 1.f, t}; break;
+    case 3: d = {s, -1.f, -t}; break;
+    case 4: d = upright ? Vec3f(-s, t, 1.f) : Vec3f(s, -t, 1.f); break;
+    default: d = {s, t, -1.f}; break;
+  }
+  return normalize(d);
+}
+
+void crossCell(int face, bool vertical, int* column, int* row) {
+  // +X, -X, +Y, -Y, +Z, -Z: right, left, up, down, backward, forward.
+  static const int kVertical[6][2] = {{2, 1}, {0, 1}, {1, 0}, {1, 2}, {1, 3}, {1, 1}};
+  static const int kHorizontal[6][2] = {{2, 1}, {0, 1}, {1, 0}, {1, 2}, {3, 1}, {1, 1}};
+  const int* c = vertical ? kVertical[face] : kHorizontal[face];
+  *column = c[0];
+  *row = c[1];
 }
 
 Vec2f probeDiskPoint(ProbeLayout layout, Vec3f d) {
@@ -61,15 +104,39 @@ Color bilinearInDisk(const Image& img, const std::vector<float>& rgb, float x, f
   return weight > 0.f ? sum * (1.f / weight) : plain;
 }
 
+// Bilinear between pixel centres of one cube face, the cell [x0, x0 + n) x [y0, y0 + n),
+// clamped at the face's edges so that no other face (or the cross's empty cells) bleeds in.
+Color bilinearInFace(const Image& img, const std::vector<float>& rgb, int x0, int y0, int n, float x, float y) {
+  float fx = x - 0.5f, fy = y - 0.5f;
+  float xf = std::floor(fx), yf = std::floor(fy);
+  float tx = fx - xf, ty = fy - yf;
+  int xa = std::clamp(int(xf), 0, n - 1), xb = std::clamp(int(xf) + 1, 0, n - 1);
+  int ya = std::clamp(int(yf), 0, n - 1), yb = std::clamp(int(yf) + 1, 0, n - 1);
+  auto at = [&](int px, int py) {
+    const float* q = &rgb[(size_t(y0 + py) * img.width + size_t(x0 + px)) * 3];
+    return Color(q[0], q[1], q[2]);
+  };
+  return (at(xa, ya) * (1.f - tx) + at(xb, ya) * tx) * (1.f - ty) + (at(xa, yb) * (1.f - tx) + at(xb, yb) * tx) * ty;
+}
+
+std::string sizeText(const Image& img) { return std::to_string(img.width) + "x" + std::to_string(img.height); }
+
 }  // namespace
 
 Image probeToLatLong(const Image& probe, ProbeLayout layout, const ProbeConversion& opts, size_t* invalid) {
-  if (probe.width != probe.height || probe.width < 2)
-    throw std::runtime_error("a light probe is a square image of at least 2x2, not " + std::to_string(probe.width) + "x" +
-                             std::to_string(probe.height) +
+  bool cross = layout == ProbeLayout::Cross;
+  bool vertical = probe.width * 4 == probe.height * 3;
+  int face = probe.width / (vertical ? 3 : 4);  // a cross's face size
+  if (cross) {
+    if (!(vertical || probe.width * 3 == probe.height * 4) || face < 1 || probe.width % (vertical ? 3 : 4) != 0)
+      throw std::runtime_error("a cube cross is 3N x 4N (vertical) or 4N x 3N (horizontal) pixels, not " + sizeText(probe));
+  } else if (probe.width != probe.height || probe.width < 2) {
+    throw std::runtime_error("a light probe is a square image of at least 2x2, not " + sizeText(probe) +
                              (probe.width == 2 * probe.height ? " (this looks like a lat-long map already)" : ""));
+  }
   // Bounds that keep a mistyped option from asking for gigabytes or hours.
-  int width = opts.width > 0 ? opts.width : std::min(2 * probe.width, kMaxProbeMapWidth);
+  int natural = cross ? 4 * face : 2 * probe.width;
+  int width = opts.width > 0 ? opts.width : std::min(std::max(natural, 2), kMaxProbeMapWidth);
   if (width < 2 || width % 2 != 0 || width > kMaxProbeMapWidth)
     throw std::runtime_error("the lat-long width must be even, from 2 to " + std::to_string(kMaxProbeMapWidth) +
                              ", not " + std::to_string(width));
@@ -78,9 +145,11 @@ Image probeToLatLong(const Image& probe, ProbeLayout layout, const ProbeConversi
                              std::to_string(kMaxProbeSamplesPerSide) + " lookups a map pixel, not " +
                              std::to_string(opts.samplesPerSide));
   int height = width / 2;
-  // Probe pixels across one map pixel: the probe spans pi from its centre to its rim in width / 2
-  // pixels, linearly for the angular map; a mirror ball spreads the centre by pi / 2 more.
-  float perPixel = float(probe.width) / float(height) * (layout == ProbeLayout::Angular ? 0.5f : 0.25f * kPi);
+  // Probe pixels across one map pixel, where the probe is sharpest: the disks span pi from
+  // centre to rim in width / 2 pixels, linearly for the angular map, and a mirror ball spreads
+  // its centre by pi / 2 more; a cube face spans pi / 2 in N pixels at its centre.
+  float perPixel = cross ? 4.f * float(face) / float(width)
+                         : float(probe.width) / float(height) * (layout == ProbeLayout::Angular ? 0.5f : 0.25f * kPi);
   int n = opts.samplesPerSide > 0 ? opts.samplesPerSide
                                   : std::clamp(int(std::ceil(perPixel - 1e-3f)), 1, kMaxProbeSamplesPerSide);
 
@@ -101,13 +170,24 @@ Image probeToLatLong(const Image& probe, ProbeLayout layout, const ProbeConversi
         for (int i = 0; i < n; ++i) {
           Vec2f uv((float(x) + (float(i) + 0.5f) / float(n)) / float(width),
                    (float(y) + (float(j) + 0.5f) / float(n)) / float(height));
-          Vec2f p = probeDiskPoint(layout, latLongToProbeFrame(EnvironmentMapView::uvToDir(uv)));
-          float r = std::sqrt(p.x * p.x + p.y * p.y);
-          if (r > rimMax) p = p * (rimMax / r);
-          // Image row 0 is the disk's top (y = +1).
+          Vec3f d = latLongToProbeFrame(EnvironmentMapView::uvToDir(uv));
+          Color c;
+          if (cross) {
+            CubeFacePoint f = cubeFacePoint(d, !vertical);
+            int col, row;
+            crossCell(f.face, vertical, &col, &row);
+            // Image rows run down, t up.
+            c = bilinearInFace(probe, rgb, col * face, row * face, face, (f.st.x + 1.f) * 0.5f * float(face),
+                               (1.f - f.st.y) * 0.5f * float(face));
+          } else {
+            Vec2f p = probeDiskPoint(layout, d);
+            float r = std::sqrt(p.x * p.x + p.y * p.y);
+            if (r > rimMax) p = p * (rimMax / r);
+            // Image row 0 is the disk's top (y = +1).
+            c = bilinearInDisk(probe, rgb, (p.x + 1.f) * 0.5f * float(probe.width), (1.f - p.y) * 0.5f * float(probe.height));
+          }
           // Each lookup weighted before the sum, so that values near FLT_MAX cannot add up to inf.
-          sum += bilinearInDisk(probe, rgb, (p.x + 1.f) * 0.5f * float(probe.width), (1.f - p.y) * 0.5f * float(probe.height)) *
-                 (1.f / float(n * n));
+          sum += c * (1.f / float(n * n));
         }
       out.set(x, y, sum);
     }

@@ -595,8 +595,8 @@ class Loader {
         o.bilinear = filter == "bilinear";
         // envgi's own: a square light probe, resampled to lat-long as it is read.
         std::string layout = getString(f, p, "layout", "latlong");
-        if (layout != "latlong" && layout != "angular" && layout != "mirrorball")
-          fail(f, n, "layout must be latlong, angular or mirrorball, not '" + layout + "'");
+        if (layout != "latlong" && layout != "angular" && layout != "mirrorball" && layout != "cross")
+          fail(f, n, "layout must be latlong, angular, mirrorball or cross, not '" + layout + "'");
         try {
           scene_.env = std::make_unique<EnvironmentMap>(
               layout == "latlong" ? EnvironmentMap::load(path.string(), o)

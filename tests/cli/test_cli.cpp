@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "cli/CliRunner.h"
+#include "envmap/LightProbe.h"
 #include "image/Image.h"
 
 using namespace envgi::test;
@@ -120,7 +121,7 @@ TEST(CliEnvmap, ConvertMakesALatLongMapOfAProbe) {
             std::string::npos)
       << latlong.output;
   CliResult layout = runCli("envmap convert " + probe + " --layout cubemap -o " + never);
-  EXPECT_NE(layout.output.find("unknown light-probe layout 'cubemap' (angular, mirrorball)"), std::string::npos)
+  EXPECT_NE(layout.output.find("unknown light-probe layout 'cubemap' (angular, mirrorball, cross)"), std::string::npos)
       << layout.output;
   CliResult odd = runCli("envmap convert " + probe + " --width 33 -o " + never);
   EXPECT_NE(odd.output.find("must be even, from 2 to 32768, not 33"), std::string::npos) << odd.output;
@@ -129,8 +130,28 @@ TEST(CliEnvmap, ConvertMakesALatLongMapOfAProbe) {
   EXPECT_FALSE(fs::exists(never));
 }
 
+// Correlation of the luminance of a map made from a probe against the original map half a turn
+// round (the probe's forward, the original's -Z, in the made map's centre column), its columns
+// mirrored where asked, over rows [y0, y1) and the columns keep(x) keeps.
+namespace {
+template <class Keep>
+double halfTurnCorrelation(const envgi::Image& made, const envgi::Image& orig, bool mirrored, int y0, int y1, Keep keep) {
+  double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0, n = 0;
+  int w = orig.width;
+  for (int y = y0; y < y1; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (!keep(x)) continue;
+      int ox = (x + w / 2) % w;
+      if (mirrored) ox = w - 1 - ox;
+      double a = envgi::luminance(made.at(x, y)), b = envgi::luminance(orig.at(ox, y));
+      sa += a, sb += b, saa += a * a, sbb += b * b, sab += a * b, n += 1;
+    }
+  return (sab - sa * sb / n) / std::sqrt((saa - sa * sa / n) * (sbb - sb * sb / n));
+}
+}  // namespace
+
 // The mirror-ball layout against physics: envgi renders a chrome sphere in a lat-long map,
-// seen from far along +Z (nearly orthographic, the ball filling the frame); that picture,
+// seen from far down -Z looking along +Z (nearly orthographic, the ball filling the frame); that picture,
 // converted as a mirror ball, must give the map back. The converted map faces the ball's centre,
 // -Z, in its centre column, where the original has +Z: half a turn apart. Mirrored left and
 // right it would not match.
@@ -157,18 +178,62 @@ TEST(CliEnvmap, AChromeSpheresPictureConvertsBackToItsMap) {
   // Correlation over the hemisphere that faces the camera (the ball's rim squeezes the other),
   // away from the poles; `mirrored` reads the original with its columns reversed.
   auto correlation = [&](bool mirrored) {
-    double sa = 0, sb = 0, saa = 0, sbb = 0, sab = 0, n = 0;
-    for (int y = 20; y < 108; ++y)
-      for (int x = 64; x < 192; ++x) {
-        int ox = (x + 128) % 256;
-        if (mirrored) ox = 255 - ox;
-        double a = envgi::luminance(back.at(x, y)), b = envgi::luminance(orig.at(ox, y));
-        sa += a, sb += b, saa += a * a, sbb += b * b, sab += a * b, n += 1;
-      }
-    return (sab - sa * sb / n) / std::sqrt((saa - sa * sa / n) * (sbb - sb * sb / n));
+    return halfTurnCorrelation(back, orig, mirrored, 20, 108, [](int x) { return x >= 64 && x < 192; });
   };
   EXPECT_GT(correlation(false), 0.995);
   EXPECT_LT(correlation(true), 0.99);
+}
+
+// The cube crosses against envgi's own camera: six 90-degree views from the centre of a map,
+// rendered by envgi and laid out as a vertical cross (the backward view upside down) and as a
+// horizontal one, convert back to the map, half a turn round as for the mirror ball.
+TEST(CliEnvmap, CrossesOfRenderedCubeFacesConvertBackToTheirMap) {
+  TempDir d;
+  std::string map = std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/uffizi_probe_128_latlong_256x128.hdr";
+  std::ofstream(d.file("face.xml")) << R"(<scene version="3.0.0">
+  <sensor type="perspective"><float name="fov" value="90"/>
+    <transform name="to_world"><lookat origin="0,0,0" target="$target" up="$up"/></transform>
+    <sampler type="sobol"><integer name="sample_count" value="4"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/><rfilter type="box"/></film>
+  </sensor>
+  <emitter type="envmap"><string name="filename" value=")" + map + R"("/></emitter>
+</scene>)";
+  // Faces +X, -X, +Y, -Y, +Z (upside down, then upright), -Z: where each looks and its up.
+  const char* views[7][2] = {{"1,0,0", "0,1,0"},  {"-1,0,0", "0,1,0"}, {"0,1,0", "0,0,1"}, {"0,-1,0", "0,0,-1"},
+                             {"0,0,1", "0,-1,0"}, {"0,0,1", "0,1,0"},  {"0,0,-1", "0,1,0"}};
+  std::vector<envgi::Image> faces;
+  for (int i = 0; i < 7; ++i) {
+    std::string out = d.file("f" + std::to_string(i) + ".exr");
+    CliResult r = runCli("render " + d.file("face.xml") + " -o " + out + " --no-progress -D target=" + views[i][0] +
+                         " -D up=" + views[i][1]);
+    ASSERT_EQ(r.code, 0) << r.output;
+    faces.push_back(envgi::loadImage(out));
+  }
+  envgi::Image orig = envgi::loadImage(map);
+  for (bool vertical : {true, false}) {
+    envgi::Image cross(vertical ? 96 : 128, vertical ? 128 : 96);
+    for (int f = 0; f < 6; ++f) {
+      int col, row;
+      envgi::crossCell(f, vertical, &col, &row);
+      const envgi::Image& view = faces[f < 4 ? f : (f == 4 ? (vertical ? 4 : 5) : 6)];
+      for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 32; ++x) cross.set(col * 32 + x, row * 32 + y, view.at(x, y));
+    }
+    std::string crossFile = d.file(vertical ? "vcross.exr" : "hcross.exr"), back = d.file("back.exr");
+    envgi::saveImage(cross, crossFile);
+    CliResult c = runCli("envmap convert " + crossFile + " --layout cross --width 256 -o " + back);
+    ASSERT_EQ(c.code, 0) << c.output;
+    envgi::Image conv = envgi::loadImage(back);
+    // Over the whole map away from the poles, or over the middle of the backward face alone
+    // (the converted map's seam), which the vertical cross holds upside down.
+    auto correlation = [&](bool mirrored, bool backOnly = false) {
+      if (backOnly) return halfTurnCorrelation(conv, orig, mirrored, 40, 88, [](int x) { return x < 24 || x >= 232; });
+      return halfTurnCorrelation(conv, orig, mirrored, 8, 120, [](int) { return true; });
+    };
+    EXPECT_GT(correlation(false), 0.99) << (vertical ? "vertical" : "horizontal");
+    EXPECT_LT(correlation(true), 0.97) << (vertical ? "vertical" : "horizontal");
+    EXPECT_GT(correlation(false, true), 0.95) << (vertical ? "vertical" : "horizontal") << ", backward face";
+  }
 }
 
 TEST(CliEnvmap, ErrorsAreOneLineAndLeaveNoFile) {

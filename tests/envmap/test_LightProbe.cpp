@@ -187,3 +187,119 @@ TEST(LightProbe, EnvironmentMapReadsAProbeAsItsConversion) {
   EXPECT_THROW(EnvironmentMap::loadProbe(bundled("studio.hdr"), ProbeLayout::Angular), std::runtime_error)
       << "a lat-long map is not a probe";
 }
+
+namespace {
+
+// The direction at a continuous point (X, Y) of a cube cross of face size n (pixel units).
+Vec3f crossDirection(bool vertical, int n, float X, float Y) {
+  for (int f = 0; f < 6; ++f) {
+    int col, row;
+    crossCell(f, vertical, &col, &row);
+    float fx = X - float(col * n), fy = Y - float(row * n);
+    if (fx >= 0.f && fx <= float(n) && fy >= 0.f && fy <= float(n))
+      return cubeFaceDirection(f, {fx / float(n) * 2.f - 1.f, 1.f - fy / float(n) * 2.f}, !vertical);
+  }
+  return Vec3f(0.f);
+}
+
+// A cross whose every face pixel holds f of the direction at its centre.
+template <class F>
+Image crossOf(bool vertical, int n, F f) {
+  Image img(vertical ? 3 * n : 4 * n, vertical ? 4 * n : 3 * n);
+  for (int face = 0; face < 6; ++face) {
+    int col, row;
+    crossCell(face, vertical, &col, &row);
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        img.set(col * n + x, row * n + y,
+                f(cubeFaceDirection(face, {(float(x) + 0.5f) / float(n) * 2.f - 1.f, 1.f - (float(y) + 0.5f) / float(n) * 2.f},
+                                    !vertical)));
+  }
+  return img;
+}
+
+}  // namespace
+
+TEST(LightProbe, CubeFacePointAndDirectionAreInverses) {
+  for (bool upright : {false, true})
+    for (float t = 0.013f; t < 0.995f; t += 0.047f)
+      for (float phi = 0.f; phi < 6.28f; phi += 0.39f) {
+        float theta = t * kPi;
+        Vec3f d(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
+        CubeFacePoint p = cubeFacePoint(d, upright);
+        ASSERT_LE(std::fabs(p.st.x), 1.f);
+        ASSERT_LE(std::fabs(p.st.y), 1.f);
+        EXPECT_LT(length(cubeFaceDirection(p.face, p.st, upright) - d), 1e-5f);
+      }
+  // The forward face looks along -Z with +X to the right and +Y up.
+  EXPECT_LT(length(cubeFaceDirection(5, {1.f, 0.f}, false) - normalize(Vec3f(1, 0, -1))), 1e-6f);
+  EXPECT_LT(length(cubeFaceDirection(5, {0.f, 1.f}, false) - normalize(Vec3f(0, 1, -1))), 1e-6f);
+}
+
+TEST(LightProbe, CrossFacesMeetAlongTheirSharedEdges) {
+  // Wherever two faces touch in the cross, both give the same direction along the edge, so the
+  // cross folds into a cube: the vertical cross's upside-down backward face under the downward
+  // one, the horizontal cross's upright one right of the +X face.
+  const int n = 8;
+  for (bool vertical : {true, false}) {
+    int w = vertical ? 3 * n : 4 * n, h = vertical ? 4 * n : 3 * n;
+    int shared = 0;
+    for (int f = 0; f < 6; ++f) {
+      int col, row;
+      crossCell(f, vertical, &col, &row);
+      // Just inside this face and just across its right and bottom edges.
+      for (float a = 0.5f; a < float(n); a += 1.f) {
+        float eps = 1e-3f;
+        float rx = float((col + 1) * n), by = float((row + 1) * n);
+        if (rx + eps < float(w)) {
+          Vec3f in = crossDirection(vertical, n, rx - eps, float(row * n) + a);
+          Vec3f out = crossDirection(vertical, n, rx + eps, float(row * n) + a);
+          if (lengthSq(out) > 0.f) {
+            EXPECT_LT(length(in - out), 1e-2f) << "face " << f << " right edge";
+            ++shared;
+          }
+        }
+        if (by + eps < float(h)) {
+          Vec3f in = crossDirection(vertical, n, float(col * n) + a, by - eps);
+          Vec3f out = crossDirection(vertical, n, float(col * n) + a, by + eps);
+          if (lengthSq(out) > 0.f) {
+            EXPECT_LT(length(in - out), 1e-2f) << "face " << f << " bottom edge";
+            ++shared;
+          }
+        }
+      }
+    }
+    EXPECT_EQ(shared, 5 * n) << "five shared edges in a cross of six faces";
+  }
+}
+
+TEST(LightProbe, CrossMapFollowsTheProbe) {
+  auto f = [](Vec3f d) { return Color(1.f + d.x, 1.f + d.y * d.z, 1.5f - d.z); };
+  for (bool vertical : {true, false}) {
+    Image cross = crossOf(vertical, 64, f);
+    Image map = probeToLatLong(cross, ProbeLayout::Cross);
+    ASSERT_EQ(map.width, 256) << "four face widths";
+    double worst = 0.0;
+    for (int y = 0; y < map.height; ++y)
+      for (int x = 0; x < map.width; ++x) {
+        Color e = map.at(x, y) - f(probeDirAt(map, x, y));
+        worst = std::max({worst, double(std::fabs(e.x)), double(std::fabs(e.y)), double(std::fabs(e.z))});
+      }
+    EXPECT_LT(worst, 0.03) << (vertical ? "vertical" : "horizontal");
+  }
+  EXPECT_NE(std::string(probeLayoutName(ProbeLayout::Cross)), "?");
+}
+
+TEST(LightProbe, CrossOfTheWrongShapeIsAnError) {
+  for (const Image& img : {Image(64, 64), Image(30, 41), Image(5, 2)}) {
+    try {
+      probeToLatLong(img, ProbeLayout::Cross);
+      ADD_FAILURE() << img.width << "x" << img.height << " converted";
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find("a cube cross is 3N x 4N (vertical) or 4N x 3N (horizontal) pixels, not"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+  EXPECT_EQ(probeToLatLong(Image(3, 4), ProbeLayout::Cross).width, 4) << "one pixel a face";
+}

@@ -67,16 +67,17 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   opts.scale = flags & 8 ? 1e-3f : 2.f;
   if (flags & 16) {
     // The map as a light probe's resampling: a square image converts, any other is refused.
-    ProbeLayout layout = flags & 32 ? ProbeLayout::MirrorBall : ProbeLayout::Angular;
+    ProbeLayout layout = flags & 32 ? ProbeLayout::MirrorBall : (flags & 64 ? ProbeLayout::Cross : ProbeLayout::Angular);
     ProbeConversion c{2 * (1 + in.next() % 8), in.next() % 3};
-    bool square = w == h && w >= 2;
+    bool rightShape = layout == ProbeLayout::Cross ? (w * 4 == h * 3 && w % 3 == 0) || (w * 3 == h * 4 && w % 4 == 0)
+                                               : w == h && w >= 2;
     try {
       img = probeToLatLong(img, layout, c);
       w = img.width, h = img.height;  // the pixel edges the density check stays away from
-      check(square, "a probe that is not square was converted");
+      check(rightShape, "a probe of the wrong shape was converted");
       for (float v : img.rgb) check(std::isfinite(v) && v >= 0.f, "a probe's lat-long texel is negative or not finite");
     } catch (const std::runtime_error&) {
-      check(!square, "a square probe was refused");
+      check(!rightShape, "a probe of the right shape was refused");
     }
   }
   try {

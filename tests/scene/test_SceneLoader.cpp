@@ -185,7 +185,7 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
       {"<integrator type=\"direct\"><string name=\"strategy\" value=\"magic\"/></integrator>", "unknown strategy 'magic'"},
       {"<emitter type=\"envmap\"><string name=\"filename\" value=\"missing.exr\"/></emitter>", "cannot open image"},
       {"<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/><string name=\"layout\" value=\"cube\"/></emitter>",
-       "layout must be latlong, angular or mirrorball, not 'cube'"},
+       "layout must be latlong, angular, mirrorball or cross, not 'cube'"},
       {"<emitter type=\"envmap\"><string name=\"filename\" value=\"sky.exr\"/><string name=\"layout\" value=\"angular\"/></emitter>",
        "a light probe is a square image of at least 2x2, not 8x4"},
       {"<shape type=\"sphere\"><float name=\"radius\" value=\"$undefined\"/></shape>", "undefined parameter '$undefined'"},
