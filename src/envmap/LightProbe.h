@@ -32,7 +32,8 @@ enum class ProbeLayout { Angular, MirrorBall, Cross };
 ProbeLayout parseProbeLayout(const std::string& name);
 const char* probeLayoutName(ProbeLayout layout);
 
-// Where unit direction d of the probe's frame lands on the probe's disk, x right, y up, |p| <= 1.
+// Where unit direction d of the probe's frame lands on a disk layout (Angular, MirrorBall), x
+// right, y up, |p| <= 1.
 Vec2f probeDiskPoint(ProbeLayout layout, Vec3f d);
 // The inverse on the disk: the unit direction that lands on p (|p| <= 1).
 Vec3f probeDiskDirection(ProbeLayout layout, Vec2f p);
