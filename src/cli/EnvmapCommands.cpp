@@ -66,11 +66,6 @@ void addSampleOptions(CLI::App* c, SampleArgs& a) {
   c->add_flag("--mis-compensation", a.misCompensation, "Sample max(L - mean, 0) (Karlik et al. 2019)");
 }
 
-// The map as the scene's envmap reads it: a lat-long file, or a light probe resampled.
-EnvironmentMap loadMap(const std::string& path, const std::string& layout, const EnvironmentMapOptions& opts = {}) {
-  return layout == "latlong" ? EnvironmentMap::load(path, opts) : EnvironmentMap::loadProbe(path, parseProbeLayout(layout), opts);
-}
-
 EnvironmentMapOptions mapOptions(const SampleArgs& a) {
   EnvironmentMapOptions o;
   o.misCompensation = a.misCompensation;
@@ -78,7 +73,7 @@ EnvironmentMapOptions mapOptions(const SampleArgs& a) {
 }
 
 void runInfo(const std::string& path, const std::string& layout) {
-  EnvironmentMap env = loadMap(path, layout);
+  EnvironmentMap env = EnvironmentMap::loadLayout(path, layout);
   EnvironmentMapStats s = env.stats();
   fmt::print("map:            {}\n", path);
   fmt::print("size:           {} x {}\n", s.width, s.height);
@@ -93,7 +88,7 @@ void runInfo(const std::string& path, const std::string& layout) {
 }
 
 void runSamples(const SampleArgs& a) {
-  EnvironmentMap env = loadMap(a.map, a.layout, mapOptions(a));
+  EnvironmentMap env = EnvironmentMap::loadLayout(a.map, a.layout, mapOptions(a));
   std::vector<EnvSample> samples = drawSamples(env, a);
   std::string csv = "u,v,x,y,z,pdf\n";
   csv.reserve(samples.size() * 80);
@@ -107,7 +102,7 @@ void runSamples(const SampleArgs& a) {
 }
 
 void runPlot(const SampleArgs& a, float exposure) {
-  EnvironmentMap env = loadMap(a.map, a.layout, mapOptions(a));
+  EnvironmentMap env = EnvironmentMap::loadLayout(a.map, a.layout, mapOptions(a));
   std::vector<EnvSample> samples = drawSamples(env, a);
   Image img = env.image();
   SaveOptions so;

@@ -66,6 +66,11 @@ EnvironmentMap EnvironmentMap::loadProbe(const std::string& path, ProbeLayout la
   return EnvironmentMap(std::move(map), opts, path);
 }
 
+EnvironmentMap EnvironmentMap::loadLayout(const std::string& path, const std::string& layout,
+                                          const EnvironmentMapOptions& opts) {
+  return layout == "latlong" ? load(path, opts) : loadProbe(path, parseProbeLayout(layout), opts);
+}
+
 EnvironmentMap EnvironmentMap::constant(Color radiance, const EnvironmentMapOptions& opts) {
   Image img(32, 16);
   for (int y = 0; y < img.height; ++y)
@@ -128,12 +133,7 @@ EnvironmentMap::EnvironmentMap(Image img, const EnvironmentMapOptions& opts, con
     : image_(std::move(img)), opts_(opts) {
   if (!(opts.scale >= 0.f) || !std::isfinite(opts.scale))
     throw std::runtime_error("environment map '" + name + "': scale must be a finite number >= 0");
-  for (float& v : image_.rgb) {
-    if (!std::isfinite(v) || v < 0.f) {
-      v = 0.f;
-      ++invalid_;
-    }
-  }
+  invalid_ = zeroInvalidRadiance(image_);
   if (invalid_ > 0)
     spdlog::warn("environment map '{}': {} NaN, infinite or negative channel values replaced with 0", name, invalid_);
   std::vector<float> weight = samplingWeights(image_, opts.bilinear, opts.misCompensation);

@@ -36,6 +36,10 @@ class EnvironmentMap {
   // A square light probe (angular map or mirror ball), resampled to a lat-long map at twice its
   // width (probeToLatLong); throws as probeToLatLong and load() do.
   static EnvironmentMap loadProbe(const std::string& path, ProbeLayout layout, const EnvironmentMapOptions& opts = {});
+  // load() for layout "latlong", loadProbe() for a probe layout's name (parseProbeLayout): the
+  // scene's envmap and the envmap commands read a file so.
+  static EnvironmentMap loadLayout(const std::string& path, const std::string& layout,
+                                   const EnvironmentMapOptions& opts = {});
   // A map of constant radiance (small, so that the sin-theta weighting still applies).
   static EnvironmentMap constant(Color radiance, const EnvironmentMapOptions& opts = {});
 

@@ -78,45 +78,30 @@ Vec3f probeDiskDirection(ProbeLayout layout, Vec2f p) {
 
 namespace {
 
-// Bilinear between pixel centres, clamped at the image's edges, (x, y) in pixels, over the
-// texels inside the disk only: those outside (usually black, or the photograph's backdrop)
-// would darken the rim, which holds the whole backward direction.
-Color bilinearInDisk(const Image& img, const std::vector<float>& rgb, float x, float y) {
+// Bilinear between pixel centres of the cell [x0, x0 + w) x [y0, y0 + h) of the image, (x, y)
+// in pixels of the cell, clamped at the cell's edges so that no other cube face (or a cross's
+// empty cells) bleeds in; and over the texels that inside(px, py) keeps only, so that a disk's
+// rim is not darkened by the corners outside it (usually black, or the photograph's backdrop).
+// Where it keeps none of the four, all four count.
+template <class Inside>
+Color bilinearInCell(const Image& img, int x0, int y0, int w, int h, float x, float y, Inside inside) {
   float fx = x - 0.5f, fy = y - 0.5f;
-  float x0f = std::floor(fx), y0f = std::floor(fy);
-  float tx = fx - x0f, ty = fy - y0f;
-  int xs[2] = {std::clamp(int(x0f), 0, img.width - 1), std::clamp(int(x0f) + 1, 0, img.width - 1)};
-  int ys[2] = {std::clamp(int(y0f), 0, img.height - 1), std::clamp(int(y0f) + 1, 0, img.height - 1)};
+  float xf = std::floor(fx), yf = std::floor(fy);
+  float tx = fx - xf, ty = fy - yf;
+  int xs[2] = {std::clamp(int(xf), 0, w - 1), std::clamp(int(xf) + 1, 0, w - 1)};
+  int ys[2] = {std::clamp(int(yf), 0, h - 1), std::clamp(int(yf) + 1, 0, h - 1)};
   float wx[2] = {1.f - tx, tx}, wy[2] = {1.f - ty, ty};
   Color sum(0.f), plain(0.f);
   float weight = 0.f;
   for (int j = 0; j < 2; ++j)
     for (int i = 0; i < 2; ++i) {
-      const float* q = &rgb[(size_t(ys[j]) * img.width + xs[i]) * 3];
-      Color c(q[0], q[1], q[2]);
-      float w = wx[i] * wy[j];
-      plain += c * w;
-      float dx = (float(xs[i]) + 0.5f) / float(img.width) * 2.f - 1.f, dy = (float(ys[j]) + 0.5f) / float(img.height) * 2.f - 1.f;
-      if (dx * dx + dy * dy > 1.f) continue;
-      sum += c * w;
-      weight += w;
+      Color c = img.at(x0 + xs[i], y0 + ys[j]) * (wx[i] * wy[j]);
+      plain += c;
+      if (!inside(xs[i], ys[j])) continue;
+      sum += c;
+      weight += wx[i] * wy[j];
     }
   return weight > 0.f ? sum * (1.f / weight) : plain;
-}
-
-// Bilinear between pixel centres of one cube face, the cell [x0, x0 + n) x [y0, y0 + n),
-// clamped at the face's edges so that no other face (or the cross's empty cells) bleeds in.
-Color bilinearInFace(const Image& img, const std::vector<float>& rgb, int x0, int y0, int n, float x, float y) {
-  float fx = x - 0.5f, fy = y - 0.5f;
-  float xf = std::floor(fx), yf = std::floor(fy);
-  float tx = fx - xf, ty = fy - yf;
-  int xa = std::clamp(int(xf), 0, n - 1), xb = std::clamp(int(xf) + 1, 0, n - 1);
-  int ya = std::clamp(int(yf), 0, n - 1), yb = std::clamp(int(yf) + 1, 0, n - 1);
-  auto at = [&](int px, int py) {
-    const float* q = &rgb[(size_t(y0 + py) * img.width + size_t(x0 + px)) * 3];
-    return Color(q[0], q[1], q[2]);
-  };
-  return (at(xa, ya) * (1.f - tx) + at(xb, ya) * tx) * (1.f - ty) + (at(xa, yb) * (1.f - tx) + at(xb, yb) * tx) * ty;
 }
 
 std::string sizeText(const Image& img) { return std::to_string(img.width) + "x" + std::to_string(img.height); }
@@ -153,11 +138,13 @@ Image probeToLatLong(const Image& probe, ProbeLayout layout, const ProbeConversi
   int n = opts.samplesPerSide > 0 ? opts.samplesPerSide
                                   : std::clamp(int(std::ceil(perPixel - 1e-3f)), 1, kMaxProbeSamplesPerSide);
 
-  std::vector<float> rgb = probe.rgb;
-  size_t bad = 0;
-  for (float& v : rgb)
-    if (!std::isfinite(v) || v < 0.f) v = 0.f, ++bad;
+  Image clean = probe;
+  size_t bad = zeroInvalidRadiance(clean);
   if (invalid) *invalid = bad;
+  auto inDisk = [&](int px, int py) {
+    float dx = (float(px) + 0.5f) / float(probe.width) * 2.f - 1.f, dy = (float(py) + 0.5f) / float(probe.height) * 2.f - 1.f;
+    return dx * dx + dy * dy <= 1.f;
+  };
 
   // Lookups stay half a probe pixel inside the rim, where the image's corners (outside the
   // disk, usually black) would bleed in.
@@ -177,14 +164,15 @@ Image probeToLatLong(const Image& probe, ProbeLayout layout, const ProbeConversi
             int col, row;
             crossCell(f.face, vertical, &col, &row);
             // Image rows run down, t up.
-            c = bilinearInFace(probe, rgb, col * face, row * face, face, (f.st.x + 1.f) * 0.5f * float(face),
-                               (1.f - f.st.y) * 0.5f * float(face));
+            c = bilinearInCell(clean, col * face, row * face, face, face, (f.st.x + 1.f) * 0.5f * float(face),
+                               (1.f - f.st.y) * 0.5f * float(face), [](int, int) { return true; });
           } else {
             Vec2f p = probeDiskPoint(layout, d);
             float r = std::sqrt(p.x * p.x + p.y * p.y);
             if (r > rimMax) p = p * (rimMax / r);
             // Image row 0 is the disk's top (y = +1).
-            c = bilinearInDisk(probe, rgb, (p.x + 1.f) * 0.5f * float(probe.width), (1.f - p.y) * 0.5f * float(probe.height));
+            c = bilinearInCell(clean, 0, 0, probe.width, probe.height, (p.x + 1.f) * 0.5f * float(probe.width),
+                               (1.f - p.y) * 0.5f * float(probe.height), inDisk);
           }
           // Each lookup weighted before the sum, so that values near FLT_MAX cannot add up to inf.
           sum += c * (1.f / float(n * n));

@@ -361,6 +361,13 @@ size_t nonFiniteValues(const Image& img) {
   return n;
 }
 
+size_t zeroInvalidRadiance(Image& img) {
+  size_t n = 0;
+  for (float& v : img.rgb)
+    if (!std::isfinite(v) || v < 0.f) v = 0.f, ++n;
+  return n;
+}
+
 std::vector<unsigned char> toneMapImage(const Image& img, const SaveOptions& opts) {
   static const SrgbSteps steps;
   const float scale = std::exp2(opts.exposure);

@@ -51,6 +51,9 @@ std::string encodeJpeg(int width, int height, const std::vector<unsigned char>& 
 
 // How many channel values are NaN or infinite.
 size_t nonFiniteValues(const Image& img);
+// Sets NaN, infinite and negative channel values to 0 (radiance that a light cannot have);
+// returns how many there were.
+size_t zeroInvalidRadiance(Image& img);
 
 // The whole image as 8-bit sRGB, 3 bytes a pixel.
 std::vector<unsigned char> toneMapImage(const Image& img, const SaveOptions& opts);

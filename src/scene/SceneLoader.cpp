@@ -10,7 +10,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "envmap/LightProbe.h"
 #include "image/Image.h"
 #include "materials/BsdfFactory.h"
 #include "scene/NameTables.h"
@@ -598,9 +597,7 @@ class Loader {
         if (layout != "latlong" && layout != "angular" && layout != "mirrorball" && layout != "cross")
           fail(f, n, "layout must be latlong, angular, mirrorball or cross, not '" + layout + "'");
         try {
-          scene_.env = std::make_unique<EnvironmentMap>(
-              layout == "latlong" ? EnvironmentMap::load(path.string(), o)
-                                  : EnvironmentMap::loadProbe(path.string(), parseProbeLayout(layout), o));
+          scene_.env = std::make_unique<EnvironmentMap>(EnvironmentMap::loadLayout(path.string(), layout, o));
         } catch (const std::runtime_error& e) {
           rethrowAt(f, n, e);
         }

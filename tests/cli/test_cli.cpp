@@ -148,6 +148,23 @@ double halfTurnCorrelation(const envgi::Image& made, const envgi::Image& orig, b
     }
   return (sab - sa * sb / n) / std::sqrt((saa - sa * sa / n) * (sbb - sb * sb / n));
 }
+// The bundled Uffizi lat-long map, and a scene file in d lit by it alone: a square, box-filtered
+// Sobol camera with the given field of view and lookat, and `body` (shapes, integrator) beside it.
+std::string uffiziMap() { return std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/uffizi_probe_128_latlong_256x128.hdr"; }
+std::string writeUffiziScene(const TempDir& d, const std::string& name, const std::string& fov, const std::string& lookat,
+                             int spp, int res, const std::string& body) {
+  std::ofstream(d.file(name)) << R"(<scene version="3.0.0">
+  <sensor type="perspective"><float name="fov" value=")" + fov + R"("/>
+    <transform name="to_world"><lookat )" + lookat + R"(/></transform>
+    <sampler type="sobol"><integer name="sample_count" value=")" + std::to_string(spp) + R"("/></sampler>
+    <film type="hdrfilm"><integer name="width" value=")" + std::to_string(res) + R"("/><integer name="height" value=")" +
+                                     std::to_string(res) + R"("/><rfilter type="box"/></film>
+  </sensor>
+  <emitter type="envmap"><string name="filename" value=")" + uffiziMap() + R"("/></emitter>
+  )" + body + R"(
+</scene>)";
+  return d.file(name);
+}
 }  // namespace
 
 // The mirror-ball layout against physics: envgi renders a chrome sphere in a lat-long map,
@@ -157,17 +174,10 @@ double halfTurnCorrelation(const envgi::Image& made, const envgi::Image& orig, b
 // right it would not match.
 TEST(CliEnvmap, AChromeSpheresPictureConvertsBackToItsMap) {
   TempDir d;
-  std::string map = std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/uffizi_probe_128_latlong_256x128.hdr";
-  std::ofstream(d.file("ball.xml")) << R"(<scene version="3.0.0">
-  <integrator type="path"><integer name="max_depth" value="2"/></integrator>
-  <sensor type="perspective"><float name="fov" value="0.11459"/>
-    <transform name="to_world"><lookat origin="0,0,-1000" target="0,0,0" up="0,1,0"/></transform>
-    <sampler type="sobol"><integer name="sample_count" value="16"/></sampler>
-    <film type="hdrfilm"><integer name="width" value="128"/><integer name="height" value="128"/><rfilter type="box"/></film>
-  </sensor>
-  <emitter type="envmap"><string name="filename" value=")" + map + R"("/></emitter>
-  <shape type="sphere"><float name="radius" value="1"/><bsdf type="conductor"/></shape>
-</scene>)";
+  std::string map = uffiziMap();
+  writeUffiziScene(d, "ball.xml", "0.11459", R"(origin="0,0,-1000" target="0,0,0" up="0,1,0")", 16, 128,
+                   R"(<integrator type="path"><integer name="max_depth" value="2"/></integrator>
+  <shape type="sphere"><float name="radius" value="1"/><bsdf type="conductor"/></shape>)");
   CliResult r = runCli("render " + d.file("ball.xml") + " -o " + d.file("ball.exr") + " --no-progress");
   ASSERT_EQ(r.code, 0) << r.output;
   CliResult c = runCli("envmap convert " + d.file("ball.exr") + " --layout mirrorball --width 256 -o " + d.file("back.exr"));
@@ -189,15 +199,8 @@ TEST(CliEnvmap, AChromeSpheresPictureConvertsBackToItsMap) {
 // horizontal one, convert back to the map, half a turn round as for the mirror ball.
 TEST(CliEnvmap, CrossesOfRenderedCubeFacesConvertBackToTheirMap) {
   TempDir d;
-  std::string map = std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/uffizi_probe_128_latlong_256x128.hdr";
-  std::ofstream(d.file("face.xml")) << R"(<scene version="3.0.0">
-  <sensor type="perspective"><float name="fov" value="90"/>
-    <transform name="to_world"><lookat origin="0,0,0" target="$target" up="$up"/></transform>
-    <sampler type="sobol"><integer name="sample_count" value="4"/></sampler>
-    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/><rfilter type="box"/></film>
-  </sensor>
-  <emitter type="envmap"><string name="filename" value=")" + map + R"("/></emitter>
-</scene>)";
+  std::string map = uffiziMap();
+  writeUffiziScene(d, "face.xml", "90", R"(origin="0,0,0" target="$target" up="$up")", 4, 32, "");
   // Faces +X, -X, +Y, -Y, +Z (upside down, then upright), -Z: where each looks and its up.
   const char* views[7][2] = {{"1,0,0", "0,1,0"},  {"-1,0,0", "0,1,0"}, {"0,1,0", "0,0,1"}, {"0,-1,0", "0,0,-1"},
                              {"0,0,1", "0,-1,0"}, {"0,0,1", "0,1,0"},  {"0,0,-1", "0,1,0"}};
