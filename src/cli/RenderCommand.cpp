@@ -35,6 +35,9 @@ struct RenderArgs {
   bool aces = false;
   double checkpoint = 60.0;
   double timeLimit = 0.0;
+  float noiseThreshold = 0.f;
+  int minSpp = 16;
+  std::string sampleMap;
   std::string device = "auto", sampler, pointMethod, filter;
   int points = 0;
   int gpu = 0;
@@ -50,6 +53,11 @@ void runRender(const RenderArgs& a) {
   std::string ext = fs::path(a.output).extension().string();
   if (ext != ".exr" && ext != ".pfm" && ext != ".hdr" && ext != ".png")
     throw std::runtime_error("output '" + a.output + "' must end in .exr, .pfm, .hdr or .png");
+  if (!a.sampleMap.empty()) {
+    std::string me = fs::path(a.sampleMap).extension().string();
+    if (me != ".exr" && me != ".pfm" && me != ".hdr" && me != ".png")
+      throw std::runtime_error("--sample-map '" + a.sampleMap + "' must end in .exr, .pfm, .hdr or .png");
+  }
   auto t0 = std::chrono::steady_clock::now();
   Scene scene;
   loadScene(a.scene, parseDefines(a.defines), scene);
@@ -92,13 +100,20 @@ void runRender(const RenderArgs& a) {
   };
   ro.cancel = &g_cancel;
   ro.timeLimitSeconds = a.timeLimit;
+  ro.noiseThreshold = a.noiseThreshold;
+  ro.adaptiveMinSpp = a.minSpp;
+  std::vector<int> samples;
+  if (!a.sampleMap.empty()) ro.samplesOut = &samples;
   std::signal(SIGINT, onInterrupt);
   std::signal(SIGTERM, onInterrupt);
   RenderStats st;
   const IntegratorSettings& is = scene.integrator;
   const int requestedSpp = a.spp > 0 ? a.spp : scene.sampler.sampleCount;
-  spdlog::info("rendering {}x{} with '{}' (strategy {}), {} spp, {} sampler", scene.camera.width, scene.camera.height,
-               integratorName(is.type), is.env.strategy, requestedSpp, samplerName(scene.sampler.type));
+  spdlog::info("rendering {}x{} with '{}' (strategy {}), {} spp, {} sampler{}", scene.camera.width, scene.camera.height,
+               integratorName(is.type), is.env.strategy, requestedSpp, samplerName(scene.sampler.type),
+               a.noiseThreshold > 0.f
+                   ? fmt::format(", adaptive: noise threshold {:g} from {} spp", a.noiseThreshold, a.minSpp)
+                   : "");
   Image img;
   if (cuda) {
     Bvh bvh(scene);
@@ -123,6 +138,19 @@ void runRender(const RenderArgs& a) {
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   write(img);
+  if (!a.sampleMap.empty()) {
+    // Each pixel's share of the requested samples: 1 where it took them all.
+    Image map(scene.camera.width, scene.camera.height);
+    for (size_t i = 0; i < samples.size(); ++i)
+      map.rgb[3 * i] = map.rgb[3 * i + 1] = map.rgb[3 * i + 2] = float(samples[i]) / float(requestedSpp);
+    saveImage(map, a.sampleMap, SaveOptions{});
+  }
+  if (a.noiseThreshold > 0.f) {
+    double full = double(scene.camera.width) * scene.camera.height * st.sppDone;
+    spdlog::info("adaptive sampling: {:.3g} samples, {:.1f}% of {} spp everywhere; {:.1f}% of the pixels stopped early",
+                 double(st.pixelSamples), full > 0 ? 100.0 * double(st.pixelSamples) / full : 0.0, st.sppDone,
+                 100.0 * double(st.pixelsStopped) / (double(scene.camera.width) * scene.camera.height));
+  }
   if (st.cancelled) spdlog::warn("interrupted: wrote the {} samples per pixel finished so far", st.sppDone);
   if (st.timeLimited)
     spdlog::info("time limit of {:g} s: stopped after {} of {} spp", a.timeLimit, st.sppDone, requestedSpp);
@@ -176,6 +204,15 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("--time-limit", a->timeLimit,
                 "Seconds of sampling at most: stop at the last pass that fits, with the samples done (0: none)")
       ->check(atLeast(0));
+  c->add_option("--noise-threshold", a->noiseThreshold,
+                "Adaptive sampling: a pixel stops once its noise (standard error of its mean luminance over the "
+                "root of that mean) and its neighbours' is below this, as Cycles' noise threshold (0: off)")
+      ->check(atLeast(0))
+      ->check(finiteNumber());
+  c->add_option("--min-spp", a->minSpp, "Adaptive sampling: samples every pixel takes before it may stop (default 16)")
+      ->check(atLeast(2));
+  c->add_option("--sample-map", a->sampleMap,
+                "Also write each pixel's share of the requested samples as an image (.exr, .pfm, .hdr or .png)");
   c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
   c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(atLeast(0));
   c->add_option("--filter", a->filter, "Pixel filter: " + nameList(kFilterNames) + " (overrides the scene)");

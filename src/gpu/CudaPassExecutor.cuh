@@ -126,6 +126,18 @@ class CudaPassExecutor final : public PassExecutor {
     size_t px = size_t(cam_.width) * cam_.height;
     check(cudaMemset(film_.sum, 0, px * sizeof(Color)), "clearing the film");
     if (film_.sumSqLum) check(cudaMemset(film_.sumSqLum, 0, px * sizeof(double)), "clearing the film");
+    film_.active = nullptr;
+    return true;
+  }
+
+  // The mask lives beside the film, allocated on first use; film_.active points at it while a
+  // render is adaptive.
+  bool setActivePixels(const std::vector<unsigned char>& mask) override {
+    size_t px = size_t(cam_.width) * cam_.height;
+    if (mask.size() != px) return false;
+    if (!activeMask_) activeMask_ = scene_->arena.allocate<unsigned char>(px, "adaptive sampling mask");
+    check(cudaMemcpy(activeMask_, mask.data(), px, cudaMemcpyHostToDevice), "uploading the adaptive sampling mask");
+    film_.active = activeMask_;
     return true;
   }
 
@@ -148,6 +160,7 @@ class CudaPassExecutor final : public PassExecutor {
   SampleSequence seq_;
   Integrator integ_;
   FilmView film_;
+  unsigned char* activeMask_ = nullptr;     // adaptive sampling's mask on the device, once set
   unsigned long long* counters_ = nullptr;  // rays, dropped samples, regeneration's next item
   int regenBlocks_ = 0;  // > 0: passes by path regeneration, this many blocks
 };

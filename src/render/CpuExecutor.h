@@ -42,7 +42,8 @@ class CpuExecutor final : public PassExecutor {
   void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
     int W = cam_.width, H = cam_.height;
     int tilesX = (W + tile_ - 1) / tile_, tilesY = (H + tile_ - 1) / tile_;
-    FilmView fv{film_.sum.data(), film_.sumSqLum.empty() ? nullptr : film_.sumSqLum.data(), W, H};
+    FilmView fv{film_.sum.data(), film_.sumSqLum.empty() ? nullptr : film_.sumSqLum.data(), W, H,
+                active_.empty() ? nullptr : active_.data()};
     std::atomic<uint64_t> rays{0}, dropped{0};
     arena_.execute([&] {
       tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& r) {
@@ -75,6 +76,13 @@ class CpuExecutor final : public PassExecutor {
     cam_ = cam;
     film_.sum.assign(size_t(cam.width) * cam.height, Color(0.f));
     if (!film_.sumSqLum.empty()) film_.sumSqLum.assign(film_.sum.size(), 0.0);
+    active_.clear();
+    return true;
+  }
+
+  bool setActivePixels(const std::vector<unsigned char>& mask) override {
+    if (mask.size() != film_.sum.size()) return false;
+    active_ = mask;
     return true;
   }
 
@@ -87,6 +95,7 @@ class CpuExecutor final : public PassExecutor {
   int tile_;
   bool byBounce_ = false;
   FilmSums film_;
+  std::vector<unsigned char> active_;  // empty: every pixel takes samples
   tbb::enumerable_thread_specific<TileBatch> batch_;  // renderTileByBounce's room, one per thread
 };
 

@@ -35,6 +35,9 @@ class PassExecutor {
   // Starts over with a new camera and an empty film, keeping what does not depend on the
   // camera (photon maps, a grid). False: this executor cannot, make a new one.
   virtual bool restart(const Camera&) { return false; }
+  // Adaptive sampling: later passes sample only the pixels whose mask entry is non-zero (one a
+  // pixel, row-major). False: this executor samples every pixel in every pass (SPPM).
+  virtual bool setActivePixels(const std::vector<unsigned char>& /*mask*/) { return false; }
 };
 
 }  // namespace envgi

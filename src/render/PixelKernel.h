@@ -73,11 +73,14 @@ struct KernelSettings {
 };
 
 // The film as the kernels see it: per-pixel sums of radiance and of squared luminance (the
-// latter may be null), row-major.
+// latter may be null), row-major. Adaptive sampling (AdaptiveSampling.h) sets active: a pixel
+// whose entry is 0 has converged and takes no more samples; null means every pixel is active.
 struct FilmView {
   Color* sum = nullptr;
   double* sumSqLum = nullptr;
   int width = 0, height = 0;
+  const unsigned char* active = nullptr;
+  ENVGI_HD bool takesSamples(size_t pixel) const { return !active || active[pixel] != 0; }
 };
 
 struct PixelCounters {
@@ -113,10 +116,11 @@ ENVGI_HD inline bool acceptedSample(const Color& L, PixelCounters* counters) {
 template <class Integrator>
 ENVGI_HD void renderPixel(const Camera& cam, const SampleSequence& seq, const Integrator& integrate, int x, int y,
                           int s0, int s1, FilmView film, PixelCounters* counters) {
+  size_t pixel = size_t(y) * size_t(cam.width) + size_t(x);
+  if (!film.takesSamples(pixel)) return;
   Sampler smp = sequenceSampler(seq);
   Color acc(0.f);
   double accSq = 0.0;
-  size_t pixel = size_t(y) * size_t(cam.width) + size_t(x);
   for (int s = s0; s < s1; ++s) {
     Color L = integrate(startCameraSample(cam, smp, x, y, s), smp, &counters->rays);
     if (!acceptedSample(L, counters)) continue;
@@ -146,6 +150,7 @@ ENVGI_HD void regeneratePaths(const Camera& cam, const SampleSequence& seq, cons
       uint64_t item = fetch();
       if (item >= total) break;
       pixel = item % npix;
+      if (!film.takesSamples(pixel)) continue;  // converged: its item costs one fetch
       int x = int(pixel % uint64_t(cam.width)), y = int(pixel / uint64_t(cam.width));
       st = integ.begin(startCameraSample(cam, smp, x, y, s0 + int(item / npix)));
     }
@@ -206,8 +211,10 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
   for (int s = s0; s < s1; ++s) {
     int live = 0;
     for (int k = 0; k < n; ++k) {
+      int x = x0 + k % tw, y = y0 + k / tw;
+      if (!film.takesSamples(size_t(y) * size_t(cam.width) + size_t(x))) continue;
       b->sampler[k] = sequenceSampler(seq);
-      b->state[k] = integ.begin(startCameraSample(cam, b->sampler[k], x0 + k % tw, y0 + k / tw, s));
+      b->state[k] = integ.begin(startCameraSample(cam, b->sampler[k], x, y, s));
       b->active[live++] = k;
     }
     while (live > 0) {
@@ -248,6 +255,7 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
   }
   for (int k = 0; k < n; ++k) {
     size_t pixel = size_t(y0 + k / tw) * size_t(cam.width) + size_t(x0 + k % tw);
+    if (!film.takesSamples(pixel)) continue;
     film.sum[pixel] += b->acc[k];
     if (film.sumSqLum) film.sumSqLum[pixel] += b->accSq[k];
   }

@@ -2,12 +2,14 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <mutex>
 #include <stdexcept>
 
 #include "accel/Bvh.h"
+#include "render/AdaptiveSampling.h"
 #include "render/CpuExecutor.h"
 #include "integrators/PhotonIntegrator.h"
 #include "render/GridExecutor.h"
@@ -144,7 +146,7 @@ PreparedRender prepareOnTracer(const Scene& scene, const Tracer& tracer, const R
       if (!ge.photons.tracer) ge.photons.tracer = cpuPhotonTracer(scene, tracer);
       SequenceAndSpp q = gridSequence(scene, opts);
       auto ex = std::make_unique<GridExecutor<Tracer>>(scene, tracer, ge, q.sequence, opts.threads,
-                                                       opts.varianceOut != nullptr, opts.tileSize);
+                                                       opts.keepsVariance(), opts.tileSize);
       logGridBuild(ex->build(), ge.gatherRays);
       return {std::move(ex), q.spp};
     }
@@ -157,7 +159,7 @@ PreparedRender prepareOnTracer(const Scene& scene, const Tracer& tracer, const R
   const SceneView& sc = scene.view();
   SampleIntegrator<Tracer> integ{k.type, k.path, k.direct, &sc, tracer};
   return {std::make_unique<CpuExecutor<decltype(integ)>>(sc.camera, k.sequence, integ, opts.threads,
-                                                         opts.varianceOut != nullptr, name, opts.tileSize),
+                                                         opts.keepsVariance(), name, opts.tileSize),
           k.spp};
 }
 
@@ -179,7 +181,7 @@ PreparedRender preparePhoton(const Scene& scene, const EmbreeAccel& accel, const
   php.chain = chainParams(scene, ps.maxDepth, ps.rrDepth, ps.hideEmitters);
   PhotonSample sample{&scene.view(), EmbreeTracer{&accel}, globalMap, causticMap, php};
   return {std::make_unique<CpuExecutor<PhotonSample>>(scene.view().camera, sequenceOf(scene, spp), sample,
-                                                       opts.threads, opts.varianceOut != nullptr, "cpu",
+                                                       opts.threads, opts.keepsVariance(), "cpu",
                                                        opts.tileSize),
           spp};
 }
@@ -242,6 +244,18 @@ Image filmMean(const FilmSums& film, int width, int height, int samples) {
   return img;
 }
 
+Image filmMean(const FilmSums& film, int width, int height, const std::vector<int>& samples) {
+  Image img(width, height);
+  size_t n = std::min({film.sum.size(), samples.size(), size_t(width) * size_t(height)});
+  for (size_t i = 0; i < n; ++i) {
+    Color c = film.sum[i] / float(std::max(samples[i], 1));
+    img.rgb[3 * i] = c.x;
+    img.rgb[3 * i + 1] = c.y;
+    img.rgb[3 * i + 2] = c.z;
+  }
+  return img;
+}
+
 Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts, RenderStats* stats) {
   // Passes double the samples done (1, 1, 2, 4, ...) up to the executor's limit (64 samples on
   // the CPU), so a checkpoint comes early, and each pass ends at a power of two or a multiple of
@@ -261,32 +275,54 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   auto lastCheckpoint = t0;
   int sppDone = 0;
   bool cancelled = false, timeLimited = false;
-  auto meanImage = [&](int n) {
+  const size_t px = size_t(W) * size_t(H);
+  std::vector<int> samples(px, 0);  // each pixel's samples so far
+  // Adaptive sampling's mask (AdaptiveSampling.h): every pixel starts active.
+  const bool adaptive = opts.noiseThreshold > 0.f;
+  std::vector<unsigned char> active(adaptive ? px : 0, 1);
+  size_t activeCount = px;
+  uint64_t pixelSamples = 0;
+  if (adaptive && !ex.setActivePixels(active))
+    throw std::runtime_error("adaptive sampling (a noise threshold) needs an integrator that samples pixels one by "
+                             "one: path, direct, photon or grid, not sppm");
+  auto meanImage = [&]() {
     ex.readFilm(&film);
-    return filmMean(film, W, H, n);
+    return filmMean(film, W, H, samples);
   };
   for (auto [s0, s1] : passes) {
     if (opts.cancel && opts.cancel->load()) {
       cancelled = true;
       break;
     }
-    if (opts.timeLimitSeconds > 0.0 && sppDone > 0) {
+    if (opts.timeLimitSeconds > 0.0 && pixelSamples > 0) {
+      // At the rate of the passes so far, a pixel-sample at a time (adaptive passes shrink).
       double spent = std::chrono::duration<double>(Clock::now() - t0).count();
-      if (spent + spent / sppDone * (s1 - s0) > opts.timeLimitSeconds) {
+      if (spent + spent / double(pixelSamples) * double(activeCount) * (s1 - s0) > opts.timeLimitSeconds) {
         timeLimited = true;
         break;
       }
     }
     ex.runPass(s0, s1, progress, &counters);
+    for (size_t i = 0; i < px; ++i)
+      if (!adaptive || active[i]) samples[i] = s1;
+    pixelSamples += uint64_t(activeCount) * uint64_t(s1 - s0);
     sppDone = s1;
+    if (adaptive && sppDone >= opts.adaptiveMinSpp && sppDone < spp) {
+      ex.readFilm(&film);
+      if (film.sumSqLum.size() != px) throw std::runtime_error("this executor kept no per-pixel variance");
+      activeCount = updateActivePixels(film.sum, film.sumSqLum, samples, W, H, opts.noiseThreshold, 1, &active);
+      spdlog::debug("adaptive sampling: {} of {} pixels still sampling after {} spp", activeCount, px, sppDone);
+      if (activeCount == 0) break;  // every pixel has converged: the render is done
+      ex.setActivePixels(active);
+    }
     double sinceCheckpoint = std::chrono::duration<double>(Clock::now() - lastCheckpoint).count();
     if (opts.checkpoint && opts.checkpointSeconds > 0.0 && sinceCheckpoint >= opts.checkpointSeconds && sppDone < spp) {
-      opts.checkpoint(meanImage(sppDone), sppDone);
+      opts.checkpoint(meanImage(), sppDone);
       lastCheckpoint = Clock::now();
     }
   }
   progress.finish();
-  Image img = meanImage(std::max(sppDone, 1));
+  Image img = meanImage();
   if (stats) {
     stats->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     stats->sppDone = sppDone;
@@ -294,16 +330,20 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     stats->nonFiniteSamples = counters.dropped;
     stats->cancelled = cancelled;
     stats->timeLimited = timeLimited;
+    stats->pixelSamples = pixelSamples;
+    stats->pixelsStopped = size_t(std::count_if(samples.begin(), samples.end(), [&](int n) { return n < sppDone; }));
   }
   if (opts.varianceOut && sppDone > 0) {
     if (film.sumSqLum.empty()) throw std::runtime_error("this executor kept no per-pixel variance");
-    opts.varianceOut->assign(size_t(W) * H, 0.f);
+    opts.varianceOut->assign(px, 0.f);
     for (size_t i = 0; i < film.sum.size(); ++i) {
-      double mean = luminance(film.sum[i]) / sppDone;
-      double var = std::max(0.0, film.sumSqLum[i] / sppDone - mean * mean);
-      (*opts.varianceOut)[i] = float(var / std::max(1, sppDone - 1));
+      int n = std::max(samples[i], 1);
+      double mean = luminance(film.sum[i]) / n;
+      double var = std::max(0.0, film.sumSqLum[i] / n - mean * mean);
+      (*opts.varianceOut)[i] = float(var / std::max(1, n - 1));
     }
   }
+  if (opts.samplesOut) *opts.samplesOut = samples;
   if (counters.dropped > 0) spdlog::warn("{} samples were NaN, infinite or negative and were dropped", counters.dropped);
   return img;
 }

@@ -38,6 +38,15 @@ struct RenderOptions {
   // When set, receives the variance of each pixel's mean luminance (for Z-tests between
   // estimators, as Mitsuba's render tests use).
   std::vector<float>* varianceOut = nullptr;
+  // Adaptive sampling (AdaptiveSampling.h; Cycles' noise threshold): when > 0, a pixel stops
+  // once its noise and its neighbours' is below this, checked after each pass from
+  // adaptiveMinSpp samples on. 0: every pixel takes every sample.
+  float noiseThreshold = 0.f;
+  int adaptiveMinSpp = 16;
+  // When set, receives the samples each pixel took (row-major).
+  std::vector<int>* samplesOut = nullptr;
+  // Whether executors must keep per-pixel sums of squared luminance.
+  bool keepsVariance() const { return varianceOut != nullptr || noiseThreshold > 0.f; }
   CpuTracer cpuTracer = CpuTracer::Embree;
   // Where the photon and grid integrators trace their photon maps; null: the CPU (Embree).
   std::shared_ptr<PhotonBatchTracer> photonTracer;
@@ -50,6 +59,8 @@ struct RenderStats {
   uint64_t nonFiniteSamples = 0;
   bool cancelled = false;
   bool timeLimited = false;  // stopped by timeLimitSeconds before the requested samples
+  uint64_t pixelSamples = 0;  // samples taken over all pixels (fewer than pixels x sppDone when adaptive)
+  size_t pixelsStopped = 0;   // pixels that adaptive sampling stopped before sppDone
   double raysPerSecond() const { return seconds > 0.0 ? double(rays) / seconds : 0.0; }
 };
 
@@ -87,6 +98,8 @@ Image render(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& 
 
 // The film's per-pixel means after `samples` samples a pixel.
 Image filmMean(const FilmSums& film, int width, int height, int samples);
+// The same with each pixel's own count (adaptive sampling); a pixel with none is black.
+Image filmMean(const FilmSums& film, int width, int height, const std::vector<int>& samples);
 
 // The loop itself, over an executor that already holds the scene (e.g. a GPU's).
 Image renderPasses(PassExecutor& executor, int width, int height, int spp, const RenderOptions& opts,

@@ -133,6 +133,40 @@ TEST(CliRender, TimeLimitStopsAtAPassWithTheSamplesDone) {
   EXPECT_FALSE(fs::exists(d.file("x.exr")));
 }
 
+// Adaptive sampling from the command line: the log says how many samples it took, and the
+// sample map shows the background stopping at --min-spp while the sphere and floor go on.
+TEST(CliRender, NoiseThresholdStopsConvergedPixelsAndMapsTheirSamples) {
+  TempDir d;
+  std::string scene = tinyScene(d, 32, 64);
+  std::string out = d.file("adaptive.exr"), map = d.file("samples.pfm");
+  CliResult r = runCli("render " + scene + " -o " + out + " --no-progress --noise-threshold 0.05 --min-spp 8 --sample-map " + map);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("adaptive: noise threshold 0.05 from 8 spp"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("adaptive sampling: "), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("of the pixels stopped early"), std::string::npos) << r.output;
+  envgi::Image m = envgi::loadImage(map);
+  ASSERT_EQ(m.width, 32);
+  int atMin = 0, atAll = 0;
+  for (size_t i = 0; i < m.rgb.size(); i += 3) {
+    float share = m.rgb[i];
+    EXPECT_TRUE(share == 0.125f || share == 0.25f || share == 0.5f || share == 1.f) << share;
+    atMin += share == 0.125f;
+    atAll += share == 1.f;
+  }
+  EXPECT_GT(atMin, 0) << "the map's background converges at once";
+  EXPECT_GT(atAll, 0) << "the glossy sphere does not";
+  EXPECT_TRUE(fs::exists(out));
+  // Bad values stop before anything is written.
+  for (const std::string& bad : std::vector<std::string>{"--noise-threshold -1", "--noise-threshold nan", "--min-spp 1",
+                          "--noise-threshold 0.1 --sample-map " + d.file("m.txt"),
+                          "--noise-threshold 0.1 --integrator sppm"}) {
+    std::string o = d.file("bad.exr");
+    CliResult b = runCli("render " + scene + " -o " + o + " --no-progress " + bad);
+    EXPECT_NE(b.code, 0) << bad << "\n" << b.output;
+    EXPECT_FALSE(fs::exists(o)) << bad;
+  }
+}
+
 // Under a time limit the progress log (every 10% when not on a terminal) counts the time too:
 // no line promises more time left than the limit, and the bar gets past half way (by samples
 // alone it would stay near 0%).

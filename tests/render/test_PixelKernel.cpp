@@ -107,3 +107,52 @@ TEST(PixelKernel, TileByBounceAddsTheSameSamplesAsRenderPixel) {
     EXPECT_GT(mean, 0.0) << name << ": an image, not a black film";
   }
 }
+
+// Adaptive sampling's mask: renderPixel, renderTileByBounce and regeneratePaths leave a masked
+// pixel's sums alone and give every other pixel the same sums to the bit as an unmasked pass.
+TEST(PixelKernel, MaskedPixelsTakeNoSamplesAndTheRestTheSame) {
+  SmallScene small("buddha", IntegratorType::Path);
+  const KernelSettings& k = small.k;
+  SampleIntegrator<BvhTracer> integ = small.integrator();
+  const Camera& cam = small.scene.view().camera;
+  size_t npix = size_t(cam.width) * cam.height;
+  std::vector<unsigned char> mask(npix);
+  for (size_t i = 0; i < npix; ++i) mask[i] = (i * 7919 % 5) < 2;  // two pixels in five sample
+  Film full{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)};
+  PixelCounters cf;
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) renderPixel(cam, k.sequence, integ, x, y, 0, 4, full.view(cam), &cf);
+  auto check = [&](Film& f, const char* body) {
+    for (size_t i = 0; i < npix; ++i) {
+      if (mask[i]) {
+        EXPECT_EQ(std::memcmp(&f.sum[i], &full.sum[i], sizeof(Color)), 0) << body << " pixel " << i;
+        EXPECT_EQ(f.sumSq[i], full.sumSq[i]) << body << " pixel " << i;
+      } else {
+        EXPECT_EQ(f.sum[i].x + f.sum[i].y + f.sum[i].z, 0.f) << body << " pixel " << i;
+        EXPECT_EQ(f.sumSq[i], 0.0) << body << " pixel " << i;
+      }
+    }
+  };
+  auto masked = [&](Film& f) {
+    FilmView v = f.view(cam);
+    v.active = mask.data();
+    return v;
+  };
+  Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a, c = a;
+  PixelCounters ca, cb, cc;
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) renderPixel(cam, k.sequence, integ, x, y, 0, 4, masked(a), &ca);
+  check(a, "renderPixel");
+  TileBatch batch;
+  for (int y0 = 0; y0 < cam.height; y0 += 16)
+    for (int x0 = 0; x0 < cam.width; x0 += 16)
+      renderTileByBounce(cam, k.sequence, integ, x0, y0, std::min(x0 + 16, cam.width), std::min(y0 + 16, cam.height),
+                         0, 4, masked(b), &batch, &cb);
+  check(b, "renderTileByBounce");
+  EXPECT_EQ(ca.rays, cb.rays);
+  EXPECT_LT(ca.rays, cf.rays);
+  uint64_t next = 0;
+  regeneratePaths(cam, k.sequence, integ, 0, 4, masked(c), [&] { return next++; }, &cc);
+  check(c, "regeneratePaths");
+  EXPECT_EQ(ca.rays, cc.rays);
+}
