@@ -394,6 +394,9 @@ def main():
     ap.add_argument('--spp', type=int, required=True)
     ap.add_argument('--seed', type=int, default=0)
     ap.add_argument('--threads', type=int, default=os.cpu_count())
+    ap.add_argument('--noise-threshold', type=float, default=0.0,
+                    help="Cycles' adaptive sampling with this noise threshold (0: off, every pixel takes --spp)")
+    ap.add_argument('--min-spp', type=int, default=16, help="adaptive sampling's minimum samples")
     ap.add_argument('-D', action='append', default=[], metavar='name=value')
     a = ap.parse_args(argv)
     sc = Scene(a.scene, dict(d.split('=', 1) for d in a.D))
@@ -462,7 +465,10 @@ def render(sc, scene, a, max_depth):
     c.device = 'CPU'
     c.samples = a.spp
     c.seed = a.seed
-    c.use_adaptive_sampling = False
+    c.use_adaptive_sampling = a.noise_threshold > 0.0
+    if c.use_adaptive_sampling:
+        c.adaptive_threshold = a.noise_threshold
+        c.adaptive_min_samples = a.min_spp
     c.use_denoising = False
     c.pixel_filter_type = 'BOX'
     c.filter_width = 1.0

@@ -28,10 +28,10 @@ import numpy as np
 from crosscheck_mitsuba import ENVGI_ONLY
 
 
-def envgi_render(envgi, xml, out, spp, seed, res, threads, strategy='product'):
+def envgi_render(envgi, xml, out, spp, seed, res, threads, strategy='product', adaptive=()):
     cmd = [envgi, 'render', xml, '-o', out, '--spp', str(spp), '--seed', str(seed), '--no-progress',
            '--device', 'cpu', '--integrator', 'path', '--strategy', strategy, '-D', f'res={res}', '--threads', str(threads),
-           '--filter', 'box']
+           '--filter', 'box'] + list(adaptive)
     log = subprocess.run(cmd, check=True, capture_output=True, text=True)
     m = re.search(r'done in ([0-9.]+) s', log.stdout + log.stderr)
     return np.array(mi.Bitmap(out))[..., :3].astype(np.float64), float(m.group(1))
@@ -81,20 +81,24 @@ class Cycles:
         self.cmd = [args.blender, '-b', '--factory-startup', '-noaudio', '--python',
                     os.path.join(os.path.dirname(os.path.abspath(__file__)), 'cycles_render.py'), '--', xml,
                     '--out', out, '--threads', str(args.threads), '-D', f'res={args.res}']
+        self.adaptive = ['--noise-threshold', str(args.noise_threshold), '--min-spp', str(args.min_spp)]
         self.out = out
         self.setup = statistics.median(self.run(1, 0)[1] for _ in range(3))
         v = subprocess.run([args.blender, '--version'], capture_output=True, text=True).stdout.split('\n')[0]
         self.version = f'{v.strip()} Cycles (CPU)'
 
-    def run(self, spp, seed):
-        log = subprocess.run(self.cmd + ['--spp', str(spp), '--seed', str(seed)], capture_output=True, text=True)
+    def run(self, spp, seed, adaptive=False):
+        log = subprocess.run(self.cmd + ['--spp', str(spp), '--seed', str(seed)] + (self.adaptive if adaptive else []),
+                             capture_output=True, text=True)
         m = re.search(r'cycles render: ([0-9.]+) s', log.stdout)
         if log.returncode != 0 or not m:
             raise SystemExit(f'Cycles failed on {" ".join(self.cmd)}:\n{log.stderr[-2000:]}')
         return np.array(mi.Bitmap(self.out))[..., :3].astype(np.float64), float(m.group(1))
 
-    def render(self, spp, seed):
-        img, t = self.run(spp, seed)
+    def render(self, spp, seed, adaptive=False):
+        img, t = self.run(spp, seed, adaptive)
+        if adaptive:  # the samples are not spread evenly: the set-up alone comes off
+            return img, max(t - self.setup, 1e-3)
         return img, max(t - self.setup, 1e-3) * spp / max(spp - 1, 1)
 
 
@@ -125,7 +129,14 @@ def main():
                          'the median time')
     ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,bunny-sunrise',
                     help='comma-separated scene files (without .xml) in --scenes to compare on')
+    ap.add_argument('--noise-threshold', type=float, default=0.0,
+                    help='Cycles only: both renderers with adaptive sampling at this noise threshold, --spp the '
+                         'budget; the table then compares at equal budgets (no equal-time search: time is not '
+                         'proportional to the budget)')
+    ap.add_argument('--min-spp', type=int, default=16, help="adaptive sampling's minimum samples, both renderers")
     args = ap.parse_args()
+    if args.noise_threshold > 0 and args.renderer != 'cycles':
+        ap.error('--noise-threshold compares with Cycles (Mitsuba has no adaptive sampling)')
     if args.seeds < 1:
         ap.error('--seeds must be at least 1')
     seeds = range(7, 7 + args.seeds)
@@ -144,18 +155,27 @@ def main():
         o = other(xml, args, os.path.join(tmp, 'o.exr'))
         oref, _ = o.render(args.ref_spp, 1)
         escale, oscale = (float(np.mean(eref)), float(np.mean(oref))) if other.relative else (1.0, 1.0)
+        adaptive = args.noise_threshold > 0
+        eadaptive = ['--noise-threshold', str(args.noise_threshold), '--min-spp', str(args.min_spp)] if adaptive else []
         for spp in (int(s) for s in args.spp.split(',')):
-            rm, mt = over_seeds(lambda seed: o.render(spp, seed), oref, seeds, oscale)
+            rm, mt = over_seeds(lambda seed: o.render(spp, seed, adaptive) if adaptive else o.render(spp, seed), oref,
+                                seeds, oscale)
             erender = lambda n: lambda seed: envgi_render(args.envgi, xml, out, n, seed, args.res, args.threads,
-                                                          args.strategy)
+                                                          args.strategy, eadaptive)
             re_, et = over_seeds(erender(spp), eref, seeds, escale)
-            espp = max(1, int(round(spp * mt / max(et, 1e-3))))  # envgi logs 0.00 s for a tiny render
-            re2, et2 = over_seeds(erender(espp), eref, seeds, escale)
+            if adaptive:
+                espp, re2, et2 = spp, re_, et
+            else:
+                espp = max(1, int(round(spp * mt / max(et, 1e-3))))  # envgi logs 0.00 s for a tiny render
+                re2, et2 = over_seeds(erender(espp), eref, seeds, escale)
             rows.append((name, spp, mt, rm, et, re_, espp, et2, re2, (re2 * re2 * et2) / (rm * rm * mt),
                          (re_ * re_ * et) / (rm * rm * mt)))
             print(rows[-1], flush=True)
     n, err = other.name, 'rel. RMSE' if other.relative else 'RMSE'
     owner = n + ("'" if n.endswith('s') else "'s")
+    if args.noise_threshold > 0:
+        print(f'\nBoth with adaptive sampling: noise threshold {args.noise_threshold}, at least {args.min_spp} spp, '
+              'spp the budget; the "same time" columns repeat the budget\'s')
     print(f'\n{o.version} vs envgi path (strategy {args.strategy}), {args.res}^2, {args.threads} threads; '
           f'{err} against each renderer\'s own {args.ref_spp}-spp reference, over {args.seeds} seeds; times are '
           f'the medians of those renders\n')

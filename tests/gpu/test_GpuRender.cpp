@@ -248,6 +248,47 @@ TEST(GpuRender, RegenerationMatchesOneThreadAPixel) {
     }
 }
 
+// Adaptive sampling on the GPU: the mask reaches the regeneration kernel, so pixels stop at pass
+// ends with their noise below the threshold, fewer samples are taken, and the image's mean
+// agrees with the CPU's adaptive render.
+TEST(GpuRender, AdaptiveSamplingStopsConvergedPixels) {
+  Scene s;
+  loadBundled("buddha", IntegratorType::Path, &s);
+  s.finalize();
+  Bvh bvh(s);
+  RenderOptions o = quietOptions(64);
+  o.noiseThreshold = 0.05f;
+  o.adaptiveMinSpp = 8;
+  std::vector<float> var;
+  std::vector<int> samples, cpuSamples;
+  o.varianceOut = &var;
+  o.samplesOut = &samples;
+  auto ex = gpu::makeCudaExecutor(s, bvh, kernelSettings(s, o), 0, o.keepsVariance());
+  RenderStats st, cst;
+  Image img = renderPasses(*ex, kRes, kRes, 64, o, &st);
+  ASSERT_EQ(samples.size(), size_t(kRes) * kRes);
+  uint64_t taken = 0;
+  for (size_t i = 0; i < samples.size(); ++i) {
+    taken += uint64_t(samples[i]);
+    EXPECT_TRUE(samples[i] == 8 || samples[i] == 16 || samples[i] == 32 || samples[i] == 64) << samples[i];
+    if (samples[i] == 64) continue;
+    float lum = luminance(img.rgb[3 * i], img.rgb[3 * i + 1], img.rgb[3 * i + 2]);
+    double noise = std::sqrt(double(var[i])) / (1e-4 + std::sqrt(std::max(0.0, double(lum))));
+    EXPECT_LT(noise, 0.05 * 1.001) << "pixel " << i;
+  }
+  EXPECT_EQ(taken, st.pixelSamples);
+  EXPECT_GT(st.pixelsStopped, 0u);
+  EXPECT_LT(taken, uint64_t(kRes) * kRes * 64 * 3 / 4);
+  o.varianceOut = nullptr;
+  o.samplesOut = &cpuSamples;
+  Image cpu = renderOnCpu(s, o, &cst);
+  test::ImageAgreement a = test::compareImages(cpu, img);
+  std::printf("adaptive on the GPU: %.1f%% of the samples (CPU %.1f%%), mean ratio to the CPU's %.4f\n",
+              100.0 * double(st.pixelSamples) / (double(kRes) * kRes * 64),
+              100.0 * double(cst.pixelSamples) / (double(kRes) * kRes * 64), a.meanRatio);
+  EXPECT_NEAR(a.meanRatio, 1.0, 0.02);
+}
+
 // Without machine code for the device, every program start spends seconds in the driver's
 // PTX JIT (a build for sm_75 took 7-10 s a start on an H200).
 TEST(GpuRender, BuildHasMachineCodeForTheDevice) {
