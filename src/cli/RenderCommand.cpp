@@ -114,6 +114,9 @@ void runRender(const RenderArgs& a) {
                a.noiseThreshold > 0.f
                    ? fmt::format(", adaptive: noise threshold {:g} from {} spp", a.noiseThreshold, a.minSpp)
                    : "");
+  if (a.noiseThreshold > 0.f && a.minSpp >= requestedSpp)
+    spdlog::warn("--min-spp {} is not below the {} spp asked for: adaptive sampling never checks a pixel", a.minSpp,
+                 requestedSpp);
   Image img;
   if (cuda) {
     Bvh bvh(scene);

@@ -15,7 +15,7 @@ PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const Embre
     case IntegratorType::Path:
     case IntegratorType::Direct: {
       KernelSettings k = kernelSettings(scene, opts);
-      pr.executor = makeCudaExecutor(scene, bvh, k, gpu, opts.varianceOut != nullptr, &bytes);
+      pr.executor = makeCudaExecutor(scene, bvh, k, gpu, opts.keepsVariance(), &bytes);
       pr.spp = k.spp;
       break;
     }
@@ -26,7 +26,7 @@ PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const Embre
     case IntegratorType::Grid: {
       SequenceAndSpp q = gridSequence(scene, opts);
       pr.executor = makeCudaGridExecutor(scene, bvh, gridExecutorSettings(scene, opts), q.sequence, gpu,
-                                         opts.varianceOut != nullptr, &bytes);
+                                         opts.keepsVariance(), &bytes);
       pr.spp = q.spp;
       break;
     }

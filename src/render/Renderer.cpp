@@ -285,6 +285,12 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   if (adaptive && !ex.setActivePixels(active))
     throw std::runtime_error("adaptive sampling (a noise threshold) needs an integrator that samples pixels one by "
                              "one: path, direct, photon or grid, not sppm");
+  if (adaptive) {
+    ex.readFilm(&film);
+    if (film.sumSqLum.size() != px)
+      throw std::logic_error("adaptive sampling: the executor keeps no per-pixel variance (it was made without "
+                             "RenderOptions::keepsVariance())");
+  }
   auto meanImage = [&]() {
     ex.readFilm(&film);
     return filmMean(film, W, H, samples);

@@ -263,9 +263,10 @@ TEST(GpuRender, AdaptiveSamplingStopsConvergedPixels) {
   std::vector<int> samples, cpuSamples;
   o.varianceOut = &var;
   o.samplesOut = &samples;
-  auto ex = gpu::makeCudaExecutor(s, bvh, kernelSettings(s, o), 0, o.keepsVariance());
+  // As `render` makes it (prepareCudaRender), so that the executor keeps the variance it needs.
+  PreparedRender pr = gpu::prepareCudaRender(s, bvh, nullptr, o, 0, nullptr);
   RenderStats st, cst;
-  Image img = renderPasses(*ex, kRes, kRes, 64, o, &st);
+  Image img = renderPasses(*pr.executor, kRes, kRes, 64, o, &st);
   ASSERT_EQ(samples.size(), size_t(kRes) * kRes);
   uint64_t taken = 0;
   for (size_t i = 0; i < samples.size(); ++i) {

@@ -195,3 +195,22 @@ TEST(AdaptiveSampling, SppmRefusesANoiseThreshold) {
     EXPECT_NE(std::string(e.what()).find("not sppm"), std::string::npos) << e.what();
   }
 }
+
+// An executor made without per-pixel variance (RenderOptions::keepsVariance false) cannot
+// judge noise: the loop says so before the first pass instead of after it.
+TEST(AdaptiveSampling, AnExecutorWithoutVarianceIsRefusedBeforeAnyPass) {
+  Scene s;
+  loadSmall("buddha", 16, &s);
+  EmbreeAccel accel(s);
+  RenderOptions o;
+  o.progress = false;
+  o.spp = 4;
+  PreparedRender pr = prepareRender(s, accel, o);
+  o.noiseThreshold = 0.1f;
+  RenderStats st;
+  EXPECT_THROW(renderPasses(*pr.executor, 16, 16, 4, o, &st), std::logic_error);
+  EXPECT_EQ(st.sppDone, 0);
+  PreparedRender ok = prepareRender(s, accel, o);
+  renderPasses(*ok.executor, 16, 16, 4, o, &st);
+  EXPECT_EQ(st.sppDone, 4);
+}
