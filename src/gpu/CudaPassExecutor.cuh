@@ -115,7 +115,7 @@ class CudaPassExecutor final : public PassExecutor {
     check(cudaMemset(counters_, 0, sizeof(c)), "clearing counters");
     counters->rays += c[0];
     counters->dropped += c[1];
-    progress.add(size_t(cam_.width) * cam_.height * size_t(s1 - s0));
+    progress.add(activePixels() * size_t(s1 - s0));
   }
 
   // A new camera of the same size keeps everything on the device (scene, BVH, a grid) and
@@ -127,6 +127,7 @@ class CudaPassExecutor final : public PassExecutor {
     check(cudaMemset(film_.sum, 0, px * sizeof(Color)), "clearing the film");
     if (film_.sumSqLum) check(cudaMemset(film_.sumSqLum, 0, px * sizeof(double)), "clearing the film");
     film_.active = nullptr;
+    activeCount_ = 0;
     return true;
   }
 
@@ -138,6 +139,7 @@ class CudaPassExecutor final : public PassExecutor {
     if (!activeMask_) activeMask_ = scene_->arena.allocate<unsigned char>(px, "adaptive sampling mask");
     check(cudaMemcpy(activeMask_, mask.data(), px, cudaMemcpyHostToDevice), "uploading the adaptive sampling mask");
     film_.active = activeMask_;
+    activeCount_ = mask.size() - size_t(std::count(mask.begin(), mask.end(), (unsigned char)0));
     return true;
   }
 
@@ -160,7 +162,11 @@ class CudaPassExecutor final : public PassExecutor {
   SampleSequence seq_;
   Integrator integ_;
   FilmView film_;
+  // The pixels a pass samples: all of them, or those adaptive sampling leaves on.
+  size_t activePixels() const { return film_.active ? activeCount_ : size_t(cam_.width) * cam_.height; }
+
   unsigned char* activeMask_ = nullptr;     // adaptive sampling's mask on the device, once set
+  size_t activeCount_ = 0;                  // its non-zero entries
   unsigned long long* counters_ = nullptr;  // rays, dropped samples, regeneration's next item
   int regenBlocks_ = 0;  // > 0: passes by path regeneration, this many blocks
 };

@@ -51,16 +51,20 @@ class CpuExecutor final : public PassExecutor {
         for (int t = r.begin(); t < r.end(); ++t) {
           int x0 = (t % tilesX) * tile_, y0 = (t / tilesX) * tile_;
           int x1 = std::min(W, x0 + tile_), y1 = std::min(H, y0 + tile_);
+          // Progress counts the samples taken: the tile's pixels that adaptive sampling left on.
+          size_t pixels = 0;
+          for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x) pixels += fv.takesSamples(size_t(y) * size_t(W) + size_t(x));
           if constexpr (RunsByBounce<Integrator>::value) {
             if (byBounce_) {
               renderTileByBounce(cam_, seq_, integrate_, x0, y0, x1, y1, s0, s1, fv, &batch_.local(), &pc);
-              progress.add(size_t(x1 - x0) * size_t(y1 - y0) * size_t(s1 - s0));
+              progress.add(pixels * size_t(s1 - s0));
               continue;
             }
           }
           for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) renderPixel(cam_, seq_, integrate_, x, y, s0, s1, fv, &pc);
-          progress.add(size_t(x1 - x0) * size_t(y1 - y0) * size_t(s1 - s0));
+          progress.add(pixels * size_t(s1 - s0));
         }
         rays += pc.rays;
         dropped += pc.dropped;

@@ -18,20 +18,33 @@ void Progress::add(size_t n) {
   if (!enabled_) return;
   size_t done = done_.fetch_add(n) + n;
   std::lock_guard<std::mutex> lock(m_);
+  draw(done);
+}
+
+// Under m_.
+void Progress::draw(size_t done) {
   double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   double fraction = double(done) / double(total_);
   if (timeLimit_ > 0.0) fraction = std::max(fraction, std::min(1.0, t / timeLimit_));
-  int pct = int(100.0 * fraction);
+  int pct = int(100.0 * std::min(1.0, fraction));
   if (tty_ ? (t - lastPrint_ < 0.2 && done < total_) : (pct < lastPct_ + 10 && done < total_)) return;
+  if (!tty_ && pct == lastPct_) return;  // the end already drawn
   lastPrint_ = t;
   lastPct_ = pct;
-  double eta = done > 0 ? t * double(total_ - done) / double(done) : 0.0;
+  double eta = done > 0 && done < total_ ? t * double(total_ - done) / double(done) : 0.0;
   if (timeLimit_ > 0.0) eta = std::min(eta, std::max(0.0, timeLimit_ - t));
   int bar = pct / 4;
   std::fprintf(stderr, "%s[%.*s%*s] %3d%%  %.1fs elapsed, %.1fs left%s", tty_ ? "\r" : "", bar,
                "=========================", 25 - bar, "", pct, t, eta, tty_ ? "" : "\n");
   open_ = tty_ && done < total_;
   if (tty_ && done >= total_) std::fprintf(stderr, "\n");
+}
+
+void Progress::shrinkTotal(size_t n) {
+  std::lock_guard<std::mutex> lock(m_);
+  size_t done = done_.load();
+  total_ = std::max<size_t>({total_ > n ? total_ - n : 0, done, 1});
+  if (enabled_ && n > 0) draw(done);  // the bar jumps forward; at the end, its last line
 }
 
 void Progress::finish() {

@@ -14,10 +14,15 @@ class Progress {
   // the work and the time is further along, and the time left is at most the limit's.
   Progress(size_t total, bool enabled, double timeLimit = 0.0);
   void add(size_t n);
+  // Takes n from the work still to do (adaptive sampling: pixels that stopped early), never
+  // below what is done.
+  void shrinkTotal(size_t n);
   // Ends the bar's line when the work stopped short of the total (a time limit, Ctrl-C).
   void finish();
 
  private:
+  void draw(size_t done);
+
   size_t total_;
   bool enabled_, tty_;
   double timeLimit_;

@@ -316,7 +316,9 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     if (adaptive && sppDone >= opts.adaptiveMinSpp && sppDone < spp) {
       ex.readFilm(&film);
       if (film.sumSqLum.size() != px) throw std::runtime_error("this executor kept no per-pixel variance");
+      size_t before = activeCount;
       activeCount = updateActivePixels(film.sum, film.sumSqLum, samples, W, H, opts.noiseThreshold, 1, &active);
+      progress.shrinkTotal((before - activeCount) * size_t(spp - sppDone));
       spdlog::debug("adaptive sampling: {} of {} pixels still sampling after {} spp", activeCount, px, sppDone);
       if (activeCount == 0) break;  // every pixel has converged: the render is done
       ex.setActivePixels(active);

@@ -156,6 +156,14 @@ TEST(CliRender, NoiseThresholdStopsConvergedPixelsAndMapsTheirSamples) {
   EXPECT_GT(atMin, 0) << "the map's background converges at once";
   EXPECT_GT(atAll, 0) << "the glossy sphere does not";
   EXPECT_TRUE(fs::exists(out));
+  // With the progress log on, the bar counts the samples taken and still ends at 100%.
+  CliResult withBar = runCli("render " + scene + " -o " + out + " --noise-threshold 0.05 --min-spp 8");
+  ASSERT_EQ(withBar.code, 0) << withBar.output;
+  std::istringstream lines(withBar.output);
+  std::string line, lastBar;
+  while (std::getline(lines, line))
+    if (line.find("elapsed") != std::string::npos) lastBar = line;
+  EXPECT_NE(lastBar.find("] 100%"), std::string::npos) << withBar.output;
   // Bad values stop before anything is written.
   for (const std::string& bad : std::vector<std::string>{"--noise-threshold -1", "--noise-threshold nan", "--min-spp 1",
                           "--noise-threshold 0.1 --sample-map " + d.file("m.txt"),
