@@ -148,6 +148,9 @@ void runRender(const RenderArgs& a) {
       map.rgb[3 * i] = map.rgb[3 * i + 1] = map.rgb[3 * i + 2] = float(samples[i]) / float(requestedSpp);
     saveImage(map, a.sampleMap, SaveOptions{});
   }
+  if (st.converged)
+    spdlog::info("adaptive sampling: every pixel met the noise threshold after {} of {} spp", st.sppDone,
+                 requestedSpp);
   if (a.noiseThreshold > 0.f) {
     double full = double(scene.camera.width) * scene.camera.height * st.sppDone;
     spdlog::info("adaptive sampling: {:.3g} samples, {:.1f}% of {} spp everywhere; {:.1f}% of the pixels stopped early",

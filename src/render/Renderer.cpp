@@ -339,7 +339,8 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     stats->cancelled = cancelled;
     stats->timeLimited = timeLimited;
     stats->pixelSamples = pixelSamples;
-    stats->pixelsStopped = size_t(std::count_if(samples.begin(), samples.end(), [&](int n) { return n < sppDone; }));
+    stats->pixelsStopped = adaptive ? size_t(std::count(active.begin(), active.end(), (unsigned char)0)) : 0;
+    stats->converged = adaptive && activeCount == 0;
   }
   if (opts.varianceOut && sppDone > 0) {
     if (film.sumSqLum.empty()) throw std::runtime_error("this executor kept no per-pixel variance");

@@ -60,7 +60,8 @@ struct RenderStats {
   bool cancelled = false;
   bool timeLimited = false;  // stopped by timeLimitSeconds before the requested samples
   uint64_t pixelSamples = 0;  // samples taken over all pixels (fewer than pixels x sppDone when adaptive)
-  size_t pixelsStopped = 0;   // pixels that adaptive sampling stopped before sppDone
+  size_t pixelsStopped = 0;   // pixels that adaptive sampling stopped before the samples asked for
+  bool converged = false;     // adaptive sampling stopped every pixel: the render ended early
   double raysPerSecond() const { return seconds > 0.0 ? double(rays) / seconds : 0.0; }
 };
 

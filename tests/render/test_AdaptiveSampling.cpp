@@ -214,3 +214,31 @@ TEST(AdaptiveSampling, AnExecutorWithoutVarianceIsRefusedBeforeAnyPass) {
   renderPasses(*ok.executor, 16, 16, 4, o, &st);
   EXPECT_EQ(st.sppDone, 4);
 }
+
+// A threshold every pixel meets at once ends the render after --min-spp samples: the image is
+// then a plain 64-spp render's after its first 4 samples (its checkpoint), to the bit, and the
+// stats say it converged.
+TEST(AdaptiveSampling, WhenEveryPixelConvergesTheRenderEndsEarly) {
+  Scene s;
+  loadSmall("buddha", 16, &s);
+  EmbreeAccel accel(s);
+  Rendered early = renderWith(s, accel, 64, 1e6f, 4);
+  RenderOptions o;
+  o.progress = false;
+  o.spp = 64;
+  o.checkpointSeconds = 1e-12;  // every pass
+  Image afterFour;
+  o.checkpoint = [&](const Image& img, int done) {
+    if (done == 4) afterFour = img;
+  };
+  RenderStats st;
+  render(s, accel, o, &st);
+  Rendered plain{afterFour, {}, {}, st};
+  EXPECT_TRUE(early.stats.converged);
+  EXPECT_FALSE(plain.stats.converged);
+  EXPECT_EQ(early.stats.sppDone, 4);
+  EXPECT_EQ(early.stats.pixelsStopped, 16u * 16u);
+  EXPECT_EQ(early.stats.pixelSamples, uint64_t(16 * 16 * 4));
+  ASSERT_EQ(early.img.rgb.size(), plain.img.rgb.size());
+  EXPECT_EQ(0, std::memcmp(early.img.rgb.data(), plain.img.rgb.data(), plain.img.rgb.size() * sizeof(float)));
+}
