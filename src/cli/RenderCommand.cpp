@@ -50,14 +50,15 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
 
 void runRender(const RenderArgs& a) {
   namespace fs = std::filesystem;
-  std::string ext = fs::path(a.output).extension().string();
-  if (ext != ".exr" && ext != ".pfm" && ext != ".hdr" && ext != ".png")
-    throw std::runtime_error("output '" + a.output + "' must end in .exr, .pfm, .hdr or .png");
-  if (!a.sampleMap.empty()) {
-    std::string me = fs::path(a.sampleMap).extension().string();
-    if (me != ".exr" && me != ".pfm" && me != ".hdr" && me != ".png")
-      throw std::runtime_error("--sample-map '" + a.sampleMap + "' must end in .exr, .pfm, .hdr or .png");
-  }
+  // Both images are checked before the render, so a bad name cannot cost its samples.
+  auto requireImageName = [](const std::string& path, const std::string& what) {
+    std::string e = fs::path(path).extension().string();
+    if (e != ".exr" && e != ".pfm" && e != ".hdr" && e != ".png")
+      throw std::runtime_error(what + " '" + path + "' must end in .exr, .pfm, .hdr or .png");
+    return e;
+  };
+  std::string ext = requireImageName(a.output, "output");
+  if (!a.sampleMap.empty()) requireImageName(a.sampleMap, "--sample-map");
   auto t0 = std::chrono::steady_clock::now();
   Scene scene;
   loadScene(a.scene, parseDefines(a.defines), scene);

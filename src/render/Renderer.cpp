@@ -232,11 +232,14 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
   return k;
 }
 
-Image filmMean(const FilmSums& film, int width, int height, int samples) {
+namespace {
+
+// The film's first n pixels, each divided by its count samplesOf(i) (at least 1).
+template <class Samples>
+Image meanOfFilm(const FilmSums& film, int width, int height, size_t n, Samples samplesOf) {
   Image img(width, height);
-  size_t n = std::min(film.sum.size(), size_t(width) * size_t(height));
   for (size_t i = 0; i < n; ++i) {
-    Color c = film.sum[i] / float(std::max(samples, 1));
+    Color c = film.sum[i] / float(std::max(samplesOf(i), 1));
     img.rgb[3 * i] = c.x;
     img.rgb[3 * i + 1] = c.y;
     img.rgb[3 * i + 2] = c.z;
@@ -244,16 +247,16 @@ Image filmMean(const FilmSums& film, int width, int height, int samples) {
   return img;
 }
 
+}  // namespace
+
+Image filmMean(const FilmSums& film, int width, int height, int samples) {
+  return meanOfFilm(film, width, height, std::min(film.sum.size(), size_t(width) * size_t(height)),
+                    [samples](size_t) { return samples; });
+}
+
 Image filmMean(const FilmSums& film, int width, int height, const std::vector<int>& samples) {
-  Image img(width, height);
-  size_t n = std::min({film.sum.size(), samples.size(), size_t(width) * size_t(height)});
-  for (size_t i = 0; i < n; ++i) {
-    Color c = film.sum[i] / float(std::max(samples[i], 1));
-    img.rgb[3 * i] = c.x;
-    img.rgb[3 * i + 1] = c.y;
-    img.rgb[3 * i + 2] = c.z;
-  }
-  return img;
+  return meanOfFilm(film, width, height, std::min({film.sum.size(), samples.size(), size_t(width) * size_t(height)}),
+                    [&samples](size_t i) { return samples[i]; });
 }
 
 Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts, RenderStats* stats) {
@@ -314,8 +317,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     pixelSamples += uint64_t(activeCount) * uint64_t(s1 - s0);
     sppDone = s1;
     if (adaptive && sppDone >= opts.adaptiveMinSpp && sppDone < spp) {
-      ex.readFilm(&film);
-      if (film.sumSqLum.size() != px) throw std::runtime_error("this executor kept no per-pixel variance");
+      ex.readFilm(&film);  // with its variance: checked before the first pass
       size_t before = activeCount;
       activeCount = updateActivePixels(film.sum, film.sumSqLum, samples, W, H, opts.noiseThreshold, 1, &active);
       progress.shrinkTotal((before - activeCount) * size_t(spp - sppDone));

@@ -12,6 +12,7 @@
 #include "render/AdaptiveSampling.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
+#include "support/BundledScene.h"
 #include "support/ImageAgreement.h"
 
 using namespace envgi;
@@ -30,11 +31,9 @@ struct PixelSums {
   }
 };
 
-// A bundled scene at res x res (not yet finalized).
+// A bundled scene at res x res with the path integrator, finalized.
 void loadSmall(const std::string& name, int res, Scene* s) {
-  loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/" + name + ".xml", {{"res", std::to_string(res)}}, *s);
-  s->camera.width = s->camera.height = res;
-  s->integrator.type = IntegratorType::Path;
+  test::loadBundledSmall(name, res, IntegratorType::Path, s);
   s->finalize();
 }
 

@@ -7,6 +7,7 @@
 #include "scene/SceneLoader.h"
 #include "support/RegionZTest.h"
 #include "support/ChiSquare.h"
+#include "support/BundledScene.h"
 #include "support/ImageAgreement.h"
 #include "support/TestScenes.h"
 #include "scene/NameTables.h"
@@ -35,11 +36,7 @@ Result run(const Scene& s, CpuTracer tracer, int spp) {
 }
 
 // A bundled scene at 32^2 with the given integrator (not yet finalized).
-void loadSmall(const std::string& name, IntegratorType type, Scene* s) {
-  loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/" + name + ".xml", {{"res", "32"}}, *s);
-  s->camera.width = s->camera.height = 32;
-  s->integrator.type = type;
-}
+void loadSmall(const std::string& name, IntegratorType type, Scene* s) { test::loadBundledSmall(name, 32, type, s); }
 
 // The same seed rendered with Embree and with the GPU's BVH, all passes done in both.
 test::ImageAgreement embreeAgainstBvh(const Scene& s, int spp) {
