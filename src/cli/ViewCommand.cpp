@@ -15,7 +15,8 @@ namespace envgi::cli {
 namespace {
 struct ViewArgs {
   std::string scene, host = "127.0.0.1", integrator, strategy, device = "auto";
-  int port = 8000, threads = 0, maxSpp = 4096, gpu = 0;
+  int port = 8000, threads = 0, maxSpp = 4096, gpu = 0, minSpp = 16;
+  float noiseThreshold = 0.f;
   std::vector<std::string> defines;
 };
 
@@ -35,6 +36,8 @@ void runView(const ViewArgs& a) {
   ViewOptions vo;
   vo.threads = a.threads;
   vo.maxSpp = a.maxSpp;
+  vo.noiseThreshold = a.noiseThreshold;
+  vo.adaptiveMinSpp = a.minSpp;
   if (chooseCuda(a.device)) {
     vo.prepare = gpu::cudaPreparer(a.gpu);
     spdlog::info("view: rendering on {}", gpu::deviceName(a.gpu));
@@ -65,6 +68,13 @@ void addViewCommand(CLI::App& app) {
   c->add_option("--strategy", a->strategy, "Environment strategy: " + strategyNameList());
   c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(atLeast(0));
   c->add_option("--max-spp", a->maxSpp, "Stop refining at this many samples per pixel")->check(atLeast(1));
+  c->add_option("--noise-threshold", a->noiseThreshold,
+                "Adaptive sampling, as in render: a pixel stops refining once it and its neighbours are below this "
+                "noise (0: off; the page can change it)")
+      ->check(CLI::Range(0.0, 10.0))
+      ->check(finiteNumber());
+  c->add_option("--min-spp", a->minSpp, "Adaptive sampling: samples every pixel takes before it may stop (default 16)")
+      ->check(atLeast(2));
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
   c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
   c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(atLeast(0));

@@ -101,7 +101,7 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
     server_.client = shared_from_this();
     spdlog::info("view: a page connected");
     send(server_.session.hello(), false);
-    server_.session.requestFrame();
+    server_.session.pageConnected();
     read();
   }
 

@@ -10,6 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "render/AdaptiveSampling.h"
 #include "scene/NameTables.h"
 
 namespace envgi {
@@ -25,11 +26,14 @@ struct ViewSession::State {
   float envRotation = 0.f, envScale = 1.f;  // degrees about +Y on top of the file's placement
   std::string strategy, integrator;
   float resolutionScale = 1.f;
+  float noiseThreshold = 0.f;  // adaptive sampling (AdaptiveSampling.h); 0: off
+  int minSpp = 16;
   int sceneVersion = 0;  // bumped by what every executor depends on (environment, strategy)
   bool restart = true;   // the camera or resolution changed: an empty film
   bool rebuild = true;   // the integrator, strategy or environment changed: a new executor
   bool toneChanged = false;
   bool frameRequested = true;
+  bool resend = false;  // a new page: send the film as it is, even if the last page had it
 };
 
 namespace {
@@ -46,6 +50,17 @@ Vec3f vec3(const json& j, const char* key) {
   return Vec3f(finiteFloat(v[0], key), finiteFloat(v[1], key), finiteFloat(v[2], key));
 }
 json arr(Vec3f v) { return json::array({v.x, v.y, v.z}); }
+// Whether an executor keeps the per-pixel variance that adaptive sampling reads.
+bool keepsVariance(PassExecutor& ex) {
+  FilmSums film;
+  ex.readFilm(&film);
+  return !film.sumSqLum.empty() && film.sumSqLum.size() == film.sum.size();
+}
+double meanOf(const std::vector<int>& v) {
+  double sum = 0.0;
+  for (int n : v) sum += n;
+  return v.empty() ? 0.0 : sum / double(v.size());
+}
 float number(const json& j, const char* key, float lo, float hi) {
   double v = j.at(key).get<double>();
   if (!(v >= lo && v <= hi)) throw std::runtime_error(fmt::format("'{}' must be in [{}, {}]", key, lo, hi));
@@ -68,6 +83,8 @@ ViewSession::ViewSession(std::unique_ptr<Scene> scene, std::string scenePath, Vi
   s.up = normalize(t.vector(Vec3f(0.f, 1.f, 0.f)));
   s.strategy = scene_->integrator.env.strategy;
   s.integrator = integratorName(scene_->integrator.type);
+  s.noiseThreshold = opts_.noiseThreshold;
+  s.minSpp = opts_.adaptiveMinSpp;
 }
 
 ViewSession::~ViewSession() { stop(); }
@@ -102,6 +119,8 @@ std::string ViewSession::hello() const {
             {"strategies", strategies},
             {"integrator", s.integrator},
             {"strategy", s.strategy},
+            {"noiseThreshold", s.noiseThreshold},
+            {"minSpp", s.minSpp},
             {"hasEnvironment", scene_->env != nullptr}};
   return j.dump();
 }
@@ -112,7 +131,7 @@ std::string ViewSession::handle(const std::string& message) {
     throw std::runtime_error("malformed message (not a JSON object with a 'type')");
   std::string type = j["type"];
   static const char* known[] = {"next", "save", "camera", "exposure", "tonemap", "environment", "strategy",
-                                "integrator", "resolution"};
+                                "integrator", "resolution", "adaptive"};
   if (std::find(std::begin(known), std::end(known), type) == std::end(known))
     throw std::runtime_error("unknown message type '" + type + "'");
   try {
@@ -161,6 +180,16 @@ std::string ViewSession::handle(const std::string& message) {
     } else if (type == "resolution") {
       next.resolutionScale = number(j, "scale", 0.1f, 2.f);
       next.restart = true;
+    } else if (type == "adaptive") {
+      // Stopping is final, so a new threshold starts the film over rather than reviving pixels.
+      next.noiseThreshold = number(j, "threshold", 0.f, 10.f);
+      if (j.contains("minSpp")) {
+        const json& v = j["minSpp"];
+        if (!v.is_number_integer() || v.get<int64_t>() < 2 || v.get<int64_t>() > 1000000)
+          throw std::runtime_error("'minSpp' must be an integer in [2, 1000000]");
+        next.minSpp = int(v.get<int64_t>());
+      }
+      next.restart = true;
     }
     *state_ = next;
   } catch (const json::exception& e) {
@@ -171,6 +200,15 @@ std::string ViewSession::handle(const std::string& message) {
   }
   wake_.notify_all();
   return "";
+}
+
+void ViewSession::pageConnected() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    state_->frameRequested = true;
+    state_->resend = true;
+  }
+  wake_.notify_all();
 }
 
 void ViewSession::requestFrame() {
@@ -225,14 +263,21 @@ void ViewSession::run() {
   PassCounters counters;
   Progress quiet(1, false);
   State s;
-  auto limit = [&] { return pr.executor ? std::min(opts_.maxSpp, pr.spp) : 0; };
+  // Adaptive sampling, as renderPasses does it: each pixel's samples and the mask of those
+  // still sampling; off for an executor that cannot mask pixels (SPPM).
+  bool adaptive = false, converged = false;
+  std::vector<int> samples;
+  std::vector<unsigned char> active;
+  size_t activeCount = 0;
+  auto limit = [&] { return pr.executor && !converged ? std::min(opts_.maxSpp, pr.spp) : 0; };
   while (!stop_) {
     bool restart = false, rebuild = false, send = false;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       wake_.wait(lock, [&] {
         const State& st = *state_;
-        return stop_ || st.restart || st.rebuild || (st.frameRequested && (st.toneChanged || spp != sentSpp)) ||
+        return stop_ || st.restart || st.rebuild ||
+               (st.frameRequested && (st.toneChanged || st.resend || spp != sentSpp)) ||
                spp < limit();
       });
       if (stop_) break;
@@ -267,11 +312,17 @@ void ViewSession::run() {
           if (it != parked.end()) parked.erase(it);
           prIntegrator = s.integrator;
         }
+        // An executor made while adaptive sampling was off keeps no variance: make it anew
+        // (not SPPM's, which samples every pixel every pass and never keeps it).
+        if (pr.executor && s.noiseThreshold > 0.f && scene_->integrator.type != IntegratorType::Sppm &&
+            !keepsVariance(*pr.executor))
+          pr = PreparedRender{};
         if (!pr.executor || !pr.executor->restart(scene_->view().camera)) {
           RenderOptions ro;
           ro.progress = false;
           ro.threads = opts_.threads;
           ro.spp = opts_.maxSpp;
+          ro.noiseThreshold = s.noiseThreshold;
           auto tp = Clock::now();
           pr = PreparedRender{};  // free the old executor's maps first
           pr = opts_.prepare ? opts_.prepare(*scene_, *accel_, ro) : prepareRender(*scene_, *accel_, ro);
@@ -288,17 +339,36 @@ void ViewSession::run() {
       spp = 0;
       sentSpp = -1;
       t0 = Clock::now();
+      const size_t px = size_t(scene_->camera.width) * size_t(scene_->camera.height);
+      samples.assign(px, 0);
+      active.assign(px, 1);
+      activeCount = px;
+      converged = false;
+      adaptive = pr.executor && s.noiseThreshold > 0.f && pr.executor->setActivePixels(active);
     }
     if (spp < limit()) {
       pr.executor->runPass(spp, spp + 1, quiet, &counters);
       ++spp;
+      if (adaptive) {
+        for (size_t i = 0; i < samples.size(); ++i) samples[i] += active[i];
+        // Every 4 passes from the minimum on: each check reads the film back (from a GPU too).
+        if (spp >= s.minSpp && (spp - s.minSpp) % 4 == 0 && spp < limit()) {
+          FilmSums film;
+          pr.executor->readFilm(&film);
+          activeCount = updateActivePixels(film.sum, film.sumSqLum, samples, scene_->camera.width,
+                                           scene_->camera.height, s.noiseThreshold, 1, &active);
+          converged = activeCount == 0;
+          if (!converged) pr.executor->setActivePixels(active);
+        }
+      }
     }
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      send = pr.executor && state_->frameRequested && (state_->toneChanged || spp != sentSpp);
+      send = pr.executor && state_->frameRequested && (state_->toneChanged || state_->resend || spp != sentSpp);
       if (send) {
         state_->frameRequested = false;
         state_->toneChanged = false;
+        state_->resend = false;
         // Only the tone settings: a camera or integrator that arrived since is not what this
         // film holds, and the frame must not claim it.
         s.exposure = state_->exposure;
@@ -309,7 +379,7 @@ void ViewSession::run() {
     FilmSums film;
     pr.executor->readFilm(&film);
     const Camera& cam = scene_->view().camera;
-    Image img = filmMean(film, cam.width, cam.height, spp);
+    Image img = adaptive ? filmMean(film, cam.width, cam.height, samples) : filmMean(film, cam.width, cam.height, spp);
     ViewFrame f = makeFrame(img, s);
     auto now = Clock::now();
     double seconds = std::chrono::duration<double>(now - t0).count();
@@ -327,6 +397,11 @@ void ViewSession::run() {
                   {"cameraVersion", s.cameraVersion},
                   {"integrator", s.integrator},
                   {"strategy", s.strategy},
+                  {"adaptive", adaptive},
+                  {"noiseThreshold", s.noiseThreshold},
+                  {"sampling", adaptive ? double(activeCount) / double(std::max<size_t>(1, active.size())) : 1.0},
+                  {"converged", converged},
+                  {"meanSpp", adaptive ? meanOf(samples) : double(spp)},
                   {"bytes", f.jpeg.size()}}
                  .dump();
     {

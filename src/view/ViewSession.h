@@ -1,6 +1,6 @@
 // What `envgi view` renders: one scene, progressively, on a worker thread, steered by the
 // page's messages (camera, exposure, tone curve, environment, strategy, integrator,
-// resolution, save). Frames go out tone-mapped as JPEG, at most one in flight: the page asks
+// resolution, noise threshold, save). Frames go out tone-mapped as JPEG, at most one in flight: the page asks
 // for the next when it has shown the last, so a slow link never backs up the renderer.
 #pragma once
 
@@ -30,6 +30,10 @@ struct ViewOptions {
   std::function<PreparedRender(const Scene&, const EmbreeAccel&, const RenderOptions&)> prepare;
   int threads = 0;
   int maxSpp = 4096;  // stop refining here
+  // Adaptive sampling at start (the page can change it): a pixel stops refining once it and its
+  // neighbours are below this noise (AdaptiveSampling.h); 0: off.
+  float noiseThreshold = 0.f;
+  int adaptiveMinSpp = 16;
   int jpegQuality = 85;
 };
 
@@ -52,6 +56,9 @@ class ViewSession {
   std::string handle(const std::string& message);
   // The page showed the last frame and wants the next.
   void requestFrame();
+  // A page connected: it gets the current frame, even when the render has finished (its
+  // samples or adaptive sampling's threshold reached) and an earlier page had that frame.
+  void pageConnected();
 
   int framesSent() const { return framesSent_.load(); }
   // How many executors were made (photon maps, grids...): switching back to an integrator

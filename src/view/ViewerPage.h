@@ -40,6 +40,7 @@ inline constexpr const char* kViewerPage = R"envgipage(<!doctype html>
   <label>Environment scale <input id="envScale" type="number" min="0" step="0.1" value="1"></label>
   <label>Resolution <select id="resolution">
     <option value="0.25">25%</option><option value="0.5">50%</option><option value="1" selected>100%</option><option value="2">200%</option></select></label>
+  <label>Noise threshold (0: off) <input id="noiseThreshold" type="number" min="0" max="10" step="0.005" value="0"></label>
   <button id="save">Save EXR</button>
   <div id="stats">connecting...</div>
   <div id="message"></div>
@@ -138,6 +139,10 @@ const sendEnv = () => send({ type: "environment", rotation: parseFloat($("rotati
 $("rotation").addEventListener("input", e => { $("rotationValue").textContent = e.target.value; sendEnv(); });
 $("envScale").addEventListener("change", sendEnv);
 $("resolution").addEventListener("change", e => send({ type: "resolution", scale: parseFloat(e.target.value) }));
+$("noiseThreshold").addEventListener("change", e => {
+  const v = parseFloat(e.target.value);
+  if (v >= 0 && v <= 10) send({ type: "adaptive", threshold: v }); else showMessage("noise threshold: 0 to 10");
+});
 $("save").addEventListener("click", () => send({ type: "save" }));
 
 function fill(select, names, current) {
@@ -154,6 +159,7 @@ function onText(m) {
     fill($("integrator"), m.integrators, m.integrator);
     fill($("strategy"), m.strategies, m.strategy);
     for (const id of ["rotation", "envScale"]) $(id).disabled = !m.hasEnvironment;
+    $("noiseThreshold").value = m.noiseThreshold;
   } else if (m.type === "frame") {
     pendingMeta = m;
   } else if (m.type === "saved") {
@@ -185,6 +191,9 @@ function onFrame(buffer) {
       $("stats").textContent =
         `frame   ${m.frame}\nspp     ${m.spp}\ntime    ${m.seconds.toFixed(2)} s\nfps     ${m.fps.toFixed(1)}\n` +
         `size    ${m.width}x${m.height}\n${m.integrator} / ${m.strategy}\n` +
+        (m.adaptive ? `adaptive ${m.converged ? "converged" : (100 * m.sampling).toFixed(0) + "% sampling"}\n` +
+                      `mean spp ${m.meanSpp.toFixed(1)}\n` :
+         m.noiseThreshold > 0 ? `adaptive n/a (${m.integrator})\n` : "") +
         `move->frame ${T.latencyMs === null ? "-" : T.latencyMs.toFixed(0) + " ms"}`;
     }
     send({ type: "next" });

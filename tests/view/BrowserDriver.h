@@ -117,9 +117,15 @@ class WsConnection {
   }
   // The next message (text or binary), or throws after `seconds`.
   std::string read(double seconds, bool* binary = nullptr) {
+    // The stream's expiry bounds only asynchronous operations: a synchronous read would wait
+    // for ever on a server that sends nothing.
     beast::get_lowest_layer(ws_).expires_after(std::chrono::milliseconds(int(seconds * 1000)));
     beast::flat_buffer buf;
-    ws_.read(buf);
+    beast::error_code ec;
+    ws_.async_read(buf, [&ec](beast::error_code e, std::size_t) { ec = e; });
+    ioc_.restart();
+    ioc_.run();
+    if (ec) throw beast::system_error(ec);
     if (binary) *binary = ws_.got_binary();
     return beast::buffers_to_string(buf.data());
   }

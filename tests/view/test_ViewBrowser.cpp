@@ -103,6 +103,17 @@ TEST(ViewBrowser, OrbitExposureSaveInHeadlessChromium) {
   EXPECT_EQ(img.width, 96);
   EXPECT_EQ(img.height, 64);
 
+  // A noise threshold from the page: adaptive sampling stops the converged pixels (the mean
+  // samples a pixel fall below the passes run), and the panel says how many still sample.
+  page.eval("(() => { const e = document.getElementById('noiseThreshold'); e.value = '0.1';"
+            " e.dispatchEvent(new Event('change')); })()");
+  ASSERT_TRUE(page.waitFor("envgiTest.lastMeta.adaptive === true && (envgiTest.lastMeta.converged ||"
+                           " envgiTest.lastMeta.spp === 256)", 60))
+      << page.eval("JSON.stringify(envgiTest.lastMeta)").dump() << view.log();
+  EXPECT_LT(page.eval("envgiTest.lastMeta.meanSpp").get<double>(), 0.5 * 256);
+  EXPECT_NE(page.eval("document.getElementById('stats').textContent").get<std::string>().find("adaptive"),
+            std::string::npos);
+
   // A second page is refused; the first keeps its frames.
   {
     WsConnection second(port, "/ws");
@@ -180,7 +191,8 @@ TEST(ViewBrowser, WiderBindingRequiresTheToken) {
 TEST(ViewBrowser, BadArgumentsAreOneErrorLine) {
   TempDir d;
   std::string scene = writeScene(d);
-  for (std::string bad : {"--host not-an-address", "--integrator bdpt", "--strategy magic", "--port 70000", "--device tpu"}) {
+  for (std::string bad : {"--host not-an-address", "--integrator bdpt", "--strategy magic", "--port 70000", "--device tpu",
+                          "--noise-threshold -1", "--noise-threshold nan", "--min-spp 1"}) {
     CliResult r = runCli("view " + scene + " " + bad);
     EXPECT_NE(r.code, 0) << bad;
     EXPECT_NE(r.output.find("error"), std::string::npos) << bad << ": " << r.output;

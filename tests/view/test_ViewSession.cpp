@@ -42,7 +42,7 @@ struct Sink {
   }
 };
 
-std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& sink, ViewOptions vo = {}) {
+std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& sink, ViewOptions vo = {}, int maxSpp = 16) {
   std::string xml = dir + "/ball.xml";
   test::writeBallScene(xml, 24, 16, "");
   auto scene = std::make_unique<Scene>();
@@ -53,10 +53,20 @@ std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& sink, Vie
   grid.resolution = 8;
   grid.gatherRays = 16;
   vo.threads = 1;
-  vo.maxSpp = 16;
+  vo.maxSpp = maxSpp;
   auto s = std::make_unique<ViewSession>(std::move(scene), xml, vo);
   s->start([&sink](ViewFrame f) { sink(std::move(f)); });
   return s;
+}
+
+// The error a message gets, or "" when the session takes it.
+std::string errorOfMessage(ViewSession& session, const std::string& message) {
+  try {
+    session.handle(message);
+  } catch (const std::runtime_error& e) {
+    return e.what();
+  }
+  return "";
 }
 
 }  // namespace
@@ -132,14 +142,7 @@ TEST(ViewSession, BadMessagesAreErrorsAndChangeNothing) {
   test::TempDir d;
   Sink sink;
   auto session = makeSession(d.path.string(), sink);
-  auto errorOf = [&](const std::string& m) -> std::string {
-    try {
-      session->handle(m);
-    } catch (const std::runtime_error& e) {
-      return e.what();
-    }
-    return "";
-  };
+  auto errorOf = [&](const std::string& m) { return errorOfMessage(*session, m); };
   EXPECT_EQ(errorOf("not json"), "malformed message (not a JSON object with a 'type')");
   EXPECT_EQ(errorOf("[1,2]"), "malformed message (not a JSON object with a 'type')");
   EXPECT_EQ(errorOf(R"({"type":"teleport"})"), "unknown message type 'teleport'");
@@ -231,4 +234,119 @@ TEST(ViewSession, ExecutorsComeFromTheInjectedPreparer) {
   }
   EXPECT_EQ(calls->load(), 2);
   EXPECT_EQ(session->preparations(), calls->load());
+}
+
+namespace {
+// Asks for frames until one satisfies pred; null after `tries` frames without one.
+template <class Pred>
+json frameWhere(ViewSession& session, Sink& sink, Pred pred, int tries = 400) {
+  for (int i = 0; i < tries; ++i) {
+    size_t n;
+    {
+      std::lock_guard<std::mutex> l(sink.m);
+      n = sink.frames.size();
+    }
+    session.requestFrame();
+    json f = sink.waitFor(n);
+    if (f.is_null()) return f;
+    if (pred(f)) return f;
+  }
+  ADD_FAILURE() << "no such frame in " << tries;
+  return json{};
+}
+double meanOfImage(const Image& img) {
+  double s = 0.0;
+  for (float v : img.rgb) s += v;
+  return s / double(std::max<size_t>(1, img.rgb.size()));
+}
+}  // namespace
+
+// A noise threshold (from the command line, then from the page) stops refining the pixels
+// that converged; the image divides each pixel by its own samples, so it agrees with a full
+// render; a new threshold starts over; SPPM, which cannot mask pixels, ignores it.
+TEST(ViewSession, AdaptiveSamplingStopsRefiningConvergedPixels) {
+  test::TempDir d;
+  Sink sink;
+  ViewOptions vo;
+  vo.noiseThreshold = 0.1f;
+  vo.adaptiveMinSpp = 4;
+  auto session = makeSession(d.path.string(), sink, vo, 256);
+  json hello = json::parse(session->hello());
+  EXPECT_FLOAT_EQ(hello["noiseThreshold"].get<float>(), 0.1f);
+  EXPECT_EQ(hello["minSpp"], 4);
+
+  json done = frameWhere(*session, sink, [](const json& f) { return f["converged"] == true; });
+  ASSERT_FALSE(done.is_null());
+  EXPECT_TRUE(done["adaptive"].get<bool>());
+  EXPECT_EQ(done["sampling"].get<double>(), 0.0);
+  EXPECT_LT(done["spp"].get<int>(), 256) << "every pixel converged before the viewer's limit";
+  EXPECT_GE(done["spp"].get<int>(), 4);
+  EXPECT_LE(done["meanSpp"].get<double>(), done["spp"].get<double>());
+  Image early = loadImage(json::parse(session->handle(R"({"type":"save"})"))["path"]);
+  // Converged: no more passes, so no more frames however often the page asks.
+  size_t sent = size_t(session->framesSent());
+  session->requestFrame();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(size_t(session->framesSent()), sent);
+
+  // Threshold 0 from the page: adaptive sampling off, the film starts over and runs to 256.
+  EXPECT_EQ(session->handle(R"({"type":"adaptive","threshold":0})"), "");
+  json full = frameWhere(*session, sink, [](const json& f) { return f["spp"] == 256 && f["adaptive"] == false; });
+  ASSERT_FALSE(full.is_null());
+  EXPECT_EQ(full["meanSpp"].get<double>(), 256.0);
+  EXPECT_FALSE(full["converged"].get<bool>());
+  Image ref = loadImage(json::parse(session->handle(R"({"type":"save"})"))["path"]);
+  ASSERT_EQ(early.rgb.size(), ref.rgb.size());
+  EXPECT_NEAR(meanOfImage(early), meanOfImage(ref), 0.05 * meanOfImage(ref))
+      << "each stopped pixel is divided by its own samples";
+
+  // Back on, with the minimum from the page; the new film samples from scratch.
+  session->handle(R"({"type":"adaptive","threshold":0.1,"minSpp":8})");
+  json again = frameWhere(*session, sink, [](const json& f) { return f["converged"] == true; });
+  ASSERT_FALSE(again.is_null());
+  EXPECT_GE(again["spp"].get<int>(), 8);
+  EXPECT_GE(again["meanSpp"].get<double>(), 8.0) << "every pixel takes the minimum before it may stop";
+  EXPECT_LT(again["meanSpp"].get<double>(), again["spp"].get<double>()) << "some pixels stopped before others";
+
+  // SPPM samples every pixel each pass: the threshold is kept but not applied.
+  session->handle(R"({"type":"integrator","value":"sppm"})");
+  json sppm = frameWhere(*session, sink, [](const json& f) { return f["integrator"] == "sppm"; });
+  ASSERT_FALSE(sppm.is_null());
+  EXPECT_FALSE(sppm["adaptive"].get<bool>());
+  EXPECT_GT(sppm["noiseThreshold"].get<double>(), 0.0);
+  EXPECT_EQ(sppm["sampling"].get<double>(), 1.0);
+}
+
+TEST(ViewSession, BadAdaptiveMessagesAreErrors) {
+  test::TempDir d;
+  Sink sink;
+  auto session = makeSession(d.path.string(), sink);
+  auto errorOf = [&](const std::string& m) { return errorOfMessage(*session, m); };
+  EXPECT_EQ(errorOf(R"({"type":"adaptive","threshold":-0.1})"), "adaptive: 'threshold' must be in [0, 10]");
+  EXPECT_EQ(errorOf(R"({"type":"adaptive","threshold":0.1,"minSpp":1})"),
+            "adaptive: 'minSpp' must be an integer in [2, 1000000]");
+  EXPECT_EQ(errorOf(R"({"type":"adaptive","threshold":0.1,"minSpp":2.5})"),
+            "adaptive: 'minSpp' must be an integer in [2, 1000000]");
+  EXPECT_NE(errorOf(R"({"type":"adaptive"})").find("adaptive: "), std::string::npos);
+  json hello = json::parse(session->hello());
+  EXPECT_EQ(hello["noiseThreshold"], 0.0) << "a refused message changes nothing";
+  EXPECT_EQ(hello["minSpp"], 16);
+}
+
+// A page that connects after the render has finished still gets the frame: the film is done,
+// so only pageConnected (not a plain request) sends it again.
+TEST(ViewSession, APageConnectingAfterTheLastSampleGetsTheFrame) {
+  test::TempDir d;
+  Sink sink;
+  auto session = makeSession(d.path.string(), sink, {}, 4);
+  json last = frameWhere(*session, sink, [](const json& f) { return f["spp"] == 4; });
+  ASSERT_FALSE(last.is_null());
+  size_t sent = size_t(session->framesSent());
+  session->requestFrame();
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  EXPECT_EQ(size_t(session->framesSent()), sent) << "nothing new to send";
+  session->pageConnected();
+  json again = sink.waitFor(sent);
+  ASSERT_FALSE(again.is_null());
+  EXPECT_EQ(again["spp"], 4);
 }
