@@ -47,7 +47,32 @@ EnvironmentMap EnvironmentMap::load(const std::string& path, const EnvironmentMa
   if (img.width != 2 * img.height)
     spdlog::warn("environment map '{}' is {}x{}, not 2:1; it is still read as lat-long{}", path, img.width, img.height,
                  img.width == img.height ? " (a light probe? the envmap's 'layout' reads angular maps, mirror balls and cube crosses)" : "");
-  return EnvironmentMap(std::move(img), opts, path);
+  if (!opts.bilinear) return EnvironmentMap(std::move(img), opts, path);
+  // Invalid texels are zeroed before the rows are blended, so that each counts once and
+  // spreads nothing into its neighbours.
+  size_t invalid = zeroInvalidRadiance(img);
+  if (invalid > 0)
+    spdlog::warn("environment map '{}': {} NaN, infinite or negative channel values replaced with 0", path, invalid);
+  EnvironmentMap map(rowsAtPixelCentres(img), opts, path);
+  map.invalid_ = invalid;
+  return map;
+}
+
+Image EnvironmentMap::rowsAtPixelCentres(const Image& src) {
+  const int w = src.width, h = src.height;
+  if (h < 2) return src;
+  Image out(w, h);
+  // Mitsuba's lookup at each row's centre. (Its average over the row's band, which keeps the
+  // integral over runs of rows, smooths once more on top of envgi's own bilinear lookup: it put
+  // teapot-glass's fireplace region 0.14% off Mitsuba, against 0.11% for point values.)
+  for (int j = 0; j < h; ++j) {
+    // Mitsuba's row coordinate at this row's centre: in [0.5 (h-1)/h, h - 1), so j0 + 1 < h.
+    double y = (double(j) + 0.5) * double(h - 1) / double(h);
+    int j0 = std::min(int(y), h - 2);
+    float t = float(y - double(j0));
+    for (int x = 0; x < w; ++x) out.set(x, j, src.at(x, j0) * (1.f - t) + src.at(x, j0 + 1) * t);
+  }
+  return out;
 }
 
 EnvironmentMap EnvironmentMap::loadProbe(const std::string& path, ProbeLayout layout, const EnvironmentMapOptions& opts) {

@@ -31,7 +31,9 @@ struct EnvironmentMapStats {
 
 class EnvironmentMap {
  public:
-  // Throws std::runtime_error for an unreadable file or a negative scale.
+  // A lat-long file, read as Mitsuba's envmap reads it: with a bilinear lookup, its rows lie on
+  // a grid from pole to pole (rowsAtPixelCentres). Throws std::runtime_error for an unreadable
+  // file or a negative scale.
   static EnvironmentMap load(const std::string& path, const EnvironmentMapOptions& opts = {});
   // A square light probe (angular map or mirror ball), resampled to a lat-long map at twice its
   // width (probeToLatLong); throws as probeToLatLong and load() do.
@@ -67,6 +69,15 @@ class EnvironmentMap {
   // Fills each light's selection pmf and cdf (by luminance; uniform when all are black).
   void setPoints(std::vector<DirectionalLight> points);
   const std::vector<DirectionalLight>& points() const { return points_; }
+
+  // Mitsuba's envmap puts row j of an H-row map at v = j / (H - 1), on a grid that ends at the
+  // poles, and interpolates linearly between rows; envgi's lookup (and so its sampling tables
+  // and in-pixel warp) puts rows at pixel centres, v = (j + 0.5) / H. This resamples the rows to
+  // pixel centres, each row Mitsuba's lookup at that centre. envgi's lookup then reproduces
+  // Mitsuba's placement, exactly for a map linear in v and within a second linear interpolation
+  // otherwise, and everything built on the lookup stays as it is. Columns need nothing: both
+  // put them at pixel centres.
+  static Image rowsAtPixelCentres(const Image& poleToPole);
 
   // Per-pixel sampling weight: luminance of the lookup's average over the pixel, times sin theta.
   static std::vector<float> samplingWeights(const Image& img, bool bilinear, bool misCompensation);

@@ -474,7 +474,10 @@ class Loader {
     cam.height = getInt(f, p, "height", 576);
     if (cam.width <= 0 || cam.height <= 0 || cam.width > 32768 || cam.height > 32768)
       fail(f, n, "film width and height must be between 1 and 32768");
-    for (const char* harmless : {"pixel_format", "file_format", "component_format", "banner", "high_quality_edges"})
+    // envgi draws each pixel's samples from its filter, so border pixels always see the whole
+    // filter: what sample_border (high_quality_edges in Mitsuba 0.6) turns on in Mitsuba.
+    for (const char* harmless :
+         {"pixel_format", "file_format", "component_format", "banner", "high_quality_edges", "sample_border"})
       find(p, harmless);
     warnUnused(f, p, "film");
     for (pugi::xml_node c : n.children()) {

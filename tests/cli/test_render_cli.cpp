@@ -511,3 +511,23 @@ TEST(CliCompare, ErrorsAgainstAReference) {
   EXPECT_EQ(nanRef.code, 1);
   EXPECT_NE(nanRef.output.find("has 1 NaN or infinite values"), std::string::npos) << nanRef.output;
 }
+
+// Mitsuba's film flag sample_border is what envgi always does (each pixel's samples come from its
+// filter), so a scene that sets it renders with no warning about it.
+TEST(CliRender, FilmSampleBorderIsAccepted) {
+  TempDir d;
+  std::string scene = tinyScene(d, 8, 1);
+  std::string text;
+  {
+    std::ifstream in(scene);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  text.replace(text.find("<film type=\"hdrfilm\">"), std::string("<film type=\"hdrfilm\">").size(),
+               "<film type=\"hdrfilm\"><boolean name=\"sample_border\" value=\"true\"/>");
+  std::ofstream(scene) << text;
+  CliResult r = runCli("render " + scene + " -o " + d.file("out.exr") + " --no-progress");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find("sample_border"), std::string::npos) << r.output;
+}

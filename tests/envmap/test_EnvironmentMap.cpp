@@ -2,6 +2,10 @@
 
 #include <filesystem>
 
+#include <unistd.h>
+
+#include <cmath>
+
 #include "envmap/EnvironmentMap.h"
 
 using namespace envgi;
@@ -131,4 +135,73 @@ TEST(EnvironmentMap, GraceHdrAndPfmAgree) {
   EXPECT_EQ(by, 129);
   EnvironmentMapStats st = b.stats();
   EXPECT_NEAR(st.lumMeanSolidAngle, 0.0147f, 0.0005f);
+}
+
+namespace {
+// A map file in the test's own temporary folder, removed with it.
+struct MapFile {
+  std::filesystem::path path;
+  explicit MapFile(const Image& img, const std::string& name) {
+    path = std::filesystem::temp_directory_path() / ("envgi_rows_" + std::to_string(::getpid()) + "_" + name + ".pfm");
+    saveImage(img, path.string(), SaveOptions{});
+  }
+  ~MapFile() { std::filesystem::remove(path); }
+};
+}  // namespace
+
+// A lat-long file is read as Mitsuba reads it: row j at v = j / (H - 1), linear between rows
+// (measured with Mitsuba 3.x's own envmap: a lit row peaks at theta = pi j / (H - 1)). For a map
+// linear in the row, envgi's lookup then equals Mitsuba's everywhere between the first and last
+// pixel centres; the columns stay at pixel centres, as in Mitsuba.
+TEST(EnvironmentMap, LoadedRowsLieOnMitsubasGridFromPoleToPole) {
+  const int w = 16, h = 8;
+  MapFile file(gradientMap(w, h), "gradient");  // red = column, green = row
+  EnvironmentMap env = EnvironmentMap::load(file.path.string());
+  EnvironmentMapView v = env.view();
+  for (float vv = 0.5f / h; vv <= 1.f - 0.5f / h; vv += 0.013f) {
+    Color c = v.lookupUV({(3.f + 0.5f) / w, vv});
+    EXPECT_NEAR(c.y, vv * float(h - 1), 2e-5f) << "v " << vv;  // Mitsuba: y = v (H - 1)
+    EXPECT_NEAR(c.x, 3.f, 1e-5f) << "v " << vv;                // column 3 at its centre
+  }
+  // Built from the image itself, the map keeps pixel centres (probes and tests use that).
+  EnvironmentMap direct(gradientMap(w, h), {});
+  EXPECT_NEAR(direct.view().lookupUV({0.5f, 2.5f / h}).y, 2.f, 1e-5f);
+  // A nearest-texel map has no grid to move.
+  EnvironmentMapOptions nearest;
+  nearest.bilinear = false;
+  EXPECT_EQ(EnvironmentMap::load(file.path.string(), nearest).view().lookupUV({0.5f, 2.5f / h}).y, 2.f);
+}
+
+// The resampled rows are Mitsuba's lookup at the pixel centres, each a blend of two rows with
+// weights summing to 1: a lit row's energy stays, centred where Mitsuba puts it.
+TEST(EnvironmentMap, RowsAtPixelCentresBlendTwoRowsAtMitsubasCoordinate) {
+  const int w = 4, h = 64, lit = 20;
+  Image row(w, h);
+  for (int x = 0; x < w; ++x) row.set(x, lit, Color(1.f));
+  Image out = EnvironmentMap::rowsAtPixelCentres(row);
+  double sum = 0.0, centroid = 0.0;
+  for (int j = 0; j < h; ++j) {
+    double y = (j + 0.5) * (h - 1) / double(h);
+    float expect = float(std::max(0.0, 1.0 - std::fabs(y - lit)));  // Mitsuba's tent about the row
+    EXPECT_NEAR(out.at(1, j).x, expect, 1e-5f) << "row " << j;
+    sum += out.at(1, j).x;
+    centroid += out.at(1, j).x * (j + 0.5) / h;
+  }
+  EXPECT_NEAR(sum, double(h) / (h - 1), 1e-3);  // the tent sampled every (h-1)/h rows, about h/(h-1)
+  EXPECT_NEAR(centroid / sum, double(lit) / (h - 1), 1e-3) << "the row's light sits at theta = pi j / (H - 1)";
+  Image tiny(4, 1);
+  EXPECT_EQ(EnvironmentMap::rowsAtPixelCentres(tiny).height, 1);
+}
+
+// NaN and negative texels of a file are zeroed and counted before the rows blend: the count is
+// the file's, and nothing invalid spreads into the neighbouring rows.
+TEST(EnvironmentMap, InvalidTexelsOfAFileAreZeroedBeforeTheRowsBlend) {
+  Image img = gradientMap(8, 4);
+  img.rgb[0] = NAN;
+  img.rgb[4] = -3.f;
+  img.rgb[8 * 3 + 2] = INFINITY;
+  MapFile file(img, "invalid");
+  EnvironmentMap env = EnvironmentMap::load(file.path.string());
+  EXPECT_EQ(env.invalidPixels(), 3u);
+  for (float c : env.image().rgb) EXPECT_TRUE(std::isfinite(c) && c >= 0.f);
 }
