@@ -97,10 +97,7 @@ THINLENS = ('<sensor type="thinlens"><float name="aperture_radius" value="0.2"/>
 
 # Where envgi is known to differ from Mitsuba (docs/validation.md says why): by design, or open.
 DESIGN = {
-    # Grace's fireplace seen directly: Mitsuba's rows (v = j/(H-1)) are resampled to envgi's pixel
-    # centres as the map loads, a second linear interpolation that leaves this region +0.11%
-    # (z 4.4 on the 0.1% floor); with the lookup itself on Mitsuba's grid it read -0.01%.
-    'teapot-glass': 'open: +0.1% where the map is seen directly (rows resampled to pixel centres)',
+    # (empty since stop 34: the env-map row placement, the last entry, now follows Mitsuba's)
 }
 
 # Envgi-only properties that Mitsuba would reject as unreferenced.

@@ -53,8 +53,18 @@ EnvironmentMap EnvironmentMap::load(const std::string& path, const EnvironmentMa
   size_t invalid = zeroInvalidRadiance(img);
   if (invalid > 0)
     spdlog::warn("environment map '{}': {} NaN, infinite or negative channel values replaced with 0", path, invalid);
+  // The density follows the rows resampled to pixel centres; the lookup reads the file's own
+  // rows on Mitsuba's grid. Sampling stays unbiased (its pdf comes from the same tables), and
+  // the density follows the lookup to within a second linear interpolation.
   EnvironmentMap map(rowsAtPixelCentres(img), opts, path);
   map.invalid_ = invalid;
+  if (img.height >= 2) {
+    map.densityLum_.resize(size_t(img.width) * img.height);
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x)
+        map.densityLum_[size_t(y) * img.width + x] = luminance(map.image_.at(x, y));
+    map.poleRows_ = std::move(img);
+  }
   return map;
 }
 
@@ -195,7 +205,9 @@ void EnvironmentMap::setPlacement(float scale, const Transform& toWorld) {
 
 EnvironmentMapView EnvironmentMap::view() const {
   EnvironmentMapView v;
-  v.rgb = image_.rgb.data();
+  v.rowsFromPoles = !poleRows_.rgb.empty();
+  v.rgb = v.rowsFromPoles ? poleRows_.rgb.data() : image_.rgb.data();
+  v.densityLum = densityLum_.empty() ? nullptr : densityLum_.data();
   v.width = image_.width;
   v.height = image_.height;
   v.scale = opts_.scale;

@@ -55,6 +55,8 @@ class EnvironmentMap {
   // Moves and rescales the map (the viewer's controls); the sampling tables, in the map's own
   // frame, stay valid. Throws for a negative scale.
   void setPlacement(float scale, const Transform& toWorld);
+  // The map at pixel centres, which the sampling tables follow (for a file, its rows resampled
+  // there; the lookup then reads the file's own rows on Mitsuba's grid).
   const Image& image() const { return image_; }
   const EnvironmentMapOptions& options() const { return opts_; }
   size_t invalidPixels() const { return invalid_; }
@@ -73,10 +75,9 @@ class EnvironmentMap {
   // Mitsuba's envmap puts row j of an H-row map at v = j / (H - 1), on a grid that ends at the
   // poles, and interpolates linearly between rows; envgi's lookup (and so its sampling tables
   // and in-pixel warp) puts rows at pixel centres, v = (j + 0.5) / H. This resamples the rows to
-  // pixel centres, each row Mitsuba's lookup at that centre. envgi's lookup then reproduces
-  // Mitsuba's placement, exactly for a map linear in v and within a second linear interpolation
-  // otherwise, and everything built on the lookup stays as it is. Columns need nothing: both
-  // put them at pixel centres.
+  // pixel centres, each row Mitsuba's lookup at that centre: the map that load() builds the
+  // sampling tables and the in-pixel warp from, while its lookup reads the file's rows where
+  // Mitsuba does. Columns need nothing: both put them at pixel centres.
   static Image rowsAtPixelCentres(const Image& poleToPole);
 
   // Per-pixel sampling weight: luminance of the lookup's average over the pixel, times sin theta.
@@ -84,6 +85,10 @@ class EnvironmentMap {
 
  private:
   Image image_;
+  // A lat-long file's own rows, on Mitsuba's grid from pole to pole, which the lookup reads
+  // (empty otherwise), and image_'s luminance, which the density then follows.
+  Image poleRows_;
+  std::vector<float> densityLum_;
   EnvironmentMapOptions opts_;
   PiecewiseConstant2D dist_;
   AliasTable alias_;

@@ -48,7 +48,13 @@ struct EnvSample {
 
 struct EnvironmentMapView {
   const float* rgb = nullptr;  // width * height * 3, sanitised (finite, >= 0)
+  // Per-pixel luminance that the sampling density follows (the tables and the in-pixel warp);
+  // null: the luminance of rgb. Apart from rgb when the lookup is Mitsuba's (rowsFromPoles).
+  const float* densityLum = nullptr;
   int width = 0, height = 0;
+  // Mitsuba's row placement: row j at v = j / (height - 1), from pole to pole, where the
+  // density's pixels (densityLum, resampled to pixel centres) put rows at v = (j + 0.5) / height.
+  bool rowsFromPoles = false;
   float scale = 1.f;
   bool bilinear = true;
   Transform toWorld;
@@ -89,7 +95,7 @@ struct EnvironmentMapView {
       int x = clampi(int(uv.x * width), 0, width - 1), y = clampi(int(uv.y * height), 0, height - 1);
       return texel(x, y) * scale;
     }
-    float fx = uv.x * width - 0.5f, fy = uv.y * height - 0.5f;
+    float fx = uv.x * width - 0.5f, fy = rowsFromPoles ? uv.y * float(height - 1) : uv.y * height - 0.5f;
     float x0f = std::floor(fx), y0f = std::floor(fy);
     float tx = fx - x0f, ty = fy - y0f;
     int x0 = int(x0f), y0 = int(y0f);
@@ -112,7 +118,8 @@ struct EnvironmentMapView {
     int xs[3] = {px > 0 ? px - 1 : width - 1, px, px + 1 < width ? px + 1 : 0};
     int ys[3] = {py > 0 ? py - 1 : 0, py, py + 1 < height ? py + 1 : height - 1};
     for (int j = 0; j < 3; ++j)
-      for (int i = 0; i < 3; ++i) l[j][i] = luminance(texel(xs[i], ys[j]));
+      for (int i = 0; i < 3; ++i)
+        l[j][i] = densityLum ? densityLum[size_t(ys[j]) * width + xs[i]] : luminance(texel(xs[i], ys[j]));
   }
   ENVGI_HD void pixelLattice(int px, int py, float v[3][3]) const {
     float l[3][3];

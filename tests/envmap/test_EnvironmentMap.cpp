@@ -149,27 +149,38 @@ struct MapFile {
 };
 }  // namespace
 
-// A lat-long file is read as Mitsuba reads it: row j at v = j / (H - 1), linear between rows
-// (measured with Mitsuba 3.x's own envmap: a lit row peaks at theta = pi j / (H - 1)). For a map
-// linear in the row, envgi's lookup then equals Mitsuba's everywhere between the first and last
-// pixel centres; the columns stay at pixel centres, as in Mitsuba.
+// A lat-long file is read as Mitsuba reads it: row j at v = j / (H - 1), linear between rows,
+// columns at pixel centres. The values below are Mitsuba 3's own envmap.eval on the same 16 x 8
+// map (row 3 lit at 1, column 5 at 2), at the same directions.
 TEST(EnvironmentMap, LoadedRowsLieOnMitsubasGridFromPoleToPole) {
   const int w = 16, h = 8;
-  MapFile file(gradientMap(w, h), "gradient");  // red = column, green = row
-  EnvironmentMap env = EnvironmentMap::load(file.path.string());
-  EnvironmentMapView v = env.view();
-  for (float vv = 0.5f / h; vv <= 1.f - 0.5f / h; vv += 0.013f) {
-    Color c = v.lookupUV({(3.f + 0.5f) / w, vv});
-    EXPECT_NEAR(c.y, vv * float(h - 1), 2e-5f) << "v " << vv;  // Mitsuba: y = v (H - 1)
-    EXPECT_NEAR(c.x, 3.f, 1e-5f) << "v " << vv;                // column 3 at its centre
-  }
-  // Built from the image itself, the map keeps pixel centres (probes and tests use that).
+  Image probe(w, h);
+  for (int x = 0; x < w; ++x) probe.set(x, 3, Color(1.f));
+  for (int y = 0; y < h; ++y) probe.set(5, y, probe.at(5, y) + Color(2.f));
+  MapFile file(probe, "probe");
+  EnvironmentMapView v = EnvironmentMap::load(file.path.string()).view();
+  struct Probe {
+    float u, v, mitsuba;
+  };
+  for (Probe p : {Probe{1.5f / w, 0.3f, 0.1f}, Probe{1.5f / w, 0.35f, 0.45f}, Probe{1.5f / w, 0.425f, 0.975f},
+                  Probe{1.5f / w, 0.5f, 0.5f}, Probe{1.5f / w, 0.5625f, 0.0625f}, Probe{4.6f / w, 0.3f, 0.3f},
+                  Probe{5.5f / w, 0.3f, 2.1f}, Probe{6.2f / w, 0.3f, 0.7f}})
+    EXPECT_NEAR(v.lookupUV({p.u, p.v}).x, p.mitsuba, 1e-4f) << "u " << p.u << " v " << p.v;
+  // The lit row peaks at theta = 3 pi / 7, at the poles the first and last rows hold exactly.
+  EXPECT_NEAR(v.lookupUV({1.5f / w, 3.f / 7.f}).x, 1.f, 1e-5f);
+  EXPECT_NEAR(v.lookupUV({1.5f / w, 0.f}).x, 0.f, 1e-6f);
+
+  // A map linear in the row: Mitsuba's value v (H - 1) everywhere, the poles included.
+  MapFile ramp(gradientMap(w, h), "gradient");  // red = column, green = row
+  EnvironmentMapView r = EnvironmentMap::load(ramp.path.string()).view();
+  for (float vv = 0.f; vv <= 1.f; vv += 0.013f) EXPECT_NEAR(r.lookupUV({3.5f / w, vv}).y, vv * float(h - 1), 2e-5f);
+  // Built from an image in memory, a map keeps pixel centres (probes and tests use that).
   EnvironmentMap direct(gradientMap(w, h), {});
   EXPECT_NEAR(direct.view().lookupUV({0.5f, 2.5f / h}).y, 2.f, 1e-5f);
   // A nearest-texel map has no grid to move.
   EnvironmentMapOptions nearest;
   nearest.bilinear = false;
-  EXPECT_EQ(EnvironmentMap::load(file.path.string(), nearest).view().lookupUV({0.5f, 2.5f / h}).y, 2.f);
+  EXPECT_EQ(EnvironmentMap::load(ramp.path.string(), nearest).view().lookupUV({0.5f, 2.5f / h}).y, 2.f);
 }
 
 // The resampled rows are Mitsuba's lookup at the pixel centres, each a blend of two rows with
