@@ -63,7 +63,8 @@ EnvironmentMap EnvironmentMap::load(const std::string& path, const EnvironmentMa
     for (int y = 0; y < img.height; ++y)
       for (int x = 0; x < img.width; ++x)
         map.densityLum_[size_t(y) * img.width + x] = luminance(map.image_.at(x, y));
-    map.poleRows_ = std::move(img);
+    map.image_ = std::move(img);
+    map.rowsFromPoles_ = true;
   }
   return map;
 }
@@ -205,8 +206,8 @@ void EnvironmentMap::setPlacement(float scale, const Transform& toWorld) {
 
 EnvironmentMapView EnvironmentMap::view() const {
   EnvironmentMapView v;
-  v.rowsFromPoles = !poleRows_.rgb.empty();
-  v.rgb = v.rowsFromPoles ? poleRows_.rgb.data() : image_.rgb.data();
+  v.rowsFromPoles = rowsFromPoles_;
+  v.rgb = image_.rgb.data();
   v.densityLum = densityLum_.empty() ? nullptr : densityLum_.data();
   v.width = image_.width;
   v.height = image_.height;
@@ -229,7 +230,9 @@ float EnvironmentMap::luminancePower() const {
   int w = image_.width, h = image_.height;
   for (int y = 0; y < h; ++y) {
     double dA = pixelSolidAngle(y, w, h);
-    for (int x = 0; x < w; ++x) sum += luminance(image_.at(x, y)) * dA;
+    // A file's rows on Mitsuba's grid: their resampled luminance sits at the pixels' centres.
+    for (int x = 0; x < w; ++x)
+      sum += (densityLum_.empty() ? luminance(image_.at(x, y)) : densityLum_[size_t(y) * w + x]) * dA;
   }
   return float(sum * opts_.scale);
 }

@@ -55,8 +55,7 @@ class EnvironmentMap {
   // Moves and rescales the map (the viewer's controls); the sampling tables, in the map's own
   // frame, stay valid. Throws for a negative scale.
   void setPlacement(float scale, const Transform& toWorld);
-  // The map at pixel centres, which the sampling tables follow (for a file, its rows resampled
-  // there; the lookup then reads the file's own rows on Mitsuba's grid).
+  // The texels the lookup reads: for a file, its own rows on Mitsuba's grid (rowsFromPoles).
   const Image& image() const { return image_; }
   const EnvironmentMapOptions& options() const { return opts_; }
   size_t invalidPixels() const { return invalid_; }
@@ -85,9 +84,10 @@ class EnvironmentMap {
 
  private:
   Image image_;
-  // A lat-long file's own rows, on Mitsuba's grid from pole to pole, which the lookup reads
-  // (empty otherwise), and image_'s luminance, which the density then follows.
-  Image poleRows_;
+  // For a lat-long file: image_'s rows lie on Mitsuba's grid from pole to pole, and the density
+  // follows densityLum_, the luminance of those rows resampled to pixel centres (only the
+  // luminance is kept: a second copy of the texels would cost a third more memory than this).
+  bool rowsFromPoles_ = false;
   std::vector<float> densityLum_;
   EnvironmentMapOptions opts_;
   PiecewiseConstant2D dist_;
