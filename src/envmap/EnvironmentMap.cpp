@@ -58,12 +58,9 @@ EnvironmentMap EnvironmentMap::load(const std::string& path, const EnvironmentMa
   // the density follows the lookup to within a second linear interpolation.
   EnvironmentMap map(rowsAtPixelCentres(img), opts, path);
   map.invalid_ = invalid;
-  if (img.height >= 2) {
-    map.densityLum_.resize(size_t(img.width) * img.height);
-    for (int y = 0; y < img.height; ++y)
-      for (int x = 0; x < img.width; ++x)
-        map.densityLum_[size_t(y) * img.width + x] = luminance(map.image_.at(x, y));
-    map.image_ = std::move(img);
+  if (img.height >= 2) {  // the lookup's r, g, b become the file's own rows
+    for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
+      for (int k = 0; k < 3; ++k) map.texels_[i * 4 + k] = img.rgb[i * 3 + k];
     map.rowsFromPoles_ = true;
   }
   return map;
@@ -166,23 +163,36 @@ std::vector<float> EnvironmentMap::samplingWeights(const Image& img, bool biline
 }
 
 EnvironmentMap::EnvironmentMap(Image img, const EnvironmentMapOptions& opts, const std::string& name)
-    : image_(std::move(img)), opts_(opts) {
+    : width_(img.width), height_(img.height), opts_(opts) {
   if (!(opts.scale >= 0.f) || !std::isfinite(opts.scale))
     throw std::runtime_error("environment map '" + name + "': scale must be a finite number >= 0");
-  invalid_ = zeroInvalidRadiance(image_);
+  invalid_ = zeroInvalidRadiance(img);
+  texels_.resize(size_t(width_) * height_ * 4);
+  for (size_t i = 0; i < size_t(width_) * height_; ++i) {
+    Color c(img.rgb[i * 3], img.rgb[i * 3 + 1], img.rgb[i * 3 + 2]);
+    for (int k = 0; k < 3; ++k) texels_[i * 4 + k] = c[k];
+    texels_[i * 4 + 3] = luminance(c);
+  }
   if (invalid_ > 0)
     spdlog::warn("environment map '{}': {} NaN, infinite or negative channel values replaced with 0", name, invalid_);
-  std::vector<float> weight = samplingWeights(image_, opts.bilinear, opts.misCompensation);
-  dist_ = PiecewiseConstant2D(weight.data(), image_.width, image_.height);
+  std::vector<float> weight = samplingWeights(img, opts.bilinear, opts.misCompensation);
+  dist_ = PiecewiseConstant2D(weight.data(), img.width, img.height);
   alias_ = AliasTable(weight.data(), weight.size());
   // A black map leaves the product strategy to Algorithm 1's (uniform) fallback.
-  if (dist_.integral() > 0.f) product_ = CosineProduct(weight.data(), image_.width, image_.height);
+  if (dist_.integral() > 0.f) product_ = CosineProduct(weight.data(), img.width, img.height);
   if (opts.bilinear) warpBits_ = pixelsToWarp(view());
   // The quadtree baseline balances plain map power, never compensated power.
-  std::vector<float> plain = opts.misCompensation ? samplingWeights(image_, opts.bilinear, false) : weight;
-  adaptive_ = AdaptiveQuadtree(plain.data(), image_.width, image_.height, opts.adaptiveLeaves);
+  std::vector<float> plain = opts.misCompensation ? samplingWeights(img, opts.bilinear, false) : weight;
+  adaptive_ = AdaptiveQuadtree(plain.data(), img.width, img.height, opts.adaptiveLeaves);
   if (opts.misCompensation) emission_ = AliasTable(plain.data(), plain.size());
   if (dist_.integral() <= 0.f) spdlog::warn("environment map '{}' is black everywhere: a light of zero power", name);
+}
+
+Image EnvironmentMap::image() const {
+  Image out(width_, height_);
+  for (int y = 0; y < height_; ++y)
+    for (int x = 0; x < width_; ++x) out.set(x, y, texelAt(x, y));
+  return out;
 }
 
 void EnvironmentMap::setPoints(std::vector<DirectionalLight> points) {
@@ -207,10 +217,9 @@ void EnvironmentMap::setPlacement(float scale, const Transform& toWorld) {
 EnvironmentMapView EnvironmentMap::view() const {
   EnvironmentMapView v;
   v.rowsFromPoles = rowsFromPoles_;
-  v.rgb = image_.rgb.data();
-  v.densityLum = densityLum_.empty() ? nullptr : densityLum_.data();
-  v.width = image_.width;
-  v.height = image_.height;
+  v.texels = texels_.data();
+  v.width = width_;
+  v.height = height_;
   v.scale = opts_.scale;
   v.bilinear = opts_.bilinear;
   v.toWorld = opts_.toWorld;
@@ -227,19 +236,18 @@ EnvironmentMapView EnvironmentMap::view() const {
 
 float EnvironmentMap::luminancePower() const {
   double sum = 0.0;
-  int w = image_.width, h = image_.height;
+  int w = width_, h = height_;
   for (int y = 0; y < h; ++y) {
     double dA = pixelSolidAngle(y, w, h);
-    // A file's rows on Mitsuba's grid: their resampled luminance sits at the pixels' centres.
-    for (int x = 0; x < w; ++x)
-      sum += (densityLum_.empty() ? luminance(image_.at(x, y)) : densityLum_[size_t(y) * w + x]) * dA;
+    // The density's luminance: for a file's rows on Mitsuba's grid, resampled to pixel centres.
+    for (int x = 0; x < w; ++x) sum += texels_[(size_t(y) * w + x) * 4 + 3] * dA;
   }
   return float(sum * opts_.scale);
 }
 
 EnvironmentMapStats EnvironmentMap::stats() const {
   EnvironmentMapStats st;
-  int w = image_.width, h = image_.height;
+  int w = width_, h = height_;
   st.width = w;
   st.height = h;
   st.invalidPixels = invalid_;
@@ -250,7 +258,7 @@ EnvironmentMapStats EnvironmentMap::stats() const {
   for (int y = 0; y < h; ++y) {
     double dA = pixelSolidAngle(y, w, h), s = dA;
     for (int x = 0; x < w; ++x) {
-      Color c = image_.at(x, y) * opts_.scale;
+      Color c = texelAt(x, y) * opts_.scale;
       st.channelMin = vmin(st.channelMin, c);
       st.channelMax = vmax(st.channelMax, c);
       for (int k = 0; k < 3; ++k) power[k] += c[k] * dA;

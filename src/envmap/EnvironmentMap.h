@@ -55,8 +55,10 @@ class EnvironmentMap {
   // Moves and rescales the map (the viewer's controls); the sampling tables, in the map's own
   // frame, stay valid. Throws for a negative scale.
   void setPlacement(float scale, const Transform& toWorld);
-  // The texels the lookup reads: for a file, its own rows on Mitsuba's grid (rowsFromPoles).
-  const Image& image() const { return image_; }
+  // The texels the lookup reads (a copy): for a file, its own rows on Mitsuba's grid.
+  Image image() const;
+  int width() const { return width_; }
+  int height() const { return height_; }
   const EnvironmentMapOptions& options() const { return opts_; }
   size_t invalidPixels() const { return invalid_; }
   EnvironmentMapStats stats() const;
@@ -83,12 +85,16 @@ class EnvironmentMap {
   static std::vector<float> samplingWeights(const Image& img, bool bilinear, bool misCompensation);
 
  private:
-  Image image_;
-  // For a lat-long file: image_'s rows lie on Mitsuba's grid from pole to pole, and the density
-  // follows densityLum_, the luminance of those rows resampled to pixel centres (only the
-  // luminance is kept: a second copy of the texels would cost a third more memory than this).
+  // 4 floats a pixel (EnvironmentMapView::texels): the lookup's r, g, b and the density's
+  // luminance. For a lat-long file the r, g, b are its rows on Mitsuba's grid from pole to pole
+  // and the luminance is of those rows resampled to pixel centres (rowsFromPoles_).
+  int width_ = 0, height_ = 0;
+  std::vector<float> texels_;
   bool rowsFromPoles_ = false;
-  std::vector<float> densityLum_;
+  Color texelAt(int x, int y) const {
+    const float* p = &texels_[(size_t(y) * width_ + x) * 4];
+    return {p[0], p[1], p[2]};
+  }
   EnvironmentMapOptions opts_;
   PiecewiseConstant2D dist_;
   AliasTable alias_;

@@ -47,13 +47,13 @@ struct EnvSample {
 };
 
 struct EnvironmentMapView {
-  const float* rgb = nullptr;  // width * height * 3, sanitised (finite, >= 0)
-  // Per-pixel luminance that the sampling density follows (the tables and the in-pixel warp);
-  // null: the luminance of rgb. Apart from rgb when the lookup is Mitsuba's (rowsFromPoles).
-  const float* densityLum = nullptr;
+  // width * height texels of 4 floats: the lookup's r, g, b (sanitised: finite, >= 0) and the
+  // luminance the sampling density follows (the tables and the in-pixel warp), side by side so
+  // that a warp and the lookup next to it share cache lines.
+  const float* texels = nullptr;
   int width = 0, height = 0;
-  // Mitsuba's row placement: row j at v = j / (height - 1), from pole to pole, where the
-  // density's pixels (densityLum, resampled to pixel centres) put rows at v = (j + 0.5) / height.
+  // Mitsuba's row placement: the lookup puts row j at v = j / (height - 1), from pole to pole,
+  // while the density's luminance (resampled) sits at pixel centres, v = (j + 0.5) / height.
   bool rowsFromPoles = false;
   float scale = 1.f;
   bool bilinear = true;
@@ -85,7 +85,7 @@ struct EnvironmentMapView {
   }
 
   ENVGI_HD Color texel(int x, int y) const {
-    const float* p = rgb + (size_t(y) * width + x) * 3;
+    const float* p = texels + (size_t(y) * width + x) * 4;
     return {p[0], p[1], p[2]};
   }
 
@@ -119,7 +119,7 @@ struct EnvironmentMapView {
     int ys[3] = {py > 0 ? py - 1 : 0, py, py + 1 < height ? py + 1 : height - 1};
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i)
-        l[j][i] = densityLum ? densityLum[size_t(ys[j]) * width + xs[i]] : luminance(texel(xs[i], ys[j]));
+        l[j][i] = texels[(size_t(ys[j]) * width + xs[i]) * 4 + 3];
   }
   ENVGI_HD void pixelLattice(int px, int py, float v[3][3]) const {
     float l[3][3];

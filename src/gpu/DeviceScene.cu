@@ -6,8 +6,7 @@ namespace envgi::gpu {
 
 EnvironmentMapView uploadEnvironment(DeviceArena& a, EnvironmentMapView v) {
   size_t px = size_t(v.width) * v.height;
-  v.rgb = a.upload(v.rgb, px * 3, "environment map");
-  if (v.densityLum) v.densityLum = a.upload(v.densityLum, px, "environment density luminance");
+  v.texels = a.upload(v.texels, px * 4, "environment map");
   v.dist.condFunc = a.upload(v.dist.condFunc, px, "environment CDFs");
   v.dist.condCdf = a.upload(v.dist.condCdf, size_t(v.height) * (v.width + 1), "environment CDFs");
   v.dist.condInt = a.upload(v.dist.condInt, size_t(v.height), "environment CDFs");

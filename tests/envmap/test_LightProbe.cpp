@@ -180,9 +180,10 @@ TEST(LightProbe, BadProbesAreErrors) {
 TEST(LightProbe, EnvironmentMapReadsAProbeAsItsConversion) {
   EnvironmentMap env = EnvironmentMap::loadProbe(bundled("uffizi_probe_128.exr"), ProbeLayout::Angular);
   Image direct = probeToLatLong(loadImage(bundled("uffizi_probe_128.exr")), ProbeLayout::Angular);
-  ASSERT_EQ(env.image().width, direct.width);
-  ASSERT_EQ(env.image().rgb.size(), direct.rgb.size());
-  for (size_t i = 0; i < direct.rgb.size(); ++i) ASSERT_EQ(env.image().rgb[i], direct.rgb[i]);
+  Image got = env.image();
+  ASSERT_EQ(got.width, direct.width);
+  ASSERT_EQ(got.rgb.size(), direct.rgb.size());
+  for (size_t i = 0; i < direct.rgb.size(); ++i) ASSERT_EQ(got.rgb[i], direct.rgb[i]);
   EXPECT_GT(env.luminancePower(), 0.f);
   EXPECT_THROW(EnvironmentMap::loadProbe(bundled("studio.hdr"), ProbeLayout::Angular), std::runtime_error)
       << "a lat-long map is not a probe";
