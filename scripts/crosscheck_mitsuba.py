@@ -159,6 +159,7 @@ def main():
     ap.add_argument('--spp', type=int, default=64)
     ap.add_argument('--res', type=int, default=48)
     ap.add_argument('--only', default='', help='substring of the configurations to run')
+    ap.add_argument('--all-regions', action='store_true', help='print every region of each configuration, not the worst')
     ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,textured,microfacets,brushed',
                     help='comma-separated scenes (XML files in --scenes, without .xml)')
     args = ap.parse_args()
@@ -219,6 +220,10 @@ def main():
             ea.append(region_means(e, regions))
             mb.append(region_means(m, regions))
         ma, mm, z, p = compare(ea, mb)
+        if args.all_regions:
+            for r in range(len(ma)):
+                print(f'    {name} region {r // regions},{r % regions}: envgi {ma[r]:.4f} mitsuba {mm[r]:.4f} '
+                      f'diff {(ma[r] - mm[r]) / max(mm[r], 1e-9) * 100:+.2f}% z {z[r]:+.1f}', file=sys.stderr)
         k = int(np.argmin(p))
         ok = p.min() > alpha
         why = next((v for key, v in DESIGN.items() if name.split(': ')[1].startswith(key)), '')
