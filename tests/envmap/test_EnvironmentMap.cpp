@@ -159,7 +159,8 @@ TEST(EnvironmentMap, LoadedRowsLieOnMitsubasGridFromPoleToPole) {
   for (int x = 0; x < w; ++x) probe.set(x, 3, Color(1.f));
   for (int y = 0; y < h; ++y) probe.set(5, y, probe.at(5, y) + Color(2.f));
   MapFile file(probe, "probe");
-  EnvironmentMapView v = EnvironmentMap::load(file.path.string()).view();
+  EnvironmentMap map = EnvironmentMap::load(file.path.string());  // the view reads its texels
+  EnvironmentMapView v = map.view();
   struct Probe {
     float u, v, mitsuba;
   };
@@ -173,7 +174,8 @@ TEST(EnvironmentMap, LoadedRowsLieOnMitsubasGridFromPoleToPole) {
 
   // A map linear in the row: Mitsuba's value v (H - 1) everywhere, the poles included.
   MapFile ramp(gradientMap(w, h), "gradient");  // red = column, green = row
-  EnvironmentMapView r = EnvironmentMap::load(ramp.path.string()).view();
+  EnvironmentMap rampMap = EnvironmentMap::load(ramp.path.string());
+  EnvironmentMapView r = rampMap.view();
   for (float vv = 0.f; vv <= 1.f; vv += 0.013f) EXPECT_NEAR(r.lookupUV({3.5f / w, vv}).y, vv * float(h - 1), 2e-5f);
   // Built from an image in memory, a map keeps pixel centres (probes and tests use that).
   EnvironmentMap direct(gradientMap(w, h), {});
