@@ -74,6 +74,7 @@ class CudaGridExecutor final : public PassExecutor {
   void readFilm(FilmSums* out) override { camera_->readFilm(out); }
   bool restart(const Camera& cam) override { return camera_->restart(cam); }
   bool setActivePixels(const std::vector<unsigned char>& mask) override { return camera_->setActivePixels(mask); }
+  bool keepsVariance() const override { return camera_->keepsVariance(); }
   size_t deviceBytes() const { return camera_->deviceBytes(); }
 
  private:

@@ -142,6 +142,7 @@ class CudaPassExecutor final : public PassExecutor {
     activeCount_ = mask.size() - size_t(std::count(mask.begin(), mask.end(), (unsigned char)0));
     return true;
   }
+  bool keepsVariance() const override { return film_.sumSqLum != nullptr; }
 
   void readFilm(FilmSums* out) override {
     size_t px = size_t(cam_.width) * cam_.height;

@@ -89,6 +89,7 @@ class CpuExecutor final : public PassExecutor {
     active_ = mask;
     return true;
   }
+  bool keepsVariance() const override { return !film_.sumSqLum.empty(); }
 
  private:
   Camera cam_;

@@ -32,6 +32,7 @@ class GridExecutor final : public PassExecutor {
   void readFilm(FilmSums* out) override { camera_->readFilm(out); }
   bool restart(const Camera& cam) override { return camera_->restart(cam); }
   bool setActivePixels(const std::vector<unsigned char>& mask) override { return camera_->setActivePixels(mask); }
+  bool keepsVariance() const override { return camera_->keepsVariance(); }
   const GridBuild& build() const { return build_; }
   int gatherRaysDone() const { return build_.grid.raysPerPoint(); }
 

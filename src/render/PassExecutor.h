@@ -38,6 +38,8 @@ class PassExecutor {
   // Adaptive sampling: later passes sample only the pixels whose mask entry is non-zero (one a
   // pixel, row-major). False: this executor samples every pixel in every pass (SPPM).
   virtual bool setActivePixels(const std::vector<unsigned char>& /*mask*/) { return false; }
+  // Whether readFilm returns each pixel's sum of squared luminance (adaptive sampling's noise).
+  virtual bool keepsVariance() const { return false; }
 };
 
 }  // namespace envgi

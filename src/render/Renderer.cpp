@@ -9,7 +9,7 @@
 #include <stdexcept>
 
 #include "accel/Bvh.h"
-#include "render/AdaptiveSampling.h"
+#include "render/ActivePixels.h"
 #include "render/CpuExecutor.h"
 #include "integrators/PhotonIntegrator.h"
 #include "render/GridExecutor.h"
@@ -279,51 +279,39 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   int sppDone = 0;
   bool cancelled = false, timeLimited = false;
   const size_t px = size_t(W) * size_t(H);
-  std::vector<int> samples(px, 0);  // each pixel's samples so far
-  // Adaptive sampling's mask (AdaptiveSampling.h): every pixel starts active.
-  const bool adaptive = opts.noiseThreshold > 0.f;
-  std::vector<unsigned char> active(adaptive ? px : 0, 1);
-  size_t activeCount = px;
-  uint64_t pixelSamples = 0;
-  if (adaptive && !ex.setActivePixels(active))
+  // Each pixel's samples so far, and adaptive sampling's mask: every pixel starts active.
+  ActivePixels pixels(W, H, opts.noiseThreshold);
+  const bool adaptive = pixels.attach(ex);
+  if (opts.noiseThreshold > 0.f && !adaptive)
     throw std::runtime_error("adaptive sampling (a noise threshold) needs an integrator that samples pixels one by "
                              "one: path, direct, photon or grid, not sppm");
-  if (adaptive) {
-    ex.readFilm(&film);
-    if (film.sumSqLum.size() != px)
-      throw std::logic_error("adaptive sampling: the executor keeps no per-pixel variance (it was made without "
-                             "RenderOptions::keepsVariance())");
-  }
   auto meanImage = [&]() {
     ex.readFilm(&film);
-    return filmMean(film, W, H, samples);
+    return filmMean(film, W, H, pixels.samples());
   };
   for (auto [s0, s1] : passes) {
     if (opts.cancel && opts.cancel->load()) {
       cancelled = true;
       break;
     }
-    if (opts.timeLimitSeconds > 0.0 && pixelSamples > 0) {
+    if (opts.timeLimitSeconds > 0.0 && pixels.pixelSamples() > 0) {
       // At the rate of the passes so far, a pixel-sample at a time (adaptive passes shrink).
       double spent = std::chrono::duration<double>(Clock::now() - t0).count();
-      if (spent + spent / double(pixelSamples) * double(activeCount) * (s1 - s0) > opts.timeLimitSeconds) {
+      if (spent + spent / double(pixels.pixelSamples()) * double(pixels.activeCount()) * (s1 - s0) >
+          opts.timeLimitSeconds) {
         timeLimited = true;
         break;
       }
     }
     ex.runPass(s0, s1, progress, &counters);
-    for (size_t i = 0; i < px; ++i)
-      if (!adaptive || active[i]) samples[i] = s1;
-    pixelSamples += uint64_t(activeCount) * uint64_t(s1 - s0);
+    pixels.passDone(s0, s1);
     sppDone = s1;
     if (adaptive && sppDone >= opts.adaptiveMinSpp && sppDone < spp) {
-      ex.readFilm(&film);  // with its variance: checked before the first pass
-      size_t before = activeCount;
-      activeCount = updateActivePixels(film.sum, film.sumSqLum, samples, W, H, opts.noiseThreshold, 1, &active);
-      progress.shrinkTotal((before - activeCount) * size_t(spp - sppDone));
-      spdlog::debug("adaptive sampling: {} of {} pixels still sampling after {} spp", activeCount, px, sppDone);
-      if (activeCount == 0) break;  // every pixel has converged: the render is done
-      ex.setActivePixels(active);
+      size_t before = pixels.activeCount();
+      size_t left = pixels.update(ex, &film);
+      progress.shrinkTotal((before - left) * size_t(spp - sppDone));
+      spdlog::debug("adaptive sampling: {} of {} pixels still sampling after {} spp", left, px, sppDone);
+      if (left == 0) break;  // every pixel has converged: the render is done
     }
     double sinceCheckpoint = std::chrono::duration<double>(Clock::now() - lastCheckpoint).count();
     if (opts.checkpoint && opts.checkpointSeconds > 0.0 && sinceCheckpoint >= opts.checkpointSeconds && sppDone < spp) {
@@ -340,21 +328,21 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     stats->nonFiniteSamples = counters.dropped;
     stats->cancelled = cancelled;
     stats->timeLimited = timeLimited;
-    stats->pixelSamples = pixelSamples;
-    stats->pixelsStopped = adaptive ? size_t(std::count(active.begin(), active.end(), (unsigned char)0)) : 0;
-    stats->converged = adaptive && activeCount == 0;
+    stats->pixelSamples = pixels.pixelSamples();
+    stats->pixelsStopped = adaptive ? px - pixels.activeCount() : 0;
+    stats->converged = pixels.converged();
   }
   if (opts.varianceOut && sppDone > 0) {
     if (film.sumSqLum.empty()) throw std::runtime_error("this executor kept no per-pixel variance");
     opts.varianceOut->assign(px, 0.f);
     for (size_t i = 0; i < film.sum.size(); ++i) {
-      int n = std::max(samples[i], 1);
+      int n = std::max(pixels.samples()[i], 1);
       double mean = luminance(film.sum[i]) / n;
       double var = std::max(0.0, film.sumSqLum[i] / n - mean * mean);
       (*opts.varianceOut)[i] = float(var / std::max(1, n - 1));
     }
   }
-  if (opts.samplesOut) *opts.samplesOut = samples;
+  if (opts.samplesOut) *opts.samplesOut = pixels.samples();
   if (counters.dropped > 0) spdlog::warn("{} samples were NaN, infinite or negative and were dropped", counters.dropped);
   return img;
 }

@@ -10,7 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "render/AdaptiveSampling.h"
+#include "render/ActivePixels.h"
 #include "scene/NameTables.h"
 
 namespace envgi {
@@ -50,17 +50,6 @@ Vec3f vec3(const json& j, const char* key) {
   return Vec3f(finiteFloat(v[0], key), finiteFloat(v[1], key), finiteFloat(v[2], key));
 }
 json arr(Vec3f v) { return json::array({v.x, v.y, v.z}); }
-// Whether an executor keeps the per-pixel variance that adaptive sampling reads.
-bool keepsVariance(PassExecutor& ex) {
-  FilmSums film;
-  ex.readFilm(&film);
-  return !film.sumSqLum.empty() && film.sumSqLum.size() == film.sum.size();
-}
-double meanOf(const std::vector<int>& v) {
-  double sum = 0.0;
-  for (int n : v) sum += n;
-  return v.empty() ? 0.0 : sum / double(v.size());
-}
 float number(const json& j, const char* key, float lo, float hi) {
   double v = j.at(key).get<double>();
   if (!(v >= lo && v <= hi)) throw std::runtime_error(fmt::format("'{}' must be in [{}, {}]", key, lo, hi));
@@ -263,22 +252,21 @@ void ViewSession::run() {
   PassCounters counters;
   Progress quiet(1, false);
   State s;
-  // Adaptive sampling, as renderPasses does it: each pixel's samples and the mask of those
-  // still sampling; off for an executor that cannot mask pixels (SPPM).
-  bool adaptive = false, converged = false;
-  std::vector<int> samples;
-  std::vector<unsigned char> active;
-  size_t activeCount = 0;
-  auto limit = [&] { return pr.executor && !converged ? std::min(opts_.maxSpp, pr.spp) : 0; };
+  // Adaptive sampling, as renderPasses does it; off for an executor that cannot mask pixels (SPPM).
+  ActivePixels pixels(0, 0, 0.f);
+  bool adaptive = false;
+  auto limit = [&] { return pr.executor && !pixels.converged() ? std::min(opts_.maxSpp, pr.spp) : 0; };
+  // Whether the page asked for a frame that differs from the one it has (under mutex_).
+  auto frameWanted = [&](const State& st) {
+    return st.frameRequested && (st.toneChanged || st.resend || spp != sentSpp);
+  };
   while (!stop_) {
     bool restart = false, rebuild = false, send = false;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       wake_.wait(lock, [&] {
         const State& st = *state_;
-        return stop_ || st.restart || st.rebuild ||
-               (st.frameRequested && (st.toneChanged || st.resend || spp != sentSpp)) ||
-               spp < limit();
+        return stop_ || st.restart || st.rebuild || frameWanted(st) || spp < limit();
       });
       if (stop_) break;
       restart = state_->restart;
@@ -315,7 +303,7 @@ void ViewSession::run() {
         // An executor made while adaptive sampling was off keeps no variance: make it anew
         // (not SPPM's, which samples every pixel every pass and never keeps it).
         if (pr.executor && s.noiseThreshold > 0.f && scene_->integrator.type != IntegratorType::Sppm &&
-            !keepsVariance(*pr.executor))
+            !pr.executor->keepsVariance())
           pr = PreparedRender{};
         if (!pr.executor || !pr.executor->restart(scene_->view().camera)) {
           RenderOptions ro;
@@ -339,32 +327,22 @@ void ViewSession::run() {
       spp = 0;
       sentSpp = -1;
       t0 = Clock::now();
-      const size_t px = size_t(scene_->camera.width) * size_t(scene_->camera.height);
-      samples.assign(px, 0);
-      active.assign(px, 1);
-      activeCount = px;
-      converged = false;
-      adaptive = pr.executor && s.noiseThreshold > 0.f && pr.executor->setActivePixels(active);
+      pixels = ActivePixels(scene_->camera.width, scene_->camera.height, s.noiseThreshold);
+      adaptive = pr.executor && pixels.attach(*pr.executor);
     }
     if (spp < limit()) {
       pr.executor->runPass(spp, spp + 1, quiet, &counters);
       ++spp;
-      if (adaptive) {
-        for (size_t i = 0; i < samples.size(); ++i) samples[i] += active[i];
-        // Every 4 passes from the minimum on: each check reads the film back (from a GPU too).
-        if (spp >= s.minSpp && (spp - s.minSpp) % 4 == 0 && spp < limit()) {
-          FilmSums film;
-          pr.executor->readFilm(&film);
-          activeCount = updateActivePixels(film.sum, film.sumSqLum, samples, scene_->camera.width,
-                                           scene_->camera.height, s.noiseThreshold, 1, &active);
-          converged = activeCount == 0;
-          if (!converged) pr.executor->setActivePixels(active);
-        }
+      pixels.passDone(spp - 1, spp);
+      // Every 4 passes from the minimum on: each check reads the film back (from a GPU too).
+      if (adaptive && spp >= s.minSpp && (spp - s.minSpp) % 4 == 0 && spp < limit()) {
+        FilmSums film;
+        pixels.update(*pr.executor, &film);
       }
     }
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      send = pr.executor && state_->frameRequested && (state_->toneChanged || state_->resend || spp != sentSpp);
+      send = pr.executor && frameWanted(*state_);
       if (send) {
         state_->frameRequested = false;
         state_->toneChanged = false;
@@ -379,7 +357,7 @@ void ViewSession::run() {
     FilmSums film;
     pr.executor->readFilm(&film);
     const Camera& cam = scene_->view().camera;
-    Image img = adaptive ? filmMean(film, cam.width, cam.height, samples) : filmMean(film, cam.width, cam.height, spp);
+    Image img = filmMean(film, cam.width, cam.height, pixels.samples());
     ViewFrame f = makeFrame(img, s);
     auto now = Clock::now();
     double seconds = std::chrono::duration<double>(now - t0).count();
@@ -399,9 +377,9 @@ void ViewSession::run() {
                   {"strategy", s.strategy},
                   {"adaptive", adaptive},
                   {"noiseThreshold", s.noiseThreshold},
-                  {"sampling", adaptive ? double(activeCount) / double(std::max<size_t>(1, active.size())) : 1.0},
-                  {"converged", converged},
-                  {"meanSpp", adaptive ? meanOf(samples) : double(spp)},
+                  {"sampling", double(pixels.activeCount()) / double(std::max<size_t>(1, pixels.pixelCount()))},
+                  {"converged", pixels.converged()},
+                  {"meanSpp", pixels.meanSamples()},
                   {"bytes", f.jpeg.size()}}
                  .dump();
     {
