@@ -59,11 +59,15 @@ EnvironmentMap EnvironmentMap::load(const std::string& path, const EnvironmentMa
   EnvironmentMap map(rowsAtPixelCentres(img), opts, path);
   map.invalid_ = invalid;
   if (img.height >= 2) {  // the lookup's r, g, b become the file's own rows
-    for (size_t i = 0; i < size_t(img.width) * img.height; ++i)
-      for (int k = 0; k < 3; ++k) map.texels_[i * 4 + k] = img.rgb[i * 3 + k];
+    map.setLookupRgb(img);
     map.rowsFromPoles_ = true;
   }
   return map;
+}
+
+void EnvironmentMap::setLookupRgb(const Image& img) {
+  for (size_t i = 0; i < size_t(width_) * height_; ++i)
+    for (int k = 0; k < 3; ++k) texels_[i * 4 + k] = img.rgb[i * 3 + k];
 }
 
 Image EnvironmentMap::rowsAtPixelCentres(const Image& src) {
@@ -168,11 +172,9 @@ EnvironmentMap::EnvironmentMap(Image img, const EnvironmentMapOptions& opts, con
     throw std::runtime_error("environment map '" + name + "': scale must be a finite number >= 0");
   invalid_ = zeroInvalidRadiance(img);
   texels_.resize(size_t(width_) * height_ * 4);
-  for (size_t i = 0; i < size_t(width_) * height_; ++i) {
-    Color c(img.rgb[i * 3], img.rgb[i * 3 + 1], img.rgb[i * 3 + 2]);
-    for (int k = 0; k < 3; ++k) texels_[i * 4 + k] = c[k];
-    texels_[i * 4 + 3] = luminance(c);
-  }
+  setLookupRgb(img);
+  for (size_t i = 0; i < size_t(width_) * height_; ++i)
+    texels_[i * 4 + 3] = luminance(texels_[i * 4], texels_[i * 4 + 1], texels_[i * 4 + 2]);
   if (invalid_ > 0)
     spdlog::warn("environment map '{}': {} NaN, infinite or negative channel values replaced with 0", name, invalid_);
   std::vector<float> weight = samplingWeights(img, opts.bilinear, opts.misCompensation);

@@ -91,6 +91,8 @@ class EnvironmentMap {
   int width_ = 0, height_ = 0;
   std::vector<float> texels_;
   bool rowsFromPoles_ = false;
+  // Writes img's r, g, b (the map's size) into the texels' lookup channels.
+  void setLookupRgb(const Image& img);
   Color texelAt(int x, int y) const {
     const float* p = &texels_[(size_t(y) * width_ + x) * 4];
     return {p[0], p[1], p[2]};
