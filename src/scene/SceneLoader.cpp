@@ -476,9 +476,10 @@ class Loader {
       fail(f, n, "film width and height must be between 1 and 32768");
     // envgi draws each pixel's samples from its filter, so border pixels always see the whole
     // filter: what sample_border (high_quality_edges in Mitsuba 0.6) turns on in Mitsuba.
-    for (const char* harmless :
-         {"pixel_format", "file_format", "component_format", "banner", "high_quality_edges", "sample_border"})
-      find(p, harmless);
+    // The others change only how Mitsuba writes its file; each is still read with its type, so
+    // that a misspelt value is the error it is in Mitsuba.
+    for (const char* harmless : {"banner", "high_quality_edges", "sample_border"}) getBool(f, p, harmless, false);
+    for (const char* harmless : {"pixel_format", "file_format", "component_format"}) getString(f, p, harmless, "");
     warnUnused(f, p, "film");
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element) continue;

@@ -330,6 +330,35 @@ TEST(SceneLoader, HarmlessUnsupportedElementsOnlyWarn) {
   EXPECT_EQ(s.shapes[1].radiance.x, 1.f) << "an emitter's texture keeps the default radiance";
 }
 
+// The film's settings that change only how Mitsuba writes its file are accepted, each with its
+// own type, so that a value of the wrong kind is an error rather than silently ignored.
+TEST(SceneLoader, FilmFileSettingsAreReadWithTheirTypes) {
+  auto withFilm = [](const std::string& extra) {
+    std::string sensor = kSensor;
+    const std::string film = "<film type=\"hdrfilm\">";
+    sensor.replace(sensor.find(film), film.size(), film + extra);
+    return sensor;
+  };
+  Fixture f;
+  Scene s;
+  EXPECT_NO_THROW(loadScene(f.scene(withFilm(R"(<boolean name="sample_border" value="true"/>
+      <boolean name="banner" value="false"/><boolean name="high_quality_edges" value="true"/>
+      <string name="pixel_format" value="rgba"/><string name="file_format" value="openexr"/>
+      <string name="component_format" value="float16"/>)")),
+                            {}, s));
+  EXPECT_EQ(s.camera.width, 64);
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<string name="sample_border" value="true"/>)", "sample_border"},
+      {R"(<boolean name="banner" value="maybe"/>)", "maybe"},
+      {R"(<integer name="pixel_format" value="3"/>)", "pixel_format"},
+  };
+  for (const auto& [extra, expect] : bad) {
+    std::string err = loadError(f.scene(withFilm(extra)));
+    EXPECT_FALSE(err.empty()) << extra;
+    EXPECT_NE(err.find(expect), std::string::npos) << extra << "\n got: " << err;
+  }
+}
+
 TEST(SceneLoader, DirectionalAndPointEmitters) {
   Fixture f;
   Scene s;
