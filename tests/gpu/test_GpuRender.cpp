@@ -4,9 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdlib>
 #include <cstdio>
+#include <filesystem>
+#include <unistd.h>
 #include <tuple>
 
 #include "accel/Bvh.h"
@@ -20,8 +23,11 @@
 #include "scene/SceneLoader.h"
 #include "support/ImageAgreement.h"
 #include "support/RegionZTest.h"
+#include "image/Image.h"
+#include "view/ViewSessionProbe.h"
 
 using namespace envgi;
+using json = nlohmann::json;
 
 namespace {
 
@@ -73,7 +79,22 @@ Image renderOnCpu(const Scene& s, const RenderOptions& o, RenderStats* st) {
 struct Case {
   std::string scene, integrator, strategy;
   float aperture = 0.f;  // > 0: seen through a thin lens focused at 6.1
+  bool spot = false;     // the point lights become spots aimed at the origin
 };
+
+// Turns each point light into a spot aimed at the origin (cutoff 30 degrees, beam 20), so that
+// the cone's edge and its linear falloff cross the image.
+void pointLightsToSpots(Scene* s) {
+  for (DeltaLight& l : s->deltaLights) {
+    if (!l.point) continue;
+    l.axis = normalize(-l.v);
+    l.cutoff = 30.f * kPi / 180.f;
+    float beam = 20.f * kPi / 180.f;
+    l.cosCutoff = std::cos(l.cutoff);
+    l.cosBeam = std::cos(beam);
+    l.invTransition = 1.f / (l.cutoff - beam);
+  }
+}
 
 }  // namespace
 
@@ -82,6 +103,7 @@ TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
   for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured", "microfacets", "brushed", "sun-and-sky"})
     cases.push_back({sc, "path", "mis"});
   cases.push_back({"textured", "path", "mis", 0.2f});
+  cases.push_back({"sun-and-sky", "path", "mis", 0.f, true});
   for (std::string st : {"uniform", "cosine", "bsdf", "importance", "alias", "adaptive", "mis", "product"})
     cases.push_back({"buddha", "direct", st});
   const int region = 8, regionsPerCase = (kRes / region) * (kRes / region);
@@ -94,6 +116,7 @@ TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
     s.integrator.env.strategy = c.strategy;
     s.camera.apertureRadius = c.aperture;
     s.camera.focusDistance = 6.1f;
+    if (c.spot) pointLightsToSpots(&s);
     s.sampler.seed = 1;
     s.finalize();
     Result cpu = renderOn(false, s, 128);
@@ -106,8 +129,8 @@ TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
       mc += cpu.img.rgb[i];
       mg += gpu.img.rgb[i];
     }
-    std::printf("%-12s %-6s %-10s %s min p %.3g (alpha %.2g), image mean GPU/CPU %.4f, %.1f vs %.1f Mrays/s\n",
-                c.scene.c_str(), c.integrator.c_str(), c.strategy.c_str(), c.aperture > 0.f ? "lens" : "", p, alpha, mg / mc,
+    std::printf("%-12s %-6s %-10s %s%s min p %.3g (alpha %.2g), image mean GPU/CPU %.4f, %.1f vs %.1f Mrays/s\n",
+                c.scene.c_str(), c.integrator.c_str(), c.strategy.c_str(), c.aperture > 0.f ? "lens" : "", c.spot ? "spot" : "", p, alpha, mg / mc,
                 gpu.stats.raysPerSecond() / 1e6, cpu.stats.raysPerSecond() / 1e6);
     EXPECT_GT(p, alpha) << c.scene << " " << c.integrator << " " << c.strategy;
     EXPECT_EQ(gpu.stats.nonFiniteSamples, 0u);
@@ -288,6 +311,41 @@ TEST(GpuRender, AdaptiveSamplingStopsConvergedPixels) {
               100.0 * double(st.pixelSamples) / (double(kRes) * kRes * 64),
               100.0 * double(cst.pixelSamples) / (double(kRes) * kRes * 64), a.meanRatio);
   EXPECT_NEAR(a.meanRatio, 1.0, 0.02);
+}
+
+// The viewer on the GPU (`envgi view --device cuda --noise-threshold`): the session makes its
+// executor through the GPU's preparer, pixels stop once converged, and the image divides each
+// by its own samples, so its mean agrees with the same session's full render.
+TEST(GpuRender, ViewerRefinesAdaptivelyOnTheDevice) {
+  namespace fs = std::filesystem;
+  fs::path dir = fs::temp_directory_path() / ("envgi_gpu_view_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  test::Sink sink;
+  ViewOptions vo;
+  vo.noiseThreshold = 0.1f;
+  vo.adaptiveMinSpp = 4;
+  auto calls = std::make_shared<std::atomic<int>>(0);
+  vo.prepare = [calls, cuda = gpu::cudaPreparer(0)](const Scene& sc, const EmbreeAccel& a, const RenderOptions& o) {
+    ++*calls;
+    return cuda(sc, a, o);
+  };
+  auto session = test::makeSession(dir.string(), sink, vo, 256);
+  json done = test::frameWhere(*session, sink, [](const json& f) { return f["converged"] == true; });
+  ASSERT_FALSE(done.is_null());
+  EXPECT_EQ(calls->load(), 1) << "the session's executor came from the GPU's preparer";
+  EXPECT_LT(done["spp"].get<int>(), 256);
+  EXPECT_GE(done["meanSpp"].get<double>(), 4.0);
+  EXPECT_LT(done["meanSpp"].get<double>(), done["spp"].get<double>());
+  Image early = loadImage(json::parse(session->handle(R"({"type":"save"})"))["path"]);
+  session->handle(R"({"type":"adaptive","threshold":0})");
+  json full = test::frameWhere(*session, sink, [](const json& f) { return f["spp"] == 256 && f["adaptive"] == false; });
+  ASSERT_FALSE(full.is_null());
+  Image ref = loadImage(json::parse(session->handle(R"({"type":"save"})"))["path"]);
+  std::printf("viewer on the GPU: converged at %d passes, mean %.1f spp; image mean %.4f against %.4f at 256\n",
+              done["spp"].get<int>(), done["meanSpp"].get<double>(), test::meanOfImage(early), test::meanOfImage(ref));
+  EXPECT_NEAR(test::meanOfImage(early), test::meanOfImage(ref), 0.05 * test::meanOfImage(ref));
+  session->stop();
+  fs::remove_all(dir);
 }
 
 // Without machine code for the device, every program start spends seconds in the driver's

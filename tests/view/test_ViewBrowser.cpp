@@ -10,6 +10,7 @@
 
 #include "cli/CliRunner.h"
 #include "image/Image.h"
+#include "view/BallScene.h"
 #include "view/BrowserDriver.h"
 
 using namespace envgi;

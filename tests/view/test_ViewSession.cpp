@@ -10,54 +10,18 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/CliRunner.h"
-#include "view/BrowserDriver.h"
 #include "scene/SceneLoader.h"
 #include "view/ViewSession.h"
+#include "view/ViewSessionProbe.h"
 
 using namespace envgi;
 using json = nlohmann::json;
+using test::frameWhere;
+using test::makeSession;
+using test::meanOfImage;
+using test::Sink;
 
 namespace {
-
-// Collects what the session hands out, and waits for it.
-struct Sink {
-  std::mutex m;
-  std::condition_variable cv;
-  std::vector<ViewFrame> frames;
-  void operator()(ViewFrame f) {
-    std::lock_guard<std::mutex> l(m);
-    frames.push_back(std::move(f));
-    cv.notify_all();
-  }
-  // The next frame after `count` (a JSON meta), or fails the test after 30 s.
-  json waitFor(size_t count, std::string* jpeg = nullptr) {
-    std::unique_lock<std::mutex> l(m);
-    bool ok = cv.wait_for(l, std::chrono::seconds(30), [&] { return frames.size() > count; });
-    if (!ok) {
-      ADD_FAILURE() << "no frame within 30 s";
-      return json{};
-    }
-    if (jpeg) *jpeg = frames[count].jpeg;
-    return json::parse(frames[count].meta);
-  }
-};
-
-std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& sink, ViewOptions vo = {}, int maxSpp = 16) {
-  std::string xml = dir + "/ball.xml";
-  test::writeBallScene(xml, 24, 16, "");
-  auto scene = std::make_unique<Scene>();
-  loadScene(xml, {}, *scene);
-  GridSettings& grid = scene->integrator.grid;  // small, so that the grid is quick to make
-  grid.globalPhotons = 5000;
-  grid.causticPhotons = 0;
-  grid.resolution = 8;
-  grid.gatherRays = 16;
-  vo.threads = 1;
-  vo.maxSpp = maxSpp;
-  auto s = std::make_unique<ViewSession>(std::move(scene), xml, vo);
-  s->start([&sink](ViewFrame f) { sink(std::move(f)); });
-  return s;
-}
 
 // The error a message gets, or "" when the session takes it.
 std::string errorOfMessage(ViewSession& session, const std::string& message) {
@@ -236,30 +200,6 @@ TEST(ViewSession, ExecutorsComeFromTheInjectedPreparer) {
   EXPECT_EQ(session->preparations(), calls->load());
 }
 
-namespace {
-// Asks for frames until one satisfies pred; null after `tries` frames without one.
-template <class Pred>
-json frameWhere(ViewSession& session, Sink& sink, Pred pred, int tries = 400) {
-  for (int i = 0; i < tries; ++i) {
-    size_t n;
-    {
-      std::lock_guard<std::mutex> l(sink.m);
-      n = sink.frames.size();
-    }
-    session.requestFrame();
-    json f = sink.waitFor(n);
-    if (f.is_null()) return f;
-    if (pred(f)) return f;
-  }
-  ADD_FAILURE() << "no such frame in " << tries;
-  return json{};
-}
-double meanOfImage(const Image& img) {
-  double s = 0.0;
-  for (float v : img.rgb) s += v;
-  return s / double(std::max<size_t>(1, img.rgb.size()));
-}
-}  // namespace
 
 // A noise threshold (from the command line, then from the page) stops refining the pixels
 // that converged; the image divides each pixel by its own samples, so it agrees with a full
