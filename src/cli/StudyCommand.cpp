@@ -36,6 +36,8 @@ struct StudyArgs {
                                      spp = "1,4,16,64,256", times, integrator = "direct";
   std::vector<std::string> defines;
   int seeds = 2, referenceSpp = 4096, threads = 0, gpu = 0;
+  float noiseThreshold = 0.f;  // adaptive sampling in every run but the reference; 0: off
+  int minSpp = 16;
   std::string device = "auto";
 };
 
@@ -81,6 +83,7 @@ void applyStrategy(const std::string& name, Scene& scene) {
 struct Rendered {
   Image image;
   double seconds = 0.0;
+  double meanSpp = 0.0;  // samples taken a pixel, on average
   std::string device;
 };
 
@@ -92,7 +95,7 @@ using Preparer = std::function<PreparedRender(const Scene&, const EmbreeAccel&, 
 // the vertex buffers Embree reads in place). Its seconds are the render's alone, without the
 // GPU's scene upload, so that equal-time budgets compare sampling, not start-up.
 Rendered renderOnce(const StudyArgs& a, Scene& scene, const EmbreeAccel& accel, const Preparer& prepare,
-                    const std::string& strategy, int spp, uint32_t seed) {
+                    const std::string& strategy, int spp, uint32_t seed, bool reference = false) {
   applyStrategy(strategy, scene);
   scene.sampler.seed = seed;
   scene.finalize();
@@ -100,12 +103,17 @@ Rendered renderOnce(const StudyArgs& a, Scene& scene, const EmbreeAccel& accel, 
   o.spp = spp;
   o.progress = false;
   o.threads = a.threads;
+  if (!reference) {
+    o.noiseThreshold = a.noiseThreshold;
+    o.adaptiveMinSpp = a.minSpp;
+  }
   RenderStats st;
   Rendered r;
   PreparedRender pr = prepare ? prepare(scene, accel, o) : prepareRender(scene, accel, o);
   r.image = renderPasses(*pr.executor, scene.camera.width, scene.camera.height, pr.spp, o, &st);
   r.device = pr.executor->deviceName();
   r.seconds = st.seconds;
+  r.meanSpp = double(st.pixelSamples) / (double(scene.camera.width) * double(scene.camera.height));
   return r;
 }
 
@@ -117,7 +125,7 @@ std::string runKey(const StudyRun& r) {
 nlohmann::json toJson(const StudyRun& r) {
   return {{"strategy", r.strategy}, {"spp", r.spp},          {"time_budget", r.timeBudget}, {"seed", r.seed},
           {"seconds", r.seconds},   {"rmse", r.rmse},        {"relmse", r.relMse},
-          {"worst_region_rmse", r.worstRegionRmse}, {"device", r.device}};
+          {"worst_region_rmse", r.worstRegionRmse}, {"device", r.device}, {"mean_spp", r.samplesTaken()}};
 }
 
 StudyRun fromJson(const nlohmann::json& j) {
@@ -131,6 +139,7 @@ StudyRun fromJson(const nlohmann::json& j) {
   r.relMse = j.at("relmse");
   r.worstRegionRmse = j.value("worst_region_rmse", 0.0);
   r.device = j.value("device", std::string());
+  r.meanSpp = j.value("mean_spp", 0.0);
   return r;
 }
 
@@ -144,12 +153,15 @@ nlohmann::json studySettings(const StudyArgs& a) {
   for (unsigned char c : xml) h = (h ^ c) * 1099511628211ull;
   nlohmann::json defines = nlohmann::json::object();
   for (const auto& [k, v] : parseDefines(a.defines)) defines[k] = v;
-  return {{"scene", fs::path(a.scene).filename().string()},
-          {"scene_fnv1a", fmt::format("{:016x}", h)},
-          {"defines", defines},
-          {"integrator", a.integrator},
-          {"reference", a.reference.empty() ? fmt::format("rendered with mis at {} spp", a.referenceSpp)
-                                            : fs::absolute(a.reference).lexically_normal().string()}};
+  nlohmann::json s = {{"scene", fs::path(a.scene).filename().string()},
+                      {"scene_fnv1a", fmt::format("{:016x}", h)},
+                      {"defines", defines},
+                      {"integrator", a.integrator},
+                      {"reference", a.reference.empty() ? fmt::format("rendered with mis at {} spp", a.referenceSpp)
+                                                        : fs::absolute(a.reference).lexically_normal().string()}};
+  // Recorded only when on, so that a folder made before adaptive sampling reads as it was.
+  if (a.noiseThreshold > 0.f) s["adaptive_sampling"] = {{"noise_threshold", a.noiseThreshold}, {"min_spp", a.minSpp}};
+  return s;
 }
 
 // Refuses a folder whose recorded settings differ from this run's, naming what differs; returns
@@ -171,6 +183,9 @@ nlohmann::json checkStudyFolder(const StudyArgs& a) {
         if (!before.contains(key) || before[key] != value)
           diff += fmt::format("{}{}: {} before, {} now", diff.empty() ? "" : "; ", key,
                               before.contains(key) ? before[key].dump() : "none", value.dump());
+      for (const auto& [key, value] : before.items())
+        if (!now.contains(key))
+          diff += fmt::format("{}{}: {} before, none now", diff.empty() ? "" : "; ", key, value.dump());
       throw std::runtime_error(fmt::format("{} holds a study made with other settings ({}); choose another -o folder "
                                            "or remove it",
                                            a.out, diff));
@@ -195,6 +210,12 @@ void runStudy(const StudyArgs& a) {
   if (strategies.empty()) throw std::runtime_error("--strategies is empty");
   if (sppList.empty()) throw std::runtime_error("--spp is empty");
   if (a.seeds < 1) throw std::runtime_error("--seeds must be at least 1");
+  if (a.noiseThreshold > 0.f) {
+    spdlog::info("study: adaptive sampling in every run, noise threshold {:g} from {} spp", a.noiseThreshold, a.minSpp);
+    if (a.minSpp >= sppList.back())
+      spdlog::warn("--min-spp {} is not below the largest --spp ({}): adaptive sampling never checks a pixel", a.minSpp,
+                   sppList.back());
+  }
   IntegratorType integrator = findIntegrator(a.integrator);
   if (!hasSampleKernel(integrator)) throw std::runtime_error("--integrator must be direct or path");
   Scene scene;
@@ -223,7 +244,7 @@ void runStudy(const StudyArgs& a) {
     spdlog::info("study: reference {}", refPath);
   } else {
     spdlog::info("study: rendering the reference, mis at {} spp", a.referenceSpp);
-    Rendered r = renderOnce(a, scene, accel, prepare, "mis", a.referenceSpp, 1000003u);
+    Rendered r = renderOnce(a, scene, accel, prepare, "mis", a.referenceSpp, 1000003u, true);
     ref = r.image;
     saveImage(ref, refPath);
     spdlog::info("study: reference done in {:.1f} s", r.seconds);
@@ -277,6 +298,7 @@ void runStudy(const StudyArgs& a) {
       ImageError e = imageError(img.image, ref);
       r.seconds = img.seconds;
       r.device = img.device;
+      r.meanSpp = img.meanSpp;
       r.rmse = e.rmse;
       r.relMse = e.relMse;
       r.worstRegionRmse = e.worstRegionRmse;
@@ -292,11 +314,11 @@ void runStudy(const StudyArgs& a) {
     }
     runs.push_back(r);
   }
-  std::string csv = "strategy,spp,time_budget,seed,seconds,rmse,relmse,worst_region_rmse,device\n";
+  std::string csv = "strategy,spp,time_budget,seed,seconds,rmse,relmse,worst_region_rmse,device,mean_spp\n";
   nlohmann::json all = nlohmann::json::array();
   for (const StudyRun& r : runs) {
-    csv += fmt::format("{},{},{},{},{:.6f},{:.8g},{:.8g},{:.8g},\"{}\"\n", r.strategy, r.spp, r.timeBudget, r.seed,
-                       r.seconds, r.rmse, r.relMse, r.worstRegionRmse, r.device);
+    csv += fmt::format("{},{},{},{},{:.6f},{:.8g},{:.8g},{:.8g},\"{}\",{:.6g}\n", r.strategy, r.spp, r.timeBudget,
+                       r.seed, r.seconds, r.rmse, r.relMse, r.worstRegionRmse, r.device, r.samplesTaken());
     all.push_back(toJson(r));
   }
   writeFileAtomically(a.out + "/results.csv", csv);
@@ -326,6 +348,13 @@ void addStudyCommand(CLI::App& app) {
   c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(atLeast(0));
   c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
   c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(atLeast(0));
+  c->add_option("--noise-threshold", a->noiseThreshold,
+                "Adaptive sampling in every run (not the reference): a pixel stops once its noise is below this "
+                "(as render's; default 0: off)")
+      ->check(atLeast(0))
+      ->check(finiteNumber());
+  c->add_option("--min-spp", a->minSpp, "With --noise-threshold: samples every pixel takes first (default 16)")
+      ->check(atLeast(2));
   c->callback([a] { runStudy(*a); });
 }
 

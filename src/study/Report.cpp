@@ -114,7 +114,7 @@ std::string svgLogLogPlot(const std::string& title, const std::string& xLabel, c
 std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun>& runs, const Image& reference,
                             const std::vector<StudyImage>& images, const std::vector<std::string>& strategies) {
   // Median over seeds for each (strategy, spp) and (strategy, time budget).
-  std::map<std::pair<std::string, int>, std::vector<double>> bySpp, secBySpp;
+  std::map<std::pair<std::string, int>, std::vector<double>> bySpp, secBySpp, takenBySpp;
   std::map<std::pair<std::string, double>, std::vector<double>> byTime, secByTime;
   std::vector<int> sppList;
   for (const StudyRun& r : runs) {
@@ -124,16 +124,20 @@ std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun
     } else {
       bySpp[{r.strategy, r.spp}].push_back(r.rmse);
       secBySpp[{r.strategy, r.spp}].push_back(r.seconds);
+      takenBySpp[{r.strategy, r.spp}].push_back(r.samplesTaken());
       if (std::find(sppList.begin(), sppList.end(), r.spp) == sppList.end()) sppList.push_back(r.spp);
     }
   }
   std::sort(sppList.begin(), sppList.end());
+  // With adaptive sampling a run takes fewer samples than its budget: plot and tabulate those.
+  bool adaptive = false;
+  for (const StudyRun& r : runs) adaptive = adaptive || r.samplesTaken() < double(r.spp);
   std::vector<std::vector<double>> xs, ys, tx, ty;
   for (const std::string& s : strategies) {
     std::vector<double> x, y, a, b;
     for (int n : sppList)
       if (bySpp.count({s, n})) {
-        x.push_back(n);
+        x.push_back(median(takenBySpp[{s, n}]));
         y.push_back(median(bySpp[{s, n}]));
       }
     for (auto& [k, v] : byTime)
@@ -157,7 +161,11 @@ std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun
   h += "<p>RMSE against the reference, median over seeds. Lower is better; a slope of -1/2 on the "
        "samples plot is an unbiased estimator's Monte Carlo rate, a flattening curve is bias (the "
        "collapsed map, <code>points-N</code>).</p>";
-  h += svgLogLogPlot("RMSE against samples per pixel", "samples per pixel", "RMSE", strategies, xs, ys);
+  if (adaptive)
+    h += "<p>Adaptive sampling: each run stopped its converged pixels, so it took fewer samples than its "
+         "budget. The samples plot and the table give the samples taken, a pixel's mean.</p>";
+  h += svgLogLogPlot("RMSE against samples per pixel", adaptive ? "samples taken per pixel (mean)" : "samples per pixel",
+                     "RMSE", strategies, xs, ys);
   bool anyTime = !byTime.empty();
   if (anyTime) h += svgLogLogPlot("RMSE against render time", "seconds", "RMSE", strategies, tx, ty);
   h += "<h2>Images</h2><div>";
@@ -175,8 +183,10 @@ std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun
   for (const std::string& s : strategies) {
     h += "<tr><th>" + escape(s) + "</th>";
     for (int n : sppList)
-      h += bySpp.count({s, n}) ? fmt::format("<td>{:.5f}<br><small>{:.2f} s</small></td>", median(bySpp[{s, n}]),
-                                             median(secBySpp[{s, n}]))
+      h += bySpp.count({s, n}) ? fmt::format("<td>{:.5f}<br><small>{:.2f} s{}</small></td>", median(bySpp[{s, n}]),
+                                             median(secBySpp[{s, n}]),
+                                             adaptive ? fmt::format(", {:.1f} spp taken", median(takenBySpp[{s, n}]))
+                                                      : std::string())
                                : std::string("<td></td>");
     h += "</tr>";
   }

@@ -16,6 +16,10 @@ struct StudyRun {
   int seed = 0;
   double seconds = 0.0, rmse = 0.0, relMse = 0.0, worstRegionRmse = 0.0;
   std::string device{};  // what rendered it ("cpu", "cuda:0 (NVIDIA H200, regeneration)"): times depend on it
+  // Samples taken a pixel, on average: spp, or fewer where adaptive sampling stopped pixels
+  // (0: not recorded, read as spp).
+  double meanSpp = 0.0;
+  double samplesTaken() const { return meanSpp > 0.0 ? meanSpp : double(spp); }
 };
 
 struct StudyImage {

@@ -27,8 +27,9 @@ TEST(StudyCli, WritesResultsAndResumes) {
   std::string csv = slurp(out + "/results.csv");
   EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 3 * 2 + 3);  // header, spp runs, time runs
   // Each run says what rendered it: times, and so equal-time results, are the device's.
-  EXPECT_EQ(csv.substr(0, csv.find('\n')), "strategy,spp,time_budget,seed,seconds,rmse,relmse,worst_region_rmse,device");
-  EXPECT_NE(csv.find(",\"cpu\"\n"), std::string::npos) << csv;
+  EXPECT_EQ(csv.substr(0, csv.find('\n')),
+            "strategy,spp,time_budget,seed,seconds,rmse,relmse,worst_region_rmse,device,mean_spp");
+  EXPECT_NE(csv.find(",\"cpu\",16\n"), std::string::npos) << "without adaptive sampling every sample is taken\n" << csv;
   // The unbiased strategies converge: importance at 16 spp beats importance at 1.
   auto rmseOf = [&](const std::string& prefix) {
     size_t p = csv.find(prefix);
@@ -47,6 +48,49 @@ TEST(StudyCli, WritesResultsAndResumes) {
   CliResult again = runCli(args);
   ASSERT_EQ(again.code, 0) << again.output;
   EXPECT_NE(again.output.find("9 runs (9 already done)"), std::string::npos) << again.output;
+}
+
+// --noise-threshold: every run but the reference samples adaptively; each records the samples it
+// took (mean_spp), the report plots against those, and the folder keeps the threshold, so a
+// re-run with another (or none) is refused rather than mixing runs.
+TEST(StudyCli, AdaptiveSamplingRecordsTheSamplesTaken) {
+  TempDir d;
+  std::string out = d.file("study");
+  std::string base = "study " + buddha() + " -o " + out + " -D res=24 --spp 4,64 --seeds 1 --reference-spp 256 " +
+                     "--strategies mis,uniform --min-spp 4";
+  CliResult r = runCli(base + " --noise-threshold 0.3");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("adaptive sampling in every run, noise threshold 0.3 from 4 spp"), std::string::npos)
+      << r.output;
+  std::stringstream csv(slurp(out + "/results.csv"));
+  std::string line;
+  std::getline(csv, line);
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    std::vector<std::string> f;
+    std::stringstream ls(line);
+    for (std::string x; std::getline(ls, x, ',');) f.push_back(x);
+    ASSERT_EQ(f.size(), 10u) << line;
+    int spp = std::stoi(f[1]);
+    double taken = std::stod(f[9]);
+    if (spp == 4) EXPECT_EQ(taken, 4.0) << "no check before the minimum: " << line;
+    if (spp == 64) {
+      EXPECT_LT(taken, 64.0) << "the map's background converges early: " << line;
+      EXPECT_GE(taken, 4.0) << line;
+    }
+    ++rows;
+  }
+  EXPECT_EQ(rows, 4);
+  EXPECT_NE(slurp(out + "/study.json").find("\"noise_threshold\""), std::string::npos);
+  EXPECT_NE(slurp(out + "/report.html").find("spp taken"), std::string::npos);
+  for (const char* other : {" --noise-threshold 0.2", ""}) {
+    CliResult refused = runCli(base + other);
+    EXPECT_NE(refused.code, 0) << other;
+    EXPECT_NE(refused.output.find("adaptive_sampling"), std::string::npos) << refused.output;
+  }
+  CliResult bad = runCli(base + " --noise-threshold -1");
+  EXPECT_NE(bad.code, 0);
+  EXPECT_NE(bad.output.find("--noise-threshold"), std::string::npos) << bad.output;
 }
 
 // A folder keeps the settings its runs were made with (study.json): a re-run with another
