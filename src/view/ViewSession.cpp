@@ -318,17 +318,20 @@ void ViewSession::run() {
           spdlog::info("view: {} ready in {:.2f} s", s.integrator,
                        std::chrono::duration<double>(Clock::now() - tp).count());
         }
-      } catch (const std::runtime_error& e) {
+        pixels = ActivePixels(scene_->camera.width, scene_->camera.height, s.noiseThreshold);
+        adaptive = pixels.attach(*pr.executor);
+      } catch (const std::exception& e) {
+        // Any failure (a bad setting, memory for a huge film) ends this render, not the viewer.
         spdlog::warn("view: {}", e.what());
         pr = PreparedRender{};
         prIntegrator.clear();
+        pixels = ActivePixels(0, 0, 0.f);
+        adaptive = false;
         if (sink_) sink_(ViewFrame{json{{"type", "error"}, {"message", e.what()}}.dump(), ""});
       }
       spp = 0;
       sentSpp = -1;
       t0 = Clock::now();
-      pixels = ActivePixels(scene_->camera.width, scene_->camera.height, s.noiseThreshold);
-      adaptive = pr.executor && pixels.attach(*pr.executor);
     }
     if (spp < limit()) {
       pr.executor->runPass(spp, spp + 1, quiet, &counters);

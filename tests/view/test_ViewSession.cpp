@@ -273,6 +273,31 @@ TEST(ViewSession, BadAdaptiveMessagesAreErrors) {
   EXPECT_EQ(hello["minSpp"], 16);
 }
 
+// An executor that cannot do what the page asked (here, one that keeps no variance under a
+// noise threshold) ends that render with an error message to the page, not the viewer's
+// thread; the next setting the page sends renders again.
+TEST(ViewSession, AnExecutorThatCannotSampleAdaptivelyIsAnErrorNotACrash) {
+  test::TempDir d;
+  Sink sink;
+  ViewOptions vo;
+  vo.noiseThreshold = 0.1f;
+  vo.adaptiveMinSpp = 4;
+  vo.prepare = [](const Scene& sc, const EmbreeAccel& accel, const RenderOptions& o) {
+    RenderOptions plain = o;
+    plain.noiseThreshold = 0.f;  // made without the variance a threshold needs
+    return prepareRender(sc, accel, plain);
+  };
+  auto session = makeSession(d.path.string(), sink, vo, 8);
+  json err = sink.waitFor(0);
+  ASSERT_FALSE(err.is_null());
+  EXPECT_EQ(err["type"], "error");
+  EXPECT_NE(err["message"].get<std::string>().find("variance"), std::string::npos) << err.dump();
+  EXPECT_EQ(session->handle(R"({"type":"adaptive","threshold":0})"), "");
+  json f = frameWhere(*session, sink, [](const json& m) { return m["type"] == "frame" && m["spp"] == 8; });
+  ASSERT_FALSE(f.is_null());
+  EXPECT_FALSE(f["adaptive"].get<bool>());
+}
+
 // A page that connects after the render has finished still gets the frame: the film is done,
 // so only pageConnected (not a plain request) sends it again.
 TEST(ViewSession, APageConnectingAfterTheLastSampleGetsTheFrame) {
