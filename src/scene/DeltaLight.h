@@ -20,6 +20,15 @@ struct DeltaLight {
 
 ENVGI_HD inline bool isSpot(const DeltaLight& l) { return l.point && l.cosCutoff >= -1.f; }
 
+// Makes a point light a spot of the given cone (radians, 0 < beam <= cutoff <= pi): the cosines
+// and the falloff's slope that spotFalloff reads.
+inline void setSpotCone(DeltaLight& l, float cutoff, float beam) {
+  l.cutoff = cutoff;
+  l.cosCutoff = std::cos(cutoff);
+  l.cosBeam = std::cos(beam);
+  l.invTransition = cutoff > beam ? 1.f / (cutoff - beam) : 0.f;
+}
+
 // Light n of n alike for r in [0, 1): the index next-event estimation and photon emission pick.
 ENVGI_HD inline int uniformLightIndex(float r, int n) {
   int i = int(r * float(n));

@@ -557,11 +557,7 @@ class Loader {
     float beam = getFloat(f, p, "beam_width", cutoff * 0.75f);
     if (!(cutoff > 0.f && cutoff <= 180.f)) fail(f, n, "cutoff_angle must be in (0, 180] degrees");
     if (!(beam > 0.f && beam <= cutoff)) fail(f, n, "beam_width must be in (0, cutoff_angle] degrees");
-    l.cutoff = cutoff * kPi / 180.f;
-    float beamRad = beam * kPi / 180.f;
-    l.cosCutoff = std::cos(l.cutoff);
-    l.cosBeam = std::cos(beamRad);
-    l.invTransition = l.cutoff > beamRad ? 1.f / (l.cutoff - beamRad) : 0.f;
+    setSpotCone(l, cutoff * kPi / 180.f, beam * kPi / 180.f);
     return l;
   }
 

@@ -88,11 +88,7 @@ void pointLightsToSpots(Scene* s) {
   for (DeltaLight& l : s->deltaLights) {
     if (!l.point) continue;
     l.axis = normalize(-l.v);
-    l.cutoff = 30.f * kPi / 180.f;
-    float beam = 20.f * kPi / 180.f;
-    l.cosCutoff = std::cos(l.cutoff);
-    l.cosBeam = std::cos(beam);
-    l.invTransition = 1.f / (l.cutoff - beam);
+    setSpotCone(l, 30.f * kPi / 180.f, 20.f * kPi / 180.f);
   }
 }
 
