@@ -329,7 +329,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     stats->cancelled = cancelled;
     stats->timeLimited = timeLimited;
     stats->pixelSamples = pixels.pixelSamples();
-    stats->pixelsStopped = adaptive ? px - pixels.activeCount() : 0;
+    stats->pixelsStopped = px - pixels.activeCount();  // 0 unless adaptive
     stats->converged = pixels.converged();
   }
   if (opts.varianceOut && sppDone > 0) {

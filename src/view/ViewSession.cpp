@@ -254,7 +254,6 @@ void ViewSession::run() {
   State s;
   // Adaptive sampling, as renderPasses does it; off for an executor that cannot mask pixels (SPPM).
   ActivePixels pixels(0, 0, 0.f);
-  bool adaptive = false;
   auto limit = [&] { return pr.executor && !pixels.converged() ? std::min(opts_.maxSpp, pr.spp) : 0; };
   // Whether the page asked for a frame that differs from the one it has (under mutex_).
   auto frameWanted = [&](const State& st) {
@@ -319,14 +318,13 @@ void ViewSession::run() {
                        std::chrono::duration<double>(Clock::now() - tp).count());
         }
         pixels = ActivePixels(scene_->camera.width, scene_->camera.height, s.noiseThreshold);
-        adaptive = pixels.attach(*pr.executor);
+        pixels.attach(*pr.executor);
       } catch (const std::exception& e) {
         // Any failure (a bad setting, memory for a huge film) ends this render, not the viewer.
         spdlog::warn("view: {}", e.what());
         pr = PreparedRender{};
         prIntegrator.clear();
         pixels = ActivePixels(0, 0, 0.f);
-        adaptive = false;
         if (sink_) sink_(ViewFrame{json{{"type", "error"}, {"message", e.what()}}.dump(), ""});
       }
       spp = 0;
@@ -338,7 +336,7 @@ void ViewSession::run() {
       ++spp;
       pixels.passDone(spp - 1, spp);
       // Every 4 passes from the minimum on: each check reads the film back (from a GPU too).
-      if (adaptive && spp >= s.minSpp && (spp - s.minSpp) % 4 == 0 && spp < limit()) {
+      if (pixels.adaptive() && spp >= s.minSpp && (spp - s.minSpp) % 4 == 0 && spp < limit()) {
         FilmSums film;
         pixels.update(*pr.executor, &film);
       }
@@ -378,7 +376,7 @@ void ViewSession::run() {
                   {"cameraVersion", s.cameraVersion},
                   {"integrator", s.integrator},
                   {"strategy", s.strategy},
-                  {"adaptive", adaptive},
+                  {"adaptive", pixels.adaptive()},
                   {"noiseThreshold", s.noiseThreshold},
                   {"sampling", double(pixels.activeCount()) / double(std::max<size_t>(1, pixels.pixelCount()))},
                   {"converged", pixels.converged()},
