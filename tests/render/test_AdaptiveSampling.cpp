@@ -15,6 +15,7 @@
 #include "scene/SceneLoader.h"
 #include "support/BundledScene.h"
 #include "support/ImageAgreement.h"
+#include "support/SmallGrid.h"
 
 using namespace envgi;
 
@@ -252,10 +253,7 @@ TEST(AdaptiveSampling, EveryPerPixelIntegratorTakesIt) {
     Scene s;
     test::loadBundledSmall("buddha", 16, type, &s);
     s.integrator.photon.globalPhotons = s.integrator.photon.causticPhotons = 5000;
-    s.integrator.grid.globalPhotons = 5000;
-    s.integrator.grid.causticPhotons = 0;
-    s.integrator.grid.resolution = 8;
-    s.integrator.grid.gatherRays = 16;
+    test::useSmallGrid(s.integrator.grid);
     s.finalize();
     EmbreeAccel accel(s);
     Rendered r = renderWith(s, accel, 32, 0.05f, 4);

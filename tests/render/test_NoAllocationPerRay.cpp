@@ -14,6 +14,7 @@
 #include "render/Renderer.h"
 #include "scene/NameTables.h"
 #include "support/BundledScene.h"
+#include "support/SmallGrid.h"
 
 namespace {
 std::atomic<uint64_t> gAllocations{0};
@@ -59,12 +60,7 @@ TEST(NoAllocationPerRay, APassAllocatesPerTileAtMost) {
       s.integrator.photon.globalPhotons = 20000;
       s.integrator.photon.causticPhotons = 20000;
     }
-    if (s.integrator.type == IntegratorType::Grid) {
-      s.integrator.grid.globalPhotons = 5000;
-      s.integrator.grid.causticPhotons = 0;
-      s.integrator.grid.resolution = 8;
-      s.integrator.grid.gatherRays = 16;
-    }
+    test::useSmallGrid(s.integrator.grid);
     s.finalize();
     EmbreeAccel accel(s);
     RenderOptions o;

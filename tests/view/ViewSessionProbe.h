@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "scene/SceneLoader.h"
+#include "support/SmallGrid.h"
 #include "view/BallScene.h"
 #include "view/ViewSession.h"
 
@@ -49,11 +50,7 @@ inline std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& si
   writeBallScene(xml, 24, 16, "");
   auto scene = std::make_unique<Scene>();
   loadScene(xml, {}, *scene);
-  GridSettings& grid = scene->integrator.grid;  // small, so that the grid is quick to make
-  grid.globalPhotons = 5000;
-  grid.causticPhotons = 0;
-  grid.resolution = 8;
-  grid.gatherRays = 16;
+  useSmallGrid(scene->integrator.grid);
   vo.threads = 1;
   vo.maxSpp = maxSpp;
   auto s = std::make_unique<ViewSession>(std::move(scene), xml, vo);
