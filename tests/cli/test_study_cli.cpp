@@ -88,9 +88,14 @@ TEST(StudyCli, AdaptiveSamplingRecordsTheSamplesTaken) {
     EXPECT_NE(refused.code, 0) << other;
     EXPECT_NE(refused.output.find("adaptive_sampling"), std::string::npos) << refused.output;
   }
-  CliResult bad = runCli(base + " --noise-threshold -1");
-  EXPECT_NE(bad.code, 0);
-  EXPECT_NE(bad.output.find("--noise-threshold"), std::string::npos) << bad.output;
+  for (const auto& [args, option] : {std::pair<std::string, std::string>{" --noise-threshold -1", "--noise-threshold"},
+                                     {" --noise-threshold nan", "--noise-threshold"},
+                                     {" --noise-threshold 0.1 --min-spp 1", "--min-spp"}}) {
+    CliResult bad = runCli(base + args);
+    EXPECT_EQ(bad.code, 2) << args << ": " << bad.output;
+    EXPECT_NE(bad.output.find("envgi: error: " + option), std::string::npos) << bad.output;
+    EXPECT_EQ(std::count(bad.output.begin(), bad.output.end(), '\n'), 1) << "one error line: " << bad.output;
+  }
 }
 
 // A folder keeps the settings its runs were made with (study.json): a re-run with another
