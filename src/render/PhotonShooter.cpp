@@ -137,6 +137,13 @@ void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* g
         spdlog::info("no caustic paths after {} photons: the caustic map stays empty", emitted);
         cDone = true;
       }
+      // Likewise no second surface for light to reach (a lone object or floor): the global map
+      // holds only photons after a bounce, and would otherwise spin up to the cap, 64 times the
+      // requested count.
+      if (!gDone && g.empty() && emitted >= (uint64_t(1) << 20)) {
+        spdlog::info("no indirect paths after {} photons: the global map stays empty", emitted);
+        gDone = true;
+      }
     }
     double t = std::chrono::duration<double>(Clock::now() - t0).count();
     if (s.progress && t - lastLog >= 2.0) {

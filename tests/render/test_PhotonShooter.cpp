@@ -6,6 +6,7 @@
 #include "accel/Bvh.h"
 #include "render/PhotonShooter.h"
 #include "scene/SceneLoader.h"
+#include "support/TestScenes.h"
 
 using namespace envgi;
 
@@ -91,4 +92,37 @@ TEST(PhotonShooter, GpuBodyOnTheBvhStoresWhatEmbreeDoes) {
     EXPECT_NEAR(power(b.global) / power(e.global), 1.0, 0.002) << name;
     EXPECT_NEAR(power(b.caustic) / power(e.caustic), 1.0, 0.002) << name;
   }
+}
+
+// A lone floor under a sky: light reaches no second surface, so neither map can hold a photon
+// (the global map stores only after a bounce). The pass gives up on each after 2^20 photons,
+// as it did on the caustic map, instead of shooting on to the cap, 64 times the count asked.
+TEST(PhotonShooter, AMapNothingCanReachStopsAfterAMillionPhotons) {
+  Bsdf diffuse;
+  auto white = [] {
+    Image sky(4, 2);
+    for (float& v : sky.rgb) v = 1.f;
+    return sky;
+  };
+  auto s = test::sphereOnFloor(diffuse, diffuse, 10.f, white(), Vec3f(0, 4, 3), Vec3f(0, 0, 0), 8, 30.f);
+  s->spheres.clear();
+  s->shapes.pop_back();
+  s->finalize();
+  EmbreeAccel accel(*s);
+  Maps m;
+  shoot(*s, accel, nullptr, &m);
+  EXPECT_EQ(m.stats.storedGlobal, 0u);
+  EXPECT_EQ(m.stats.storedCaustic, 0u);
+  const uint64_t million = uint64_t(1) << 20;
+  EXPECT_EQ(m.stats.emittedGlobal, million);
+  EXPECT_EQ(m.stats.emittedCaustic, million);
+
+  // With the ball back, some light bounces between floor and ball: a map that is only sparse
+  // goes on filling past 2^20 photons (here to the cap: the ball is small under a wide sky).
+  auto lit = test::sphereOnFloor(diffuse, diffuse, 10.f, white(), Vec3f(0, 4, 3), Vec3f(0, 0, 0), 8, 30.f);
+  EmbreeAccel litAccel(*lit);
+  Maps full;
+  shoot(*lit, litAccel, nullptr, &full);
+  EXPECT_GT(full.stats.storedGlobal, 0u);
+  EXPECT_GT(full.stats.emittedGlobal, 2 * million);
 }
