@@ -12,9 +12,7 @@
 #define ENVGI_HD_NOINLINE __host__ __device__ __noinline__
 #else
 #define ENVGI_HD
-// Always inlined, as __forceinline__ is on the device: GCC kept normalize() and other
-// one-liners out of line in the per-ray path (2-3 points of the Embree share, docs/performance.md).
-#define ENVGI_INLINE inline __attribute__((always_inline))
+#define ENVGI_INLINE inline
 #define ENVGI_HD_NOINLINE
 #endif
 
