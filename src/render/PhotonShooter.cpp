@@ -112,6 +112,14 @@ void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* g
     spdlog::warn("the scene emits no light: no photons shot");
     gDone = cDone = true;
   }
+  // A map still empty after 2^20 photons stays empty rather than spin on to the cap: no mirror
+  // or glass leads light to a diffuse surface (caustic), or light reaches no second surface, a
+  // lone object or floor (global, which keeps only photons after a bounce).
+  auto giveUpIfEmpty = [&emitted](bool* done, const std::vector<Photon>& map, const char* paths, const char* name) {
+    if (*done || !map.empty() || emitted < (uint64_t(1) << 20)) return;
+    spdlog::info("no {} paths after {} photons: the {} map stays empty", paths, emitted, name);
+    *done = true;
+  };
   std::vector<PhotonBatch> batches;
   while (!(gDone && cDone) && emitted < cap) {
     PhotonTraceRequest req;
@@ -132,18 +140,8 @@ void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* g
       if (!cDone) cEmitted = emitted;
       gDone = gDone || g.size() >= s.globalPhotons;
       cDone = cDone || c.size() >= s.causticPhotons;
-      // No specular surface in reach of the lights: do not spin on an empty caustic map.
-      if (!cDone && c.empty() && emitted >= (uint64_t(1) << 20)) {
-        spdlog::info("no caustic paths after {} photons: the caustic map stays empty", emitted);
-        cDone = true;
-      }
-      // Likewise no second surface for light to reach (a lone object or floor): the global map
-      // holds only photons after a bounce, and would otherwise spin up to the cap, 64 times the
-      // requested count.
-      if (!gDone && g.empty() && emitted >= (uint64_t(1) << 20)) {
-        spdlog::info("no indirect paths after {} photons: the global map stays empty", emitted);
-        gDone = true;
-      }
+      giveUpIfEmpty(&cDone, c, "caustic", "caustic");
+      giveUpIfEmpty(&gDone, g, "indirect", "global");
     }
     double t = std::chrono::duration<double>(Clock::now() - t0).count();
     if (s.progress && t - lastLog >= 2.0) {

@@ -37,10 +37,7 @@ std::unique_ptr<Scene> litFloor() {
 DeltaLight spotLight(Vec3f at, Vec3f axis, float intensity, float cutoffDeg, float beamDeg) {
   DeltaLight l{at, Color(intensity), true};
   l.axis = normalize(axis);
-  l.cutoff = cutoffDeg * kPi / 180.f;
-  l.cosCutoff = std::cos(l.cutoff);
-  l.cosBeam = std::cos(beamDeg * kPi / 180.f);
-  l.invTransition = 1.f / (l.cutoff - beamDeg * kPi / 180.f);
+  setSpotCone(l, cutoffDeg * kPi / 180.f, beamDeg * kPi / 180.f);
   return l;
 }
 
