@@ -10,6 +10,9 @@
 int main(int argc, char** argv) {
   CLI::App app{"envgi: global illumination from HDR environment maps"};
   app.require_subcommand(1);
+  // -v and -q also after the subcommand (envgi render scene.xml -q), as users type them; the
+  // subcommands made below inherit this.
+  app.fallthrough();
   app.set_version_flag("--version", std::string("envgi ") + ENVGI_VERSION);
   bool verbose = false, quiet = false;
   app.add_flag("-v,--verbose", verbose, "Debug logging");

@@ -399,6 +399,26 @@ TEST(RenderCli, DeviceChoice) {
 }
 
 // --sampler on render, --version, and parse errors as one `envgi: error:` line.
+// The log flags work before or after the subcommand: -q leaves warnings and errors only, -v is
+// accepted there too.
+TEST(RenderCli, LogFlagsBeforeOrAfterTheSubcommand) {
+  TempDir d;
+  std::string scene = tinyScene(d, 8, 1);
+  for (std::string args : {"-q render " + scene + " -o " + d.file("a.exr") + " --no-progress",
+                           "render " + scene + " -o " + d.file("b.exr") + " --no-progress -q"}) {
+    CliResult r = runCli(args);
+    EXPECT_EQ(r.code, 0) << args << ": " << r.output;
+    EXPECT_EQ(r.output.find("[info]"), std::string::npos) << args << ": " << r.output;
+  }
+  CliResult loud = runCli("render " + scene + " -o " + d.file("c.exr") + " --no-progress --verbose");
+  EXPECT_EQ(loud.code, 0) << loud.output;
+  EXPECT_NE(loud.output.find("[info]"), std::string::npos) << loud.output;
+  // An option no command knows is still one error line, exit 2.
+  CliResult bad = runCli("render " + scene + " -o " + d.file("d.exr") + " --bogus");
+  EXPECT_EQ(bad.code, 2) << bad.output;
+  EXPECT_FALSE(fs::exists(d.file("d.exr")));
+}
+
 TEST(RenderCli, SamplerVersionAndParseErrors) {
   TempDir d;
   std::string scene = tinyScene(d, 8, 2);
