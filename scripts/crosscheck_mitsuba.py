@@ -204,6 +204,10 @@ def main():
                 '<emitter type="spot"><transform name="to_world"><lookat origin="-0.5, 1.8, 0.8" target="-0.3, 0, -0.5" '
                 'up="0, 1, 0"/></transform><float name="cutoff_angle" value="25"/><rgb name="intensity" value="3, 2.5, 2"/>'
                 '</emitter></scene>'))
+    # The map turned about a tilted axis (envmap to_world): sun, shadows and background all move.
+    variant('buddha, map rotated', 'buddha',
+            lambda t: t.replace('<float name="scale" value="25"/>', '<float name="scale" value="25"/><transform '
+                                'name="to_world"><rotate y="1" angle="110"/><rotate x="1" angle="30"/></transform>'))
     configs = [c for c in configs if args.only in c[0]]
     total_regions = sum(c[3] * c[3] for c in configs)
     alpha = 1.0 - 0.99 ** (1.0 / total_regions)
