@@ -1,5 +1,6 @@
 #include "scene/TriangleMesh.h"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace envgi {
@@ -9,12 +10,28 @@ void TriangleMesh::transform(const Transform& t) {
   for (Vec3f& n : normals) n = normalize(t.normal(n));
 }
 
+namespace {
+// The angle between two unit vectors, without acos's loss of precision near 0 and pi.
+float angleBetweenUnit(Vec3f a, Vec3f b) {
+  return dot(a, b) < 0.f ? kPi - 2.f * std::asin(0.5f * length(a + b)) : 2.f * std::asin(0.5f * length(b - a));
+}
+}  // namespace
+
 void TriangleMesh::computeVertexNormals() {
   normals.assign(positions.size(), Vec3f(0.f));
   for (size_t i = 0; i + 2 < indices.size(); i += 3) {
-    Vec3f p0 = positions[indices[i]], p1 = positions[indices[i + 1]], p2 = positions[indices[i + 2]];
-    Vec3f n = cross(p1 - p0, p2 - p0);  // length = twice the area: area weighting for free
-    for (int k = 0; k < 3; ++k) normals[indices[i + k]] += n;
+    const Vec3f p[3] = {positions[indices[i]], positions[indices[i + 1]], positions[indices[i + 2]]};
+    Vec3f n = cross(p[1] - p[0], p[2] - p[0]);
+    float l = length(n);
+    if (!(l > 0.f)) continue;  // a degenerate triangle has no direction to give
+    n = n / l;
+    // Each corner adds the face's unit normal times its angle there (Thurmer and Wuthrich
+    // 1998), so a vertex's normal does not lean towards the side that is cut into more
+    // triangles. Mitsuba 3 and Blender weight this way.
+    for (int k = 0; k < 3; ++k) {
+      Vec3f e1 = p[(k + 1) % 3] - p[k], e2 = p[(k + 2) % 3] - p[k];
+      normals[indices[i + k]] += n * angleBetweenUnit(normalize(e1), normalize(e2));
+    }
   }
   for (Vec3f& n : normals) {
     float l = length(n);

@@ -17,7 +17,7 @@ struct TriangleMesh {
 
   size_t triangleCount() const { return indices.size() / 3; }
   void transform(const Transform& t);
-  // Area-weighted vertex normals, as Mitsuba computes for meshes that have none.
+  // Angle-weighted vertex normals, as Mitsuba 3 computes for meshes that have none.
   void computeVertexNormals();
   // Throws when an index is out of range or a coordinate is not finite.
   void validate() const;
