@@ -36,7 +36,17 @@ ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceIntera
   if (isBlack(f) || isBlack(ls.radiance)) return out;
   out.o = offsetRayOrigin(si.p, si.ng, ls.dir, si.t);
   out.d = ls.dir;
-  out.tMax = ls.environment ? INFINITY : ls.dist * (1.f - 1e-4f) - length(out.o - si.p);
+  out.tMax = INFINITY;
+  if (!ls.environment && ls.dist < INFINITY) {
+    // Aimed from the offset origin at the light's point itself, and stopped short of it: a ray
+    // kept parallel to ls.dir from the offset origin meets the light's plane short of the point
+    // where it comes in at a grazing angle, so the light shadowed itself there (a floor edge-on
+    // to a tilted square light lost all its light: LightSampling.ShadowRaysReachAGrazingLight).
+    Vec3f to = si.p + ls.dir * ls.dist - out.o;
+    float len = length(to);
+    out.d = to / len;
+    out.tMax = len * (1.f - 1e-4f);
+  }
   float w = nB > 0.f && !ls.delta ? powerHeuristic(nE, ls.pdf, nB, bsdfPdfOfLight) : 1.f;
   out.value = f * ls.radiance * (w / (ls.pdf * nE));
   out.needsRay = true;
