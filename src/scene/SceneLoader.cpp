@@ -909,7 +909,11 @@ class Loader {
       }
     }
     if (entry.bsdf < 0) {
-      scene_.bsdfs.push_back(Bsdf{});  // Mitsuba's default: diffuse, reflectance 0.5
+      // Mitsuba's default: diffuse, reflectance 0.5, or black on an area light (a grey light
+      // facing a wall reflected 4.8% more light into the Cornell box than Mitsuba's).
+      Bsdf b;
+      if (entry.emissive) b.reflectance = Color(0.f);
+      scene_.bsdfs.push_back(b);
       entry.bsdf = int(scene_.bsdfs.size() - 1);
     }
     warnUnused(f, p, "shape '" + type + "'");

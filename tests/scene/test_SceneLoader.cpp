@@ -130,9 +130,10 @@ TEST(SceneLoader, ShapesBsdfsEmittersTransformsDefaults) {
     <shape type="obj"><string name="filename" value="t.obj"/><bsdf type="thindielectric"/></shape>
     <shape type="sphere"><bsdf type="roughdielectric"/></shape>
     <shape type="sphere"><bsdf type="roughplastic"/></shape>
-    <shape type="sphere"><bsdf type="conductor"/></shape>)"),
+    <shape type="sphere"><bsdf type="conductor"/></shape>
+    <shape type="sphere"/>)"),
             {{"r", "3"}}, s);
-  ASSERT_EQ(s.shapes.size(), 9u);
+  ASSERT_EQ(s.shapes.size(), 10u);
   EXPECT_NEAR(s.env->view().scale, 3.f, 1e-6f) << "-D overrides <default>";
   // scale then translate, in Mitsuba's order: vertex (1,0,0) -> (2,0,0) -> (3,0,0).
   EXPECT_NEAR(s.meshes[0].positions[1].x, 3.f, 1e-5f);
@@ -145,6 +146,11 @@ TEST(SceneLoader, ShapesBsdfsEmittersTransformsDefaults) {
   EXPECT_TRUE(s.shapes[2].emissive);
   EXPECT_NEAR(s.shapes[2].radiance.x, 5.f, 1e-6f);
   EXPECT_EQ(s.lightCount(), 2u);  // two triangles
+  // Mitsuba's default BSDF: diffuse 0.5, black on an area light.
+  EXPECT_EQ(s.bsdfs[size_t(s.shapes[2].bsdf)].type, BsdfType::Diffuse);
+  EXPECT_EQ(s.bsdfs[size_t(s.shapes[2].bsdf)].reflectance.y, 0.f);
+  EXPECT_EQ(s.bsdfs[size_t(s.shapes[9].bsdf)].type, BsdfType::Diffuse);
+  EXPECT_EQ(s.bsdfs[size_t(s.shapes[9].bsdf)].reflectance.y, 0.5f);
   EXPECT_TRUE(s.bsdfs[size_t(s.shapes[3].bsdf)].twoSided);
   EXPECT_EQ(s.bsdfs[size_t(s.shapes[3].bsdf)].type, BsdfType::Plastic);
   EXPECT_NEAR(s.bsdfs[size_t(s.shapes[4].bsdf)].ior, 1.333f / 1.000277f, 1e-4f);
