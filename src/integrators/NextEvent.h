@@ -44,6 +44,7 @@ ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceIntera
     // to a tilted square light lost all its light: LightSampling.ShadowRaysReachAGrazingLight).
     Vec3f to = si.p + ls.dir * ls.dist - out.o;
     float len = length(to);
+    if (!(len > 0.f)) return out;  // the light's point is the origin itself: nothing to carry
     out.d = to / len;
     out.tMax = len * (1.f - 1e-4f);
   }
