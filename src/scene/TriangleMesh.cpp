@@ -26,8 +26,8 @@ void TriangleMesh::computeVertexNormals() {
     if (!(l > 0.f)) continue;  // a degenerate triangle has no direction to give
     n = n / l;
     // Each corner adds the face's unit normal times its angle there (Thurmer and Wuthrich
-    // 1998), so a vertex's normal does not lean towards the side that is cut into more
-    // triangles. Mitsuba 3 and Blender weight this way.
+    // 1998): a vertex's normal then follows the surface's shape around it, not the size or
+    // number of the triangles that tile it. Mitsuba 3 and Blender weight this way.
     for (int k = 0; k < 3; ++k) {
       Vec3f e1 = p[(k + 1) % 3] - p[k], e2 = p[(k + 2) % 3] - p[k];
       normals[indices[i + k]] += n * angleBetweenUnit(normalize(e1), normalize(e2));
