@@ -398,7 +398,6 @@ TEST(RenderCli, DeviceChoice) {
   }
 }
 
-// --sampler on render, --version, and parse errors as one `envgi: error:` line.
 // The log flags work before or after the subcommand: -q leaves warnings and errors only, -v is
 // accepted there too.
 TEST(RenderCli, LogFlagsBeforeOrAfterTheSubcommand) {
@@ -419,6 +418,7 @@ TEST(RenderCli, LogFlagsBeforeOrAfterTheSubcommand) {
   EXPECT_FALSE(fs::exists(d.file("d.exr")));
 }
 
+// --sampler on render, --version, and parse errors as one `envgi: error:` line.
 TEST(RenderCli, SamplerVersionAndParseErrors) {
   TempDir d;
   std::string scene = tinyScene(d, 8, 2);

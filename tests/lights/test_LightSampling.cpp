@@ -4,10 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <filesystem>
 #include <fstream>
 
 #include "accel/EmbreeAccel.h"
+#include "cli/CliRunner.h"
 #include "integrators/NextEvent.h"
 #include "lights/LightSampling.h"
 #include "sampling/Pcg32.h"
@@ -41,7 +41,8 @@ struct LitScene {
 // A 0.8 x 0.8 square light of radiance 3 at height 1, turned by tiltDeg about x from facing down.
 std::unique_ptr<LitScene> squareLight(float tiltDeg) {
   auto s = std::make_unique<LitScene>();
-  std::filesystem::path path = std::filesystem::temp_directory_path() / ("envgi_lightsampling_" + std::to_string(::getpid()) + ".xml");
+  test::TempDir dir;
+  std::string path = dir.file("light.xml");
   std::ofstream(path) << R"(<scene version="3.0.0">
   <sensor type="perspective"><transform name="to_world"><lookat origin="0,3,3" target="0,0,0"/></transform>
     <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
@@ -50,8 +51,7 @@ std::unique_ptr<LitScene> squareLight(float tiltDeg) {
     <emitter type="area"><rgb name="radiance" value="3"/></emitter></shape>
   <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform></shape>
 </scene>)";
-  loadScene(path.string(), {}, s->scene);
-  std::filesystem::remove(path);
+  loadScene(path, {}, s->scene);
   float t = (90.f + tiltDeg) * kPi / 180.f;
   auto rot = [&](Vec3f v) { return Vec3f(v.x, v.y * std::cos(t) - v.z * std::sin(t), v.y * std::sin(t) + v.z * std::cos(t)); };
   for (Vec3f c : {Vec3f(-1, -1, 0), Vec3f(1, -1, 0), Vec3f(1, 1, 0), Vec3f(-1, 1, 0)})
@@ -60,12 +60,18 @@ std::unique_ptr<LitScene> squareLight(float tiltDeg) {
   return s;
 }
 
-// The mean of L cos / pdf over next-event samples at p (normal +y): the irradiance estimate.
-double estimatedIrradiance(const SceneView& sc, Vec3f p, int n) {
+// A point of the floor (normal +y).
+SurfaceInteraction floorPoint(Vec3f p) {
   SurfaceInteraction si;
   si.p = p;
   si.ng = Vec3f(0, 1, 0);
   si.shading = Frame::fromNormal(si.ng);
+  return si;
+}
+
+// The mean of L cos / pdf over next-event samples at p: the irradiance estimate.
+double estimatedIrradiance(const SceneView& sc, Vec3f p, int n) {
+  SurfaceInteraction si = floorPoint(p);
   Pcg32 rng;
   rng.setSeed(7, 1);
   double sum = 0.0;
@@ -82,14 +88,8 @@ double estimatedIrradiance(const SceneView& sc, Vec3f p, int n) {
 
 // The same through prepareLd and its shadow ray, as the integrators take it: a white diffuse
 // floor at p reflects E / pi, so pi times the mean of the light samples' values is E.
-double shadowedIrradiance(const Scene& scene, Vec3f p, int n) {
-  const SceneView& sc = scene.view();
-  EmbreeAccel accel(scene);
-  EmbreeTracer tracer{&accel};
-  SurfaceInteraction si;
-  si.p = p;
-  si.ng = Vec3f(0, 1, 0);
-  si.shading = Frame::fromNormal(si.ng);
+double shadowedIrradiance(const SceneView& sc, const EmbreeTracer& tracer, Vec3f p, int n) {
+  SurfaceInteraction si = floorPoint(p);
   Bsdf white;
   white.reflectance = Color(1.f);
   Vec3f wo = normalize(Vec3f(0.2f, 1.f, 0.3f));
@@ -127,9 +127,10 @@ TEST(LightSampling, AreaLightIrradianceMatchesLambertsFormula) {
 TEST(LightSampling, ShadowRaysReachAGrazingLight) {
   for (float tilt : {0.f, 30.f, 60.f}) {
     auto s = squareLight(tilt);
+    EmbreeAccel accel(s->scene);
     for (Vec3f p : {Vec3f(0, 0, 0), Vec3f(0.3f, 0, 0.5f), Vec3f(0, 0, 1.5f), Vec3f(0.8f, 0, -1.f), Vec3f(0, 0, 1.2f)}) {
       double exact = polygonIrradiance(s->corners, s->normal, p, Vec3f(0, 1, 0), 3.0);
-      EXPECT_NEAR(shadowedIrradiance(s->scene, p, 100000), exact, 0.015 * exact + 1e-4)
+      EXPECT_NEAR(shadowedIrradiance(s->scene.view(), EmbreeTracer{&accel}, p, 100000), exact, 0.015 * exact + 1e-4)
           << "tilt " << tilt << " at " << p.x << "," << p.y << "," << p.z;
     }
   }
