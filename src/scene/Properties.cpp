@@ -39,6 +39,7 @@ void Properties::set(const std::string& name, const std::string& tag, const std:
 }
 
 const Properties::Entry* Properties::take(const std::string& name, std::initializer_list<const char*> tags) {
+  asked_.insert(name);
   auto it = entries_.find(name);
   if (it == entries_.end()) return nullptr;
   Entry& e = it->second;

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,8 @@ class Properties {
   [[noreturn]] void fail(const std::string& what) const;
   // Names never read, with where each was given.
   std::vector<std::pair<std::string, std::string>> unused() const;
+  // Every name a reader asked for, given or not (candidates for "did you mean").
+  const std::set<std::string>& asked() const { return asked_; }
 
  private:
   struct Entry {
@@ -38,6 +41,7 @@ class Properties {
     bool used = false;
   };
   std::map<std::string, Entry> entries_;
+  std::set<std::string> asked_;
   std::string where_;
   const Entry* take(const std::string& name, std::initializer_list<const char*> tags);
 };

@@ -12,6 +12,7 @@
 
 #include "image/Image.h"
 #include "materials/BsdfFactory.h"
+#include "scene/MitsubaPlugins.h"
 #include "scene/NameTables.h"
 #include "scene/Properties.h"
 
@@ -86,6 +87,7 @@ class Loader {
   };
   std::map<std::string, NamedIndex> bsdfIds_, textureIds_;
   std::set<std::string> warned_;
+  std::set<std::string> asked_;  // every property name the loader has looked for: "did you mean" candidates
   bool haveSensor_ = false;
 
   [[noreturn]] void fail(const SourceFile* f, pugi::xml_node n, const std::string& what) const {
@@ -177,6 +179,7 @@ class Loader {
     return props;
   }
   Prop* find(Props& p, const std::string& name) {
+    asked_.insert(name);
     auto it = p.find(name);
     if (it == p.end()) return nullptr;
     it->second.used = true;
@@ -270,11 +273,25 @@ class Loader {
     expectTag(f, *x, {"transform"});
     return parseTransform(f, x->node);
   }
-  void warnUnused(const SourceFile* f, const Props& p, const std::string& plugin) {
-    for (const auto& [name, prop] : p)
-      if (!prop.used)
-        warnOnce(fmt::format("{}:{}: property '{}' of {} is not supported and was ignored", f->path,
-                             f->lineOf(prop.node.offset_debug()), name, plugin));
+  // What envgi did not read: a property that Mitsuba's plugin takes is left out with a warning
+  // (a Mitsuba scene may set it); any other is an error, as Mitsuba makes it, since it is most
+  // likely a misspelt name whose value would silently go unused.
+  void reportUnused(const SourceFile* f, const Props& p, const std::string& kind, const std::string& type) {
+    for (const auto& [name, prop] : p) {
+      if (prop.used) continue;
+      if (!mitsubaPluginTakes(kind, type, name)) {
+        std::vector<std::string> known = mitsubaPluginProperties(kind, type);
+        known.insert(known.end(), asked_.begin(), asked_.end());
+        fail(f, prop.node, unknownProperty(name, kind, type, nearestName(name, known)));
+      }
+      warnOnce(fmt::format("{}:{}: property '{}' of {} '{}' is not supported and was ignored", f->path,
+                           f->lineOf(prop.node.offset_debug()), name, kind, type));
+    }
+  }
+  static std::string unknownProperty(const std::string& name, const std::string& kind, const std::string& type,
+                                     const std::string& suggestion) {
+    return fmt::format("{} '{}' has no property '{}'{}", kind, type, name,
+                       suggestion.empty() ? "" : fmt::format(" (did you mean '{}'?)", suggestion));
   }
 
   // Mitsuba composes the operations in order: each one applies after the ones before it.
@@ -382,8 +399,14 @@ class Loader {
     try {
       Properties props = scalarProperties(f, n, p);
       scene_.integrator = IntegratorSettings::fromProperties(findIntegrator(type), props);
-      for (const auto& [name, where] : props.unused())
+      for (const auto& [name, where] : props.unused()) {
+        if (!mitsubaPluginTakes("integrator", type, name)) {
+          std::vector<std::string> known = mitsubaPluginProperties("integrator", type);
+          known.insert(known.end(), props.asked().begin(), props.asked().end());
+          throw std::runtime_error(where + ": " + unknownProperty(name, "integrator", type, nearestName(name, known)));
+        }
         warnOnce(fmt::format("{}: property '{}' of integrator '{}' is not supported and was ignored", where, name, type));
+      }
     } catch (const std::runtime_error& e) {
       rethrowAt(f, n, e);
     }
@@ -432,7 +455,7 @@ class Loader {
       if (!(cam.apertureRadius >= 0.f && cam.apertureRadius < 1e30f)) fail(f, n, "aperture_radius must be >= 0");
       if (!(cam.focusDistance > 0.f && cam.focusDistance < 1e30f)) fail(f, n, "focus_distance must be positive");
     }
-    warnUnused(f, p, "sensor");
+    reportUnused(f, p, "sensor", type);
     cam.width = 768;
     cam.height = 576;
     cam.filter = FilterType::Gaussian;
@@ -480,7 +503,7 @@ class Loader {
     // that a misspelt value is the error it is in Mitsuba.
     for (const char* harmless : {"banner", "high_quality_edges", "sample_border"}) getBool(f, p, harmless, false);
     for (const char* harmless : {"pixel_format", "file_format", "component_format"}) getString(f, p, harmless, "");
-    warnUnused(f, p, "film");
+    reportUnused(f, p, "film", type);
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element) continue;
       std::string tag = c.name();
@@ -493,7 +516,7 @@ class Loader {
           fail(f, c, e.what());
         }
         Props fp = collectProps(f, c);
-        warnUnused(f, fp, "rfilter");
+        reportUnused(f, fp, "rfilter", t);
       } else if (!isPropTag(tag)) {
         fail(f, c, fmt::format("unexpected <{}> in <film>", tag));
       }
@@ -514,7 +537,7 @@ class Loader {
     s.seed = uint32_t(getInt(f, p, "seed", 0));
     find(p, "jitter");
     if (s.sampleCount <= 0) fail(f, n, "sample_count must be positive");
-    warnUnused(f, p, "sampler '" + type + "'");
+    reportUnused(f, p, "sampler", type);
   }
 
   // A light's direction as a unit vector; zero, or so long that its length overflows, is an error.
@@ -614,7 +637,7 @@ class Loader {
                            f->lineOf(n.offset_debug()), type));
       return;
     }
-    warnUnused(f, p, "emitter '" + type + "'");
+    reportUnused(f, p, "emitter", type);
   }
 
   int bsdf(const SourceFile* f, pugi::xml_node n) {
@@ -722,7 +745,7 @@ class Loader {
       if (c.type() == pugi::node_element && !isPropTag(c.name()) && std::string(c.name()) != "texture" &&
           std::string(c.name()) != "ref")
         fail(f, c, fmt::format("unexpected <{}> in <bsdf>", c.name()));
-    warnUnused(f, p, "bsdf '" + type + "'");
+    reportUnused(f, p, "bsdf", type);
     scene_.bsdfs.push_back(b);
     return int(scene_.bsdfs.size() - 1);
   }
@@ -802,7 +825,7 @@ class Loader {
     for (pugi::xml_node c : n.children())
       if (c.type() == pugi::node_element && !isPropTag(c.name()))
         fail(f, c, fmt::format("unexpected <{}> in <texture> (a texture's colours are constants)", c.name()));
-    warnUnused(f, p, "texture '" + type + "'");
+    reportUnused(f, p, "texture", type);
     scene_.textures.push_back(std::move(t));
     return int(scene_.textures.size() - 1);
   }
@@ -916,7 +939,7 @@ class Loader {
       scene_.bsdfs.push_back(b);
       entry.bsdf = int(scene_.bsdfs.size() - 1);
     }
-    warnUnused(f, p, "shape '" + type + "'");
+    reportUnused(f, p, "shape", type);
     scene_.shapes.push_back(entry);
   }
 };

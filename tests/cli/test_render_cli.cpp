@@ -86,6 +86,20 @@ TEST(CliRender, ErrorsLeaveNoOutput) {
   EXPECT_NE(runCli("render " + scene + " -o " + out + " --strategy nonsense").code, 0);
   EXPECT_NE(runCli("render " + scene + " -o " + out + " -D broken").code, 0);
   EXPECT_FALSE(fs::exists(out));
+  // A misspelt property (here the sphere's radius) is one error line naming the nearest name.
+  std::string text;
+  {
+    std::ifstream in(scene);
+    text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  text.replace(text.find("name=\"radius\""), 13, "name=\"raduis\"");
+  std::ofstream(d.file("typo.xml")) << text;
+  CliResult typo = runCli("render " + d.file("typo.xml") + " -o " + out);
+  EXPECT_EQ(typo.code, 1) << typo.output;
+  EXPECT_NE(typo.output.find("typo.xml:9: shape 'sphere' has no property 'raduis' (did you mean 'radius'?)"),
+            std::string::npos)
+      << typo.output;
+  EXPECT_FALSE(fs::exists(out));
   size_t files = 0;
   for (auto& e : fs::directory_iterator(d.path)) files += e.path().filename().string().find(".tmp") != std::string::npos;
   EXPECT_EQ(files, 0u);
