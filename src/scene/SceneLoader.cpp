@@ -619,6 +619,7 @@ class Loader {
         std::string layout = getString(f, p, "layout", "latlong");
         if (layout != "latlong" && layout != "angular" && layout != "mirrorball" && layout != "cross")
           fail(f, n, "layout must be latlong, angular, mirrorball or cross, not '" + layout + "'");
+        reportUnused(f, p, "emitter", type);  // a misspelt property before a large map's load, not after
         try {
           scene_.env = std::make_unique<EnvironmentMap>(EnvironmentMap::loadLayout(path.string(), layout, o));
         } catch (const std::runtime_error& e) {

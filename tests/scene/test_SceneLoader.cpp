@@ -354,6 +354,9 @@ TEST(SceneLoader, APropertyMitsubaDoesNotKnowIsAnError) {
        "shape 'sphere' has no property 'radus' (did you mean 'radius'?)"},
       {R"(<emitter type="constant"><rgb name="radiance" value="1"/><float name="scale" value="2"/></emitter>)",
        "emitter 'constant' has no property 'scale'"},
+      // Said before the map is read: this one is not there at all.
+      {R"(<emitter type="envmap"><string name="filename" value="missing.exr"/><float name="scal" value="2"/></emitter>)",
+       "emitter 'envmap' has no property 'scal' (did you mean 'scale'?)"},
       {R"(<shape type="sphere"><bsdf type="diffuse"><rgb name="reflectence" value="0.5"/></bsdf></shape>)",
        "bsdf 'diffuse' has no property 'reflectence' (did you mean 'reflectance'?)"},
       {R"(<shape type="sphere"><bsdf type="roughconductor"><float name="alpha_x" value="0.1"/></bsdf></shape>)",
