@@ -388,7 +388,9 @@ class Loader {
     } else if (tag == "medium" || tag == "phase") {
       warnOnce(fmt::format("{}:{}: <{}> is not supported and was ignored", f->path, f->lineOf(n.offset_debug()), tag));
     } else {
-      fail(f, n, fmt::format("unknown element <{}>", tag));
+      std::string near = nearestName(tag, {"default", "include", "integrator", "sensor", "emitter", "shape", "bsdf",
+                                           "texture", "medium", "phase"});
+      fail(f, n, fmt::format("unknown element <{}>{}", tag, near.empty() ? "" : " (did you mean <" + near + ">?)"));
     }
   }
 
@@ -721,7 +723,9 @@ class Loader {
       if (type == "roughplastic") roughness(f, n, p, textures, b, type);
       finishPlastic(b);
     } else {
-      fail(f, n, fmt::format("unknown BSDF type '{}'", type));
+      fail(f, n, fmt::format("unknown BSDF type '{}' (diffuse, conductor, roughconductor, dielectric, thindielectric, "
+                             "roughdielectric, plastic, roughplastic, twosided)",
+                             type));
     }
     for (const auto& [name, tex] : textures) {
       int* slot = textureSlot(b, name);

@@ -173,7 +173,7 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
   };
   std::vector<Case> cases = {
       {"<shape type=\"teapot\"/>", "s.xml:2: unknown shape type 'teapot'"},
-      {"<bsdf type=\"velvet\"/>", "unknown BSDF type 'velvet'"},
+      {"<bsdf type=\"velvet\"/>", "unknown BSDF type 'velvet' (diffuse, conductor, roughconductor,"},
       {"<bsdf type=\"roughconductor\"><string name=\"distribution\" value=\"phong\"/></bsdf>",
        "roughconductor distribution must be beckmann or ggx, not 'phong'"},
       {"<bsdf type=\"roughconductor\"><float name=\"alpha\" value=\"0.2\"/><float name=\"alpha_u\" value=\"0.1\"/></bsdf>",
@@ -197,6 +197,7 @@ TEST(SceneLoader, ErrorsNameFileLineAndProblem) {
       {"<shape type=\"sphere\"><float name=\"radius\" value=\"$undefined\"/></shape>", "undefined parameter '$undefined'"},
       {"<shape type=\"sphere\"", "XML error"},
       {"<widget/>", "unknown element <widget>"},
+      {"<emiter type=\"constant\"/>", "unknown element <emiter> (did you mean <emitter>?)"},
       {"<emitter type=\"area\"/>", "must be inside a <shape>"},
       {"<shape type=\"rectangle\"><transform name=\"to_world\"><shear value=\"1\"/></transform></shape>", "unknown transform operation"},
       // A degenerate camera or rotation used to become NaN, and Debian's Embree aborts the
