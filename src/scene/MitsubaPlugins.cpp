@@ -119,7 +119,7 @@ std::string nearestName(std::string_view name, const std::vector<std::string>& c
   size_t bestDistance = 3;
   for (const std::string& c : candidates) {
     size_t d = editDistance(name, c);
-    if (d > 0 && d < bestDistance && 2 * d < name.size()) best = c, bestDistance = d;
+    if (d > 0 && d < bestDistance && 2 * d < std::max(name.size(), c.size())) best = c, bestDistance = d;
   }
   return best;
 }

@@ -15,7 +15,8 @@ namespace envgi {
 bool mitsubaPluginTakes(std::string_view kind, std::string_view type, std::string_view name);
 
 // Of the candidates other than name itself, the one nearest to it by edit distance, if it is at
-// most 2 edits away and nearer than half the name's length; empty otherwise ("did you mean ...?").
+// most 2 edits away and fewer than half the longer name's letters; empty otherwise ("did you
+// mean ...?").
 std::string nearestName(std::string_view name, const std::vector<std::string>& candidates);
 
 // The names mitsubaPluginTakes accepts for one plugin, for nearestName.

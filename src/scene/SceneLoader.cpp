@@ -74,6 +74,15 @@ class Loader {
 
   void finish() {
     if (!haveSensor_) throw std::runtime_error(files_.front()->path + ": the scene has no <sensor>");
+    // A -D value that nothing in the scene reads (a misspelt name, or a parameter of another
+    // scene) leaves the render as it would be without it: said once, with the nearest name.
+    std::vector<std::string> names(paramNames_.begin(), paramNames_.end());
+    for (const auto& [name, value] : cliDefines_) {
+      if (paramNames_.count(name)) continue;
+      std::string near = nearestName(name, names);
+      warnOnce(fmt::format("-D {}={}: {} has no parameter '{}'{}, so the value is not used", name, value,
+                           files_.front()->path, name, near.empty() ? "" : " (did you mean '" + near + "'?)"));
+    }
   }
 
  private:
@@ -87,6 +96,8 @@ class Loader {
   };
   std::map<std::string, NamedIndex> bsdfIds_, textureIds_;
   std::set<std::string> warned_;
+  // Declared by <default> or read as $name, in any file (mutable: the const substitution records it).
+  mutable std::set<std::string> paramNames_;
   std::set<std::string> asked_;  // every property name the loader has looked for: "did you mean" candidates
   bool haveSensor_ = false;
 
@@ -125,6 +136,7 @@ class Loader {
       size_t j = i + 1;
       while (j < v.size() && (std::isalnum((unsigned char)v[j]) || v[j] == '_')) ++j;
       std::string key = v.substr(i + 1, j - i - 1);
+      paramNames_.insert(key);
       auto it = params_.find(key);
       if (it == params_.end()) fail(f, n, fmt::format("undefined parameter '${}'", key));
       out += it->second;
@@ -367,6 +379,7 @@ class Loader {
     if (tag == "default") {
       checkAttrs(f, n, {"name", "value"});
       std::string name = attr(f, n, "name");
+      paramNames_.insert(name);
       if (!cliDefines_.count(name)) params_[name] = attr(f, n, "value");
     } else if (tag == "include") {
       checkAttrs(f, n, {"filename"});

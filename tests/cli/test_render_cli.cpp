@@ -69,6 +69,15 @@ TEST(CliRender, DefinesAndOverrides) {
                        " -D spp=2 --integrator direct --strategy adaptive --no-progress");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_NE(r.output.find("'direct' (strategy adaptive), 2 spp"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("has no parameter"), std::string::npos) << "spp is the scene's: " << r.output;
+  // A -D name the scene never reads renders as without it, and says so with the nearest name.
+  CliResult typo = runCli("render " + scene + " -o " + d.file("o.exr") + " -D sp=2 -D other=1 --no-progress");
+  ASSERT_EQ(typo.code, 0) << typo.output;
+  EXPECT_NE(typo.output.find("-D sp=2: " + scene + " has no parameter 'sp' (did you mean 'spp'?), so the value is not used"),
+            std::string::npos)
+      << typo.output;
+  EXPECT_NE(typo.output.find("-D other=1: " + scene + " has no parameter 'other', so"), std::string::npos) << typo.output;
+  EXPECT_NE(typo.output.find(", 1 spp"), std::string::npos) << typo.output;
 }
 
 TEST(CliRender, ErrorsLeaveNoOutput) {

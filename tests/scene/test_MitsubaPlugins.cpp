@@ -32,5 +32,6 @@ TEST(MitsubaPlugins, NearestNameIsAtMostTwoEditsAwayAndNeverTheNameItself) {
   EXPECT_EQ(nearestName("alpha_u", names), "alpha") << "a name never suggests itself";
   EXPECT_EQ(nearestName("mystery", names), "");
   EXPECT_EQ(nearestName("ab", {"a", "b"}), "") << "one edit is half of a two-letter name";
+  EXPECT_EQ(nearestName("sp", {"spp", "res"}), "spp") << "one edit of three letters";
   EXPECT_EQ(nearestName("x", {}), "");
 }
