@@ -4,7 +4,8 @@
 // Run: build/bin/envgi_bench_render --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 // BM_ShareOfPlainEmbree gives the ratio itself from back-to-back pairs, robust to drift.
 // ENVGI_BENCH_MESH=/path/to/mesh.ply swaps the Buddha for another mesh (e.g. the 871k dragon),
-// ENVGI_BENCH_ENVMAP=/path/to/map.hdr Grace Cathedral for another map. ENVGI_BENCH_DEPTH=N cuts the
+// ENVGI_BENCH_ENVMAP=/path/to/map.hdr Grace Cathedral for another map, ENVGI_BENCH_STRATEGY=S the
+// map's sampling strategy (product, the scene's, for alias, importance, ...). ENVGI_BENCH_DEPTH=N cuts the
 // paths at depth N instead of 4 (1: camera rays and the map they see; 2: one shading point), which
 // splits the cost by depth.
 #include <benchmark/benchmark.h>
@@ -64,6 +65,7 @@ struct Fixture {
     std::map<std::string, std::string> defs = {{"res", "256"}, {"spp", "4"}};
     if (const char* m = std::getenv("ENVGI_BENCH_MESH")) defs["mesh"] = m;
     if (const char* e = std::getenv("ENVGI_BENCH_ENVMAP")) defs["envmap"] = e;
+    if (const char* e = std::getenv("ENVGI_BENCH_STRATEGY")) defs["strategy"] = e;
     loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/buddha.xml", defs, scene);
     scene.integrator.type = IntegratorType::Path;
     scene.integrator.path.maxDepth = benchDepth();
