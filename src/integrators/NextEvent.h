@@ -20,14 +20,16 @@ struct LightSampleLd {
   bool needsRay = false;
 };
 
-// Its three sample dimensions are drawn whatever happens, so sequences stay aligned across
-// pixels.
+// Its three sample dimensions are taken whatever happens, so sequences stay aligned across
+// pixels. With the map the only light, the kind's choice and the area light's second pair would
+// go unused: they are skipped, not drawn (2 of a bounce's 6 draws; the image stays the same).
 ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
                                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
                                         Sampler& smp) {
   LightSampleLd out;
-  float uSel = smp.get1D();
-  Vec2f uL = smp.get2D(), uL2 = smp.get2D();
+  const bool mapOnly = sc.envSelectProb() == 1.f;  // sampleLight then takes the map for any uSel < 1
+  float uSel = smp.get1DIf(!mapOnly);
+  Vec2f uL = smp.get2D(), uL2 = smp.get2DIf(!mapOnly);
   LightSample ls;
   if (bsdfIsDelta(bsdf) || !sampleLight(sc, si, axis, strategy, uSel, uL, uL2, &ls)) return out;
   Vec3f wiLocal = si.shading.toLocal(ls.dir);

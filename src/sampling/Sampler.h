@@ -151,6 +151,28 @@ struct Sampler {
     return rng.nextFloat();
   }
 
+  // Past a draw whose value would go unused, as get1D() and get2D() would go: every later draw
+  // is the one it would have been (the generator steps as often), for the cost of a step or none.
+  ENVGI_HD void skip1D() {
+    ++dim;
+    if (type != SamplerType::Sobol) rng.nextUInt();
+  }
+  ENVGI_HD void skip2D() {
+    dim += 2;
+    if (type != SamplerType::Sobol) rng.nextUInt(), rng.nextUInt();
+  }
+  // A draw that is taken only where it is used (zero where it is skipped).
+  ENVGI_HD float get1DIf(bool used) {
+    if (used) return get1D();
+    skip1D();
+    return 0.f;
+  }
+  ENVGI_HD Vec2f get2DIf(bool used) {
+    if (used) return get2D();
+    skip2D();
+    return {0.f, 0.f};
+  }
+
   ENVGI_HD Vec2f get2D() {
     uint32_t d = dim;
     dim += 2;

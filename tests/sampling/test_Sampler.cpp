@@ -53,6 +53,32 @@ TEST_P(SamplerTypes, MeanIsOneHalf) {
   EXPECT_NEAR(sy / n, 0.5, 0.01);
 }
 
+// A skipped draw leaves every later one as it was (next-event estimation skips the draws a
+// map-only scene never uses), at sample counts that are and are not a square or a power of two.
+TEST_P(SamplerTypes, SkippedDrawsLeaveTheLaterOnesAsTheyWere) {
+  for (uint32_t spp : {16u, 19u}) {
+    Sampler drawn, skipped;
+    drawn.type = skipped.type = GetParam();
+    drawn.spp = skipped.spp = spp;
+    drawn.seed = skipped.seed = 3;
+    for (uint32_t i = 0; i < spp; ++i) {
+      drawn.start(42, i);
+      skipped.start(42, i);
+      for (int bounce = 0; bounce < 3; ++bounce) {
+        drawn.get1D();
+        skipped.skip1D();
+        Vec2f a = drawn.get2D(), b = skipped.get2D();
+        EXPECT_EQ(a.x, b.x);
+        EXPECT_EQ(a.y, b.y);
+        drawn.get2D();
+        skipped.skip2D();
+        EXPECT_EQ(drawn.get1D(), skipped.get1D()) << "sample " << i << ", bounce " << bounce;
+      }
+      EXPECT_EQ(drawn.dim, skipped.dim);
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(All, SamplerTypes,
                          ::testing::Values(SamplerType::Independent, SamplerType::Stratified, SamplerType::Sobol));
 
