@@ -34,7 +34,7 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
 
   for (int j = 0; j < bsdfSamples; ++j) {
     BsdfSample bs;
-    float uc = smp.get1D();
+    float uc = smp.get1DIf(bsdfPicksALobe(bsdf));  // skipped for a one-lobe BSDF
     Vec2f ub = smp.get2D();
     if (!bsdfSample(bsdf, woLocal, uc, ub, &bs) || (skipDelta && bs.delta)) continue;
     Vec3f wi = si.shading.toWorld(bs.wi);

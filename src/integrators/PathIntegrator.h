@@ -85,7 +85,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp), st);
 
   BsdfSample bs;
-  float uc = smp.get1D();
+  float uc = smp.get1DIf(bsdfPicksALobe(bsdf));  // skipped for a one-lobe BSDF
   Vec2f ub = smp.get2D();
   if (!bsdfSample(bsdf, woLocal, uc, ub, &bs)) return false;
   Vec3f wi = si.shading.toWorld(bs.wi);

@@ -159,6 +159,34 @@ TEST(Bsdf, EvalPdfTogetherEqualsApart) {
   }
 }
 
+// The integrators skip the lobe choice's draw where bsdfPicksALobe says a BSDF has one lobe:
+// there bsdfSample must not depend on uc at all, and where it says two, it must.
+TEST(Bsdf, OnlyTwoLobeBsdfsReadTheLobeChoice) {
+  Pcg32 rng(31);
+  std::vector<BsdfCase> all = cases();  // and the delta BSDFs, which the chi-square cases leave out
+  all.push_back({"ConductorAu", make(BsdfType::Conductor, 0.1f, "Au"), 1.f});
+  all.push_back({"Mirror", make(BsdfType::Conductor, 0.1f, "none"), 1.f});
+  for (BsdfType t : {BsdfType::Dielectric, BsdfType::ThinDielectric}) {
+    Bsdf glass = make(t, 0.1f);
+    glass.ior = 1.5f;
+    all.push_back({t == BsdfType::Dielectric ? "Dielectric" : "ThinDielectric", glass, 1.f});
+  }
+  for (const BsdfCase& c : all) {
+    bool differs = false;
+    for (int i = 0; i < 2000; ++i) {
+      Vec3f wo = sampleUniformSphere({rng.nextFloat(), rng.nextFloat()});
+      Vec2f u(rng.nextFloat(), rng.nextFloat());
+      BsdfSample a, b;
+      bool okA = bsdfSample(c.bsdf, wo, 0.02f, u, &a), okB = bsdfSample(c.bsdf, wo, 0.98f, u, &b);
+      bool same = okA == okB && (!okA || (a.wi.x == b.wi.x && a.wi.y == b.wi.y && a.wi.z == b.wi.z &&
+                                          a.weight.x == b.weight.x && a.pdf == b.pdf && a.delta == b.delta));
+      differs = differs || !same;
+      if (!bsdfPicksALobe(c.bsdf)) ASSERT_TRUE(same) << c.name << " read uc";
+    }
+    EXPECT_EQ(differs, bsdfPicksALobe(c.bsdf)) << c.name;
+  }
+}
+
 // Integral of eval() over the sphere by quadrature (independent of the sampling code).
 double hemisphereIntegral(const Bsdf& b, Vec3f wo) {
   const int n = 600;
