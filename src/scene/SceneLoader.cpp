@@ -291,19 +291,22 @@ class Loader {
   void reportUnused(const SourceFile* f, const Props& p, const std::string& kind, const std::string& type) {
     for (const auto& [name, prop] : p) {
       if (prop.used) continue;
-      if (!mitsubaPluginTakes(kind, type, name)) {
-        std::vector<std::string> known = mitsubaPluginProperties(kind, type);
-        known.insert(known.end(), asked_.begin(), asked_.end());
-        fail(f, prop.node, unknownProperty(name, kind, type, nearestName(name, known)));
-      }
+      std::string error = unknownPropertyError(kind, type, name, asked_);
+      if (!error.empty()) fail(f, prop.node, error);
       warnOnce(fmt::format("{}:{}: property '{}' of {} '{}' is not supported and was ignored", f->path,
                            f->lineOf(prop.node.offset_debug()), name, kind, type));
     }
   }
-  static std::string unknownProperty(const std::string& name, const std::string& kind, const std::string& type,
-                                     const std::string& suggestion) {
+  // Empty where Mitsuba's plugin takes the property; else the error, with the nearest of
+  // Mitsuba's names and those asked for.
+  static std::string unknownPropertyError(const std::string& kind, const std::string& type, const std::string& name,
+                                          const std::set<std::string>& asked) {
+    if (mitsubaPluginTakes(kind, type, name)) return "";
+    std::vector<std::string> known = mitsubaPluginProperties(kind, type);
+    known.insert(known.end(), asked.begin(), asked.end());
+    std::string near = nearestName(name, known);
     return fmt::format("{} '{}' has no property '{}'{}", kind, type, name,
-                       suggestion.empty() ? "" : fmt::format(" (did you mean '{}'?)", suggestion));
+                       near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near));
   }
 
   // Mitsuba composes the operations in order: each one applies after the ones before it.
@@ -415,11 +418,8 @@ class Loader {
       Properties props = scalarProperties(f, n, p);
       scene_.integrator = IntegratorSettings::fromProperties(findIntegrator(type), props);
       for (const auto& [name, where] : props.unused()) {
-        if (!mitsubaPluginTakes("integrator", type, name)) {
-          std::vector<std::string> known = mitsubaPluginProperties("integrator", type);
-          known.insert(known.end(), props.asked().begin(), props.asked().end());
-          throw std::runtime_error(where + ": " + unknownProperty(name, "integrator", type, nearestName(name, known)));
-        }
+        std::string error = unknownPropertyError("integrator", type, name, props.asked());
+        if (!error.empty()) throw std::runtime_error(where + ": " + error);
         warnOnce(fmt::format("{}: property '{}' of integrator '{}' is not supported and was ignored", where, name, type));
       }
     } catch (const std::runtime_error& e) {
