@@ -305,13 +305,13 @@ ENVGI_INLINE bool finishSample(const Bsdf& b, Vec3f wo, BsdfSample* s) {
 }
 }  // namespace detail
 
-// uc picks a lobe, u the direction within it. Returns false when no direction is produced.
 // Whether bsdfSample reads its uc, the choice between lobes (reflection or transmission, coat or
 // base); a diffuse or metal BSDF has one lobe, and its draw can be skipped.
 ENVGI_INLINE bool bsdfPicksALobe(const Bsdf& b) {
   return b.type != BsdfType::Diffuse && b.type != BsdfType::Conductor && b.type != BsdfType::RoughConductor;
 }
 
+// uc picks a lobe, u the direction within it. Returns false when no direction is produced.
 ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s) {
   bool flip = b.twoSided && wo.z < 0.f;
   if (flip) wo.z = -wo.z;

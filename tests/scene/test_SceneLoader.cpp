@@ -341,7 +341,7 @@ TEST(SceneLoader, HarmlessUnsupportedElementsOnlyWarn) {
     <shape type="sphere"><float name="silhouette_sampling_weight" value="1"/></shape>
     <shape type="sphere"><emitter type="area"><texture type="checkerboard" name="radiance"/></emitter></shape>)"),
                             {}, s));
-  EXPECT_EQ(s.shapes.size(), 2u);
+  ASSERT_EQ(s.shapes.size(), 2u);  // shapes[1] is read below
   EXPECT_EQ(s.shapes[1].radiance.x, 1.f) << "an emitter's texture keeps the default radiance";
 }
 
