@@ -84,7 +84,8 @@ struct Fixture {
       for (int x = 0; x < cam.width; ++x)
         for (uint32_t s = 0; s < 4; ++s) {
           smp.start(uint64_t(y) * cam.width + x, s);
-          pathTrace(scene.view(), tr, sampleCameraRay(cam, smp, x, y), smp, pp, &rays);
+          float w;  // the recorded rays do not depend on the filter's weight
+          pathTrace(scene.view(), tr, sampleCameraRay(cam, smp, x, y, &w), smp, pp, &rays);
         }
   }
 };

@@ -72,7 +72,11 @@ void runRender(const RenderArgs& a) {
   if (!a.pointMethod.empty()) scene.integrator.env.pointMethod = a.pointMethod;  // Scene::finalize checks it
   if (a.seed >= 0) scene.sampler.seed = uint32_t(a.seed);
   if (!a.sampler.empty()) scene.sampler.type = findSampler(a.sampler);
-  if (!a.filter.empty()) scene.camera.filter = findName(kFilterNames, a.filter, "filter");
+  // A type other than the scene's takes Mitsuba's default parameters; the scene's own keeps its.
+  if (!a.filter.empty()) {
+    FilterType t = findName(kFilterNames, a.filter, "filter");
+    if (t != scene.camera.filter.type) scene.camera.filter = makeFilter(t);
+  }
   scene.finalize();
   bool cuda = chooseCuda(a.device);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -110,8 +114,9 @@ void runRender(const RenderArgs& a) {
   RenderStats st;
   const IntegratorSettings& is = scene.integrator;
   const int requestedSpp = a.spp > 0 ? a.spp : scene.sampler.sampleCount;
-  spdlog::info("rendering {}x{} with '{}' (strategy {}), {} spp, {} sampler{}", scene.camera.width, scene.camera.height,
-               integratorName(is.type), is.env.strategy, requestedSpp, samplerName(scene.sampler.type),
+  spdlog::info("rendering {}x{} with '{}' (strategy {}), {} spp, {} sampler, {} filter{}", scene.camera.width,
+               scene.camera.height, integratorName(is.type), is.env.strategy, requestedSpp,
+               samplerName(scene.sampler.type), nameOf(kFilterNames, scene.camera.filter.type),
                a.noiseThreshold > 0.f
                    ? fmt::format(", adaptive: noise threshold {:g} from {} spp", a.noiseThreshold, a.minSpp)
                    : "");

@@ -77,6 +77,10 @@ class CudaPassExecutor final : public PassExecutor {
       film_.sumSqLum = a.allocate<double>(px, "film variance");
       check(cudaMemset(film_.sumSqLum, 0, px * sizeof(double)), "clearing the film");
     }
+    if (cam_.filter.hasNegativeLobes()) {
+      film_.weightSum = a.allocate<float>(px, "film filter weights");
+      check(cudaMemset(film_.weightSum, 0, px * sizeof(float)), "clearing the film");
+    }
     counters_ = a.allocate<unsigned long long>(3, "counters");
     check(cudaMemset(counters_, 0, 3 * sizeof(unsigned long long)), "clearing counters");
     if constexpr (RunsByBounce<Integrator>::value) {
@@ -122,10 +126,12 @@ class CudaPassExecutor final : public PassExecutor {
   // clears the film; another size needs a new film, so a new executor.
   bool restart(const Camera& cam) override {
     if (cam.width != cam_.width || cam.height != cam_.height) return false;
+    if (cam.filter.hasNegativeLobes() != (film_.weightSum != nullptr)) return false;  // a film of another kind
     cam_ = cam;
     size_t px = size_t(cam_.width) * cam_.height;
     check(cudaMemset(film_.sum, 0, px * sizeof(Color)), "clearing the film");
     if (film_.sumSqLum) check(cudaMemset(film_.sumSqLum, 0, px * sizeof(double)), "clearing the film");
+    if (film_.weightSum) check(cudaMemset(film_.weightSum, 0, px * sizeof(float)), "clearing the film");
     film_.active = nullptr;
     activeCount_ = 0;
     return true;
@@ -152,6 +158,12 @@ class CudaPassExecutor final : public PassExecutor {
     if (film_.sumSqLum) {
       out->sumSqLum.resize(px);
       check(cudaMemcpy(out->sumSqLum.data(), film_.sumSqLum, px * sizeof(double), cudaMemcpyDeviceToHost),
+            "reading the film");
+    }
+    out->weightSum.clear();
+    if (film_.weightSum) {
+      out->weightSum.resize(px);
+      check(cudaMemcpy(out->weightSum.data(), film_.weightSum, px * sizeof(float), cudaMemcpyDeviceToHost),
             "reading the film");
     }
   }

@@ -50,7 +50,12 @@ __global__ void envmapKernel(EnvironmentMapView env, int n, CheckResult* out) {
 // run on the device and on the host, to be compared.
 // coat: a rough plastic's tables over all roughnesses (device or host copy, as the caller
 // runs), which every other rough plastic case reads.
-ENVGI_HD float bsdfCameraValue(const Camera& cam, int i, const float* coat) {
+// Each of Mitsuba's six pixel filters, for the camera's draws.
+struct FilterSet {
+  ReconstructionFilter f[6];
+};
+
+ENVGI_HD float bsdfCameraValue(const Camera& cam, const FilterSet& filters, int i, const float* coat) {
   Pcg32 rng(uint64_t(i), 3u);
   Bsdf b;
   b.type = BsdfType(i % 8);
@@ -72,12 +77,12 @@ ENVGI_HD float bsdfCameraValue(const Camera& cam, int i, const float* coat) {
   if (bsdfSample(b, wo, u[0], Vec2f(u[1], u[2]), &bs))
     acc = bs.weight.y + bsdfEval(b, wo, bs.wi).x + bsdfPdf(b, wo, bs.wi);
   Ray r = cam.generateRay(float(i % cam.width) + 0.5f, float((i / cam.width) % cam.height) + 0.5f);
-  Vec2f off = sampleFilter(FilterType(i % 3), Vec2f(u[3], u[4]));
-  return acc + r.d.z + off.x;
+  FilterSample fs = sampleFilter(filters.f[i % 6], Vec2f(u[3], u[4]));
+  return acc + r.d.z + fs.offset.x + fs.offset.y + fs.weight;
 }
-__global__ void bsdfCameraKernel(Camera cam, int n, const float* coat, float* out) {
+__global__ void bsdfCameraKernel(Camera cam, FilterSet filters, int n, const float* coat, float* out) {
   int i = blockIdx.x * blockDim.x + threadIdx.x;
-  if (i < n) out[i] = bsdfCameraValue(cam, i, coat);
+  if (i < n) out[i] = bsdfCameraValue(cam, filters, i, coat);
 }
 
 // Textures looked up on the device, for comparison with the same lookups on the host.
@@ -175,6 +180,8 @@ int main() try {
   Camera cam;
   cam.width = cam.height = 64;
   cam.tanHalfX = cam.tanHalfY = 0.5f;
+  FilterSet filters;
+  for (int k = 0; k < 6; ++k) filters.f[k] = makeFilter(FilterType(k));
   float* dB = nullptr;
   cudaMalloc(&dB, sizeof(float) * n);
   int coatNodes = 0;
@@ -182,14 +189,14 @@ int main() try {
   float* dCoat = nullptr;
   cudaMalloc(&dCoat, sizeof(float) * coatNodes * kCoatStride);
   cudaMemcpy(dCoat, coat, sizeof(float) * coatNodes * kCoatStride, cudaMemcpyHostToDevice);
-  bsdfCameraKernel<<<(n + 255) / 256, 256>>>(cam, n, dCoat, dB);
+  bsdfCameraKernel<<<(n + 255) / 256, 256>>>(cam, filters, n, dCoat, dB);
   checkLaunch("bsdfCameraKernel");
   std::vector<float> bres(n);
   cudaMemcpy(bres.data(), dB, sizeof(float) * n, cudaMemcpyDeviceToHost);
   int bad = 0, bsdfMismatches = 0;
   for (int i = 0; i < n; ++i) {
     bad += !std::isfinite(bres[i]);
-    float h = bsdfCameraValue(cam, i, coat);
+    float h = bsdfCameraValue(cam, filters, i, coat);
     // Device exp, log and erf differ from the host's by ulps, which a sample may amplify.
     if (std::fabs(h - bres[i]) > 1e-3f * fmaxf(1.f, std::fabs(h)) && ++bsdfMismatches <= 5)
       std::printf("envgi_cuda_check: BSDF/camera case %d (type %d): CPU %.7g, GPU %.7g\n", i, i % 8, h, bres[i]);

@@ -119,11 +119,15 @@ ENVGI_HD uint64_t sppmCameraStep(const SceneView& sc, const Tracer& tracer, cons
   smp.type = SamplerType::Independent;
   smp.seed = s.seed;
   smp.start(uint64_t(i), uint32_t(pass));
-  Ray ray = sampleCameraRay(cam, smp, i % cam.width, i / cam.width);
+  float w;
+  Ray ray = sampleCameraRay(cam, smp, i % cam.width, i / cam.width, &w);
   Color L(0.f);
   uint64_t rays = 0;
   VisiblePoint vp = sppmCameraPath(sc, tracer, ray, smp, s.maxDepth, s.strategy, &L, &rays);
-  if (isFiniteVec(L)) px.ld[i] += L;
+  // The filter's weight scales all the pass gives the pixel: its direct light, and through the
+  // visible point's beta, the photons' flux gathered there.
+  vp.beta *= w;
+  if (isFiniteVec(L)) px.ld[i] += L * w;
   px.vp[i] = vp;
   px.vpPos[i] = vp.p;
   px.vpValid[i] = vp.valid && isFiniteVec(vp.beta) && !isBlack(vp.beta);

@@ -30,6 +30,7 @@ class CpuExecutor final : public PassExecutor {
         tile_(tileSize) {
     film_.sum.assign(size_t(cam.width) * cam.height, Color(0.f));
     if (keepVariance) film_.sumSqLum.assign(film_.sum.size(), 0.0);
+    if (cam.filter.hasNegativeLobes()) film_.weightSum.assign(film_.sum.size(), 0.f);
     if constexpr (RunsByBounce<Integrator>::value) {
       // A bounce at a time unless ENVGI_CPU_BY_BOUNCE=0 asks for renderPixel (for A/B timings:
       // docs/performance.md); the film is the same to the bit either way.
@@ -44,7 +45,7 @@ class CpuExecutor final : public PassExecutor {
     int W = cam_.width, H = cam_.height;
     int tilesX = (W + tile_ - 1) / tile_, tilesY = (H + tile_ - 1) / tile_;
     FilmView fv{film_.sum.data(), film_.sumSqLum.empty() ? nullptr : film_.sumSqLum.data(), W, H,
-                active_.empty() ? nullptr : active_.data()};
+                active_.empty() ? nullptr : active_.data(), film_.weightSum.empty() ? nullptr : film_.weightSum.data()};
     std::atomic<uint64_t> rays{0}, dropped{0};
     arena_.execute([&] {
       tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& r) {
@@ -81,6 +82,8 @@ class CpuExecutor final : public PassExecutor {
     cam_ = cam;
     film_.sum.assign(size_t(cam.width) * cam.height, Color(0.f));
     if (!film_.sumSqLum.empty()) film_.sumSqLum.assign(film_.sum.size(), 0.0);
+    film_.weightSum.clear();
+    if (cam.filter.hasNegativeLobes()) film_.weightSum.assign(film_.sum.size(), 0.f);
     active_.clear();
     return true;
   }

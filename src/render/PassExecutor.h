@@ -21,6 +21,9 @@ struct PassCounters {
 struct FilmSums {
   std::vector<Color> sum;
   std::vector<double> sumSqLum;  // empty when the executor was not asked to keep it
+  // Sums of the filter's weights, for a filter with negative lobes (ReconstructionFilter.h);
+  // empty where every sample weighs one, and the pixel is its sum over its sample count.
+  std::vector<float> weightSum;
 };
 
 class PassExecutor {

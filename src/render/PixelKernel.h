@@ -80,6 +80,7 @@ struct FilmView {
   double* sumSqLum = nullptr;
   int width = 0, height = 0;
   const unsigned char* active = nullptr;
+  float* weightSum = nullptr;  // the filter's weights summed, for a filter with negative lobes
   ENVGI_HD bool takesSamples(size_t pixel) const { return !active || active[pixel] != 0; }
 };
 
@@ -98,14 +99,16 @@ ENVGI_HD inline Sampler sequenceSampler(const SampleSequence& seq) {
 }
 
 // Starts sample s of pixel (x, y): the sampler at its first dimension, the filter offset, the
-// camera ray. The same (pixel, sample) gives the same sample on any device.
-ENVGI_HD inline Ray startCameraSample(const Camera& cam, Sampler& smp, int x, int y, int s) {
+// camera ray, and the filter's weight for the sample's radiance. The same (pixel, sample) gives
+// the same sample on any device.
+ENVGI_HD inline Ray startCameraSample(const Camera& cam, Sampler& smp, int x, int y, int s, float* weight) {
   smp.start(uint64_t(y) * uint64_t(cam.width) + uint64_t(x), uint32_t(s));
-  return sampleCameraRay(cam, smp, x, y);
+  return sampleCameraRay(cam, smp, x, y, weight);
 }
 
 // Whether a sample's radiance goes into the film; NaN, infinite or negative ones are counted
-// as dropped instead.
+// as dropped instead. It is asked of the radiance before the filter's weight, which may be
+// negative, multiplies it.
 ENVGI_HD inline bool acceptedSample(const Color& L, PixelCounters* counters) {
   if (isFiniteVec(L) && L.x >= 0.f && L.y >= 0.f && L.z >= 0.f) return true;
   ++counters->dropped;
@@ -121,14 +124,19 @@ ENVGI_HD void renderPixel(const Camera& cam, const SampleSequence& seq, const In
   Sampler smp = sequenceSampler(seq);
   Color acc(0.f);
   double accSq = 0.0;
+  float accW = 0.f;
   for (int s = s0; s < s1; ++s) {
-    Color L = integrate(startCameraSample(cam, smp, x, y, s), smp, &counters->rays);
+    float w;
+    Color L = integrate(startCameraSample(cam, smp, x, y, s, &w), smp, &counters->rays);
     if (!acceptedSample(L, counters)) continue;
+    L *= w;
     acc += L;
     accSq += double(luminance(L)) * double(luminance(L));
+    accW += w;
   }
   film.sum[pixel] += acc;
   if (film.sumSqLum) film.sumSqLum[pixel] += accSq;
+  if (film.weightSum) film.weightSum[pixel] += accW;
 }
 
 // Samples [s0, s1) of every pixel by path regeneration (Novak et al. 2010), for a GPU thread:
@@ -144,6 +152,7 @@ ENVGI_HD void regeneratePaths(const Camera& cam, const SampleSequence& seq, cons
   Sampler smp = sequenceSampler(seq);
   PathState st = integ.begin(Ray{});
   uint64_t pixel = 0;
+  float w = 1.f;
   bool active = false;
   for (;;) {
     if (!active) {
@@ -152,10 +161,12 @@ ENVGI_HD void regeneratePaths(const Camera& cam, const SampleSequence& seq, cons
       pixel = item % npix;
       if (!film.takesSamples(pixel)) continue;  // converged: its item costs one fetch
       int x = int(pixel % uint64_t(cam.width)), y = int(pixel / uint64_t(cam.width));
-      st = integ.begin(startCameraSample(cam, smp, x, y, s0 + int(item / npix)));
+      st = integ.begin(startCameraSample(cam, smp, x, y, s0 + int(item / npix), &w));
     }
     active = integ.step(&st, smp, &counters->rays);
     if (!active && acceptedSample(st.L, counters)) {
+      st.L *= w;
+      if (film.weightSum) atomicAddRelaxed(&film.weightSum[pixel], w);
       atomicAddRelaxed(&film.sum[pixel].x, st.L.x);
       atomicAddRelaxed(&film.sum[pixel].y, st.L.y);
       atomicAddRelaxed(&film.sum[pixel].z, st.L.z);
@@ -174,12 +185,14 @@ struct TileBatch {
   std::vector<int> active;
   std::vector<LightSampleLd> ld;  // each path's next-event sample of this round
   std::vector<Color> ldBeta;      // and the path's beta when it was drawn
+  std::vector<float> weight;      // each path's filter weight
   std::vector<Color> acc;
   std::vector<double> accSq;
+  std::vector<float> accW;
   void resize(size_t n) {
     if (state.size() >= n) return;
     state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), active.resize(n);
-    ld.resize(n), ldBeta.resize(n), acc.resize(n), accSq.resize(n);
+    ld.resize(n), ldBeta.resize(n), weight.resize(n), acc.resize(n), accSq.resize(n), accW.resize(n);
   }
 };
 
@@ -207,14 +220,14 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
                         int y1, int s0, int s1, FilmView film, TileBatch* b, PixelCounters* counters) {
   const int tw = x1 - x0, n = tw * (y1 - y0);
   b->resize(size_t(n));
-  for (int k = 0; k < n; ++k) b->acc[k] = Color(0.f), b->accSq[k] = 0.0;
+  for (int k = 0; k < n; ++k) b->acc[k] = Color(0.f), b->accSq[k] = 0.0, b->accW[k] = 0.f;
   for (int s = s0; s < s1; ++s) {
     int live = 0;
     for (int k = 0; k < n; ++k) {
       int x = x0 + k % tw, y = y0 + k / tw;
       if (!film.takesSamples(size_t(y) * size_t(cam.width) + size_t(x))) continue;
       b->sampler[k] = sequenceSampler(seq);
-      b->state[k] = integ.begin(startCameraSample(cam, b->sampler[k], x, y, s));
+      b->state[k] = integ.begin(startCameraSample(cam, b->sampler[k], x, y, s, &b->weight[k]));
       b->active[live++] = k;
     }
     while (live > 0) {
@@ -245,9 +258,10 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         if (b->going[k]) {
           b->active[next++] = k;
         } else if (acceptedSample(b->state[k].L, counters)) {
-          const Color& L = b->state[k].L;
+          const Color L = b->state[k].L * b->weight[k];
           b->acc[k] += L;
           b->accSq[k] += double(luminance(L)) * double(luminance(L));
+          b->accW[k] += b->weight[k];
         }
       }
       live = next;
@@ -258,6 +272,7 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
     if (!film.takesSamples(pixel)) continue;
     film.sum[pixel] += b->acc[k];
     if (film.sumSqLum) film.sumSqLum[pixel] += b->accSq[k];
+    if (film.weightSum) film.weightSum[pixel] += b->accW[k];
   }
 }
 

@@ -234,12 +234,19 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
 
 namespace {
 
-// The film's first n pixels, each divided by its count samplesOf(i) (at least 1).
+// The film's first n pixels, each divided by its count samplesOf(i) (at least 1), or with a
+// filter's weights, by their sum (a weighted mean, as pbrt-v4's and Mitsuba's films take): in a
+// flat region the signed weights then cancel instead of adding noise. Where few samples leave
+// the sum below a quarter of the count, the ratio would blow up: the plain mean, unbiased, is
+// kept there.
 template <class Samples>
 Image meanOfFilm(const FilmSums& film, int width, int height, size_t n, Samples samplesOf) {
   Image img(width, height);
+  const bool weighted = film.weightSum.size() >= n;
   for (size_t i = 0; i < n; ++i) {
-    Color c = film.sum[i] / float(std::max(samplesOf(i), 1));
+    float count = float(std::max(samplesOf(i), 1));
+    if (weighted && film.weightSum[i] > 0.25f * count) count = film.weightSum[i];
+    Color c = film.sum[i] / count;
     img.rgb[3 * i] = c.x;
     img.rgb[3 * i + 1] = c.y;
     img.rgb[3 * i + 2] = c.z;

@@ -5,17 +5,16 @@
 #include "core/Transform.h"
 #include "sampling/Warp.h"
 #include "scene/Ray.h"
+#include "scene/ReconstructionFilter.h"
 
 namespace envgi {
-
-enum class FilterType : int { Box = 0, Tent = 1, Gaussian = 2 };
 
 struct Camera {
   Transform toWorld;
   int width = 512, height = 512;
   float tanHalfX = 0.f, tanHalfY = 0.f;  // half extent of the image plane at distance 1
   float nearClip = 1e-2f, farClip = 1e4f;
-  FilterType filter = FilterType::Gaussian;
+  ReconstructionFilter filter;  // Mitsuba's default: gaussian, stddev 0.5
   // Thin lens (Mitsuba's `thinlens`); a pinhole when the radius is 0.
   float apertureRadius = 0.f, focusDistance = 1e4f;
 
@@ -59,30 +58,16 @@ ENVGI_INLINE bool projectToFilm(const Camera& c, Vec3f p, float* x, float* y) {
   return *x >= 0.f && *y >= 0.f && *x < float(c.width) && *y < float(c.height);
 }
 
-// Film offset from the pixel centre, sampled by the reconstruction filter itself, so every
-// sample has weight one (filter importance sampling). box: radius 0.5; tent: radius 1;
-// gaussian: standard deviation 0.5 (Mitsuba's default), not truncated.
-ENVGI_INLINE Vec2f sampleFilter(FilterType f, Vec2f u) {
-  switch (f) {
-    case FilterType::Box: return {u.x - 0.5f, u.y - 0.5f};
-    case FilterType::Tent: {
-      auto tent = [](float x) { return x < 0.5f ? std::sqrt(2.f * x) - 1.f : 1.f - std::sqrt(2.f - 2.f * x); };
-      return {tent(u.x), tent(u.y)};
-    }
-    case FilterType::Gaussian: break;
-  }
-  float r = 0.5f * std::sqrt(-2.f * std::log(fmaxf(1.f - u.x, 1e-12f)));
-  float phi = 2.f * kPi * u.y;
-  return {r * std::cos(phi), r * std::sin(phi)};
-}
-
 // A camera ray for pixel (x, y) from a sampler's next draws: the filter's offset, then the
-// point on the lens, which a pinhole does not draw (so its sequence stays as it was).
+// point on the lens, which a pinhole does not draw (so its sequence stays as it was). *weight
+// is the sample's filter weight, which multiplies its radiance in the film: one except for
+// the filters with negative lobes (ReconstructionFilter.h).
 template <class Smp>
-ENVGI_HD Ray sampleCameraRay(const Camera& cam, Smp& smp, int x, int y) {
-  Vec2f off = sampleFilter(cam.filter, smp.get2D());
+ENVGI_HD Ray sampleCameraRay(const Camera& cam, Smp& smp, int x, int y, float* weight) {
+  FilterSample fs = sampleFilter(cam.filter, smp.get2D());
+  *weight = fs.weight;
   Vec2f lens = cam.hasLens() ? smp.get2D() : Vec2f(0.5f, 0.5f);
-  return cam.generateRay(float(x) + 0.5f + off.x, float(y) + 0.5f + off.y, lens);
+  return cam.generateRay(float(x) + 0.5f + fs.offset.x, float(y) + 0.5f + fs.offset.y, lens);
 }
 
 }  // namespace envgi

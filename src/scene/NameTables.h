@@ -57,7 +57,9 @@ inline constexpr Named<SamplerType> kSamplerNames[] = {
 };
 
 inline constexpr Named<FilterType> kFilterNames[] = {
-    {"box", FilterType::Box, false}, {"tent", FilterType::Tent, false}, {"gaussian", FilterType::Gaussian, false}};
+    {"box", FilterType::Box, false},           {"tent", FilterType::Tent, false},
+    {"gaussian", FilterType::Gaussian, false}, {"mitchell", FilterType::Mitchell, false},
+    {"catmullrom", FilterType::CatmullRom, false}, {"lanczos", FilterType::Lanczos, false}};
 
 inline IntegratorType findIntegrator(const std::string& name) { return findName(kIntegratorNames, name, "integrator"); }
 inline const char* integratorName(IntegratorType t) { return nameOf(kIntegratorNames, t); }

@@ -473,7 +473,7 @@ class Loader {
     reportUnused(f, p, "sensor", type);
     cam.width = 768;
     cam.height = 576;
-    cam.filter = FilterType::Gaussian;
+    cam.filter = makeFilter(FilterType::Gaussian);
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element) continue;
       std::string tag = c.name();
@@ -525,13 +525,27 @@ class Loader {
       if (tag == "rfilter") {
         checkAttrs(f, c, {"type", "name", "id"});
         std::string t = attr(f, c, "type");
+        FilterType ft{};
         try {
-          cam.filter = findName(kFilterNames, t, "rfilter type");
+          ft = findName(kFilterNames, t, "rfilter type");
         } catch (const std::runtime_error& e) {
           fail(f, c, e.what());
         }
         Props fp = collectProps(f, c);
+        FilterParams params;  // each type reads its own, with Mitsuba's defaults
+        if (ft == FilterType::Tent) params.radius = getFloat(f, fp, "radius", params.radius);
+        if (ft == FilterType::Gaussian) params.stddev = getFloat(f, fp, "stddev", params.stddev);
+        if (ft == FilterType::Mitchell) {
+          params.b = getFloat(f, fp, "B", params.b);
+          params.c = getFloat(f, fp, "C", params.c);
+        }
+        if (ft == FilterType::Lanczos) params.lobes = getInt(f, fp, "lobes", params.lobes);
         reportUnused(f, fp, "rfilter", t);
+        try {
+          cam.filter = makeFilter(ft, params);
+        } catch (const std::invalid_argument& e) {
+          fail(f, c, fmt::format("rfilter '{}': {}", t, e.what()));
+        }
       } else if (!isPropTag(tag)) {
         fail(f, c, fmt::format("unexpected <{}> in <film>", tag));
       }

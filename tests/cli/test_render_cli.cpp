@@ -450,8 +450,13 @@ TEST(RenderCli, SamplerVersionAndParseErrors) {
   EXPECT_NE(s.output.find("stratified sampler"), std::string::npos) << s.output;
   EXPECT_EQ(runCli("render " + scene + " -o " + d.file("t.exr") + " --sampler halton").code, 1);
   EXPECT_EQ(runCli("render " + scene + " -o " + d.file("f.exr") + " --filter tent --no-progress").code, 0);
-  CliResult f = runCli("render " + scene + " -o " + d.file("g.exr") + " --filter lanczos");
-  EXPECT_NE(f.output.find("unknown filter 'lanczos' (box, tent, gaussian)"), std::string::npos) << f.output;
+  CliResult l = runCli("render " + scene + " -o " + d.file("l.exr") + " --filter lanczos --no-progress");
+  EXPECT_EQ(l.code, 0) << l.output;
+  EXPECT_NE(l.output.find("independent sampler, lanczos filter"), std::string::npos) << l.output;
+  CliResult f = runCli("render " + scene + " -o " + d.file("g.exr") + " --filter lanczoz");
+  EXPECT_NE(f.output.find("unknown filter 'lanczoz' (box, tent, gaussian, mitchell, catmullrom, lanczos)"),
+            std::string::npos)
+      << f.output;
   EXPECT_FALSE(fs::exists(d.file("g.exr")));
   // The collapsed map's options and the device index: bad values are one error line, no file.
   for (std::string bad : {"--strategy points --point-method bogus", "--strategy magic", "--points 0", "--gpu -1"}) {

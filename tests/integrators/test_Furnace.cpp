@@ -213,7 +213,7 @@ TEST(Furnace, TexturedEnclosureGivesItsAnalyticRadiance) {
     s->camera.toWorld = lookAt(Vec3f(0.f), Vec3f(1, 0, 0), Vec3f(0, 1, 0));
     s->camera.width = s->camera.height = 16;
     s->camera.tanHalfX = s->camera.tanHalfY = std::tan(0.5f * 50.f * kPi / 180.f);
-    s->camera.filter = FilterType::Box;
+    s->camera.filter = makeFilter(FilterType::Box);
     s->sampler.sampleCount = 32;
     s->sampler.type = SamplerType::Sobol;
     // "photon-map": the photon integrator reading its global map at the visible point.

@@ -305,7 +305,7 @@ TEST(PhotonIntegrators, EmissiveClosedBoxGivesLeOverOneMinusRho) {
   s->shapes[0].radiance = Color(Le);
   s->camera.width = s->camera.height = 16;
   s->camera.tanHalfX = s->camera.tanHalfY = 0.8f;
-  s->camera.filter = FilterType::Box;
+  s->camera.filter = makeFilter(FilterType::Box);
   s->finalize();
   EmbreeAccel accel(*s);
   const double expected = Le / (1.0 - rho);

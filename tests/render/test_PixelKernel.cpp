@@ -108,6 +108,57 @@ TEST(PixelKernel, TileByBounceAddsTheSameSamplesAsRenderPixel) {
   }
 }
 
+// With a filter with negative lobes (Lanczos), the three bodies add the same weighted sums and
+// the same sums of weights to the bit; the weights are not all one, some are negative, and the
+// film's weighted mean of a pixel lies near its plain mean.
+TEST(PixelKernel, EveryBodyAddsTheFiltersWeights) {
+  SmallScene small("buddha", IntegratorType::Path);
+  small.scene.camera.filter = makeFilter(FilterType::Lanczos);
+  small.scene.finalize();
+  const KernelSettings& k = small.k;
+  SampleIntegrator<BvhTracer> integ = small.integrator();
+  const Camera& cam = small.scene.view().camera;
+  ASSERT_EQ(cam.filter.type, FilterType::Lanczos);
+  size_t npix = size_t(cam.width) * cam.height;
+  struct WeightedFilm {
+    Film f;
+    std::vector<float> w;
+    FilmView view(const Camera& cam) {
+      FilmView v = f.view(cam);
+      v.weightSum = w.data();
+      return v;
+    }
+  };
+  WeightedFilm a{{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, std::vector<float>(npix, 0.f)};
+  WeightedFilm b = a, c = a;
+  PixelCounters ca, cb, cc;
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) renderPixel(cam, k.sequence, integ, x, y, 0, 8, a.view(cam), &ca);
+  uint64_t next = 0;
+  regeneratePaths(cam, k.sequence, integ, 0, 8, b.view(cam), [&] { return next++; }, &cb);
+  TileBatch batch;
+  for (int y0 = 0; y0 < cam.height; y0 += 16)
+    for (int x0 = 0; x0 < cam.width; x0 += 16)
+      renderTileByBounce(cam, k.sequence, integ, x0, y0, std::min(x0 + 16, cam.width), std::min(y0 + 16, cam.height), 0,
+                         8, c.view(cam), &batch, &cc);
+  EXPECT_EQ(std::memcmp(a.w.data(), b.w.data(), npix * sizeof(float)), 0);
+  EXPECT_EQ(std::memcmp(a.w.data(), c.w.data(), npix * sizeof(float)), 0);
+  EXPECT_EQ(std::memcmp(a.f.sum.data(), b.f.sum.data(), npix * sizeof(Color)), 0);
+  EXPECT_EQ(std::memcmp(a.f.sum.data(), c.f.sum.data(), npix * sizeof(Color)), 0);
+  double total = 0.0;
+  size_t notEight = 0;
+  for (float w : a.w) total += w, notEight += std::fabs(w - 8.f) > 1e-3f;
+  EXPECT_GT(notEight, npix / 2) << "the weights are applied";
+  EXPECT_NEAR(total / double(npix), 8.0, 0.5) << "and average one a sample";
+  // filmMean divides by the weights' sum where it is at least a quarter of the count.
+  FilmSums fs{a.f.sum, {}, a.w};
+  Image img = filmMean(fs, cam.width, cam.height, 8);
+  for (size_t i = 0; i < npix; ++i) {
+    float d = a.w[i] > 2.f ? a.w[i] : 8.f;
+    ASSERT_NEAR(img.rgb[3 * i + 1], a.f.sum[i].y / d, 1e-6f * (1.f + std::fabs(a.f.sum[i].y))) << i;
+  }
+}
+
 // Adaptive sampling's mask: renderPixel, renderTileByBounce and regeneratePaths leave a masked
 // pixel's sums alone and give every other pixel the same sums to the bit as an unmasked pass.
 TEST(PixelKernel, MaskedPixelsTakeNoSamplesAndTheRestTheSame) {

@@ -67,7 +67,7 @@ TEST(SceneLoader, SensorFilmSamplerIntegrator) {
   EXPECT_EQ(s.camera.height, 32);
   EXPECT_NEAR(s.camera.tanHalfY, std::tan(30.f * kPi / 180.f), 1e-5f);
   EXPECT_NEAR(s.camera.tanHalfX, 2.f * s.camera.tanHalfY, 1e-5f);
-  EXPECT_EQ(s.camera.filter, FilterType::Tent);
+  EXPECT_EQ(s.camera.filter.type, FilterType::Tent);
   EXPECT_EQ(s.sampler.type, SamplerType::Stratified);
   EXPECT_EQ(s.sampler.sampleCount, 9);
   EXPECT_EQ(s.sampler.seed, 4u);
@@ -107,6 +107,50 @@ TEST(SceneLoader, SensorFilmSamplerIntegrator) {
   std::string unfocused = focused;
   unfocused.replace(unfocused.find("value=\"3.5\""), 11, "value=\"0\"");
   EXPECT_NE(loadError(f.scene(unfocused)).find("focus_distance must be positive"), std::string::npos);
+}
+
+// Each of Mitsuba's rfilters with the parameters its plugin takes, Mitsuba's defaults where none
+// is given; a value out of range, or a parameter of another filter, is an error with the line.
+TEST(SceneLoader, EveryMitsubaFilterWithItsParameters) {
+  Fixture f;
+  auto withFilter = [&](const std::string& rfilter) {
+    std::string body = kSensor;
+    body.replace(body.find("<rfilter type=\"tent\"/>"), 22, rfilter);
+    return f.scene(body);
+  };
+  auto filterOf = [&](const std::string& rfilter) {
+    Scene s;
+    loadScene(withFilter(rfilter), {}, s);
+    return s.camera.filter;
+  };
+  EXPECT_EQ(filterOf("<rfilter type=\"box\"/>").radius, 0.5f);
+  EXPECT_EQ(filterOf("<rfilter type=\"tent\"/>").radius, 1.f);
+  EXPECT_EQ(filterOf("<rfilter type=\"tent\"><float name=\"radius\" value=\"1.5\"/></rfilter>").radius, 1.5f);
+  ReconstructionFilter g = filterOf("<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"0.25\"/></rfilter>");
+  EXPECT_EQ(g.stddev, 0.25f);
+  EXPECT_EQ(g.radius, 1.f);
+  ReconstructionFilter m = filterOf("<rfilter type=\"mitchell\"><float name=\"B\" value=\"0.5\"/>"
+                                    "<float name=\"C\" value=\"0.25\"/></rfilter>");
+  EXPECT_EQ(m.type, FilterType::Mitchell);
+  EXPECT_EQ(m.b, 0.5f);
+  EXPECT_EQ(m.c, 0.25f);
+  EXPECT_NEAR(filterOf("<rfilter type=\"mitchell\"/>").b, 1.f / 3.f, 1e-7f);
+  ReconstructionFilter cr = filterOf("<rfilter type=\"catmullrom\"/>");
+  EXPECT_EQ(cr.type, FilterType::CatmullRom);
+  EXPECT_EQ(cr.c, 0.5f);
+  EXPECT_EQ(filterOf("<rfilter type=\"lanczos\"/>").radius, 3.f);
+  EXPECT_EQ(filterOf("<rfilter type=\"lanczos\"><integer name=\"lobes\" value=\"2\"/></rfilter>").radius, 2.f);
+  // Errors: the line of the rfilter (line 7 of the file), and what is wrong.
+  std::string e = loadError(withFilter("<rfilter type=\"tent\"><float name=\"radius\" value=\"0\"/></rfilter>"));
+  EXPECT_NE(e.find("s.xml:7: rfilter 'tent': tent's radius must be positive, got 0"), std::string::npos) << e;
+  e = loadError(withFilter("<rfilter type=\"lanczos\"><integer name=\"lobes\" value=\"0\"/></rfilter>"));
+  EXPECT_NE(e.find("lanczos's lobes must be 1 to 64"), std::string::npos) << e;
+  e = loadError(withFilter("<rfilter type=\"gaussian\"><float name=\"stddev\" value=\"-1\"/></rfilter>"));
+  EXPECT_NE(e.find("gaussian's stddev must be positive"), std::string::npos) << e;
+  e = loadError(withFilter("<rfilter type=\"catmullrom\"><float name=\"radius\" value=\"2\"/></rfilter>"));
+  EXPECT_NE(e.find("has no property 'radius'"), std::string::npos) << e;
+  e = loadError(withFilter("<rfilter type=\"mitchel\"/>"));
+  EXPECT_NE(e.find("unknown rfilter type 'mitchel'"), std::string::npos) << e;
 }
 
 TEST(SceneLoader, ShapesBsdfsEmittersTransformsDefaults) {

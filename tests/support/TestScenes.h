@@ -17,7 +17,7 @@ inline std::unique_ptr<Scene> furnaceScene(const Bsdf& b, int res, int spp) {
   s->camera.toWorld = lookAt(Vec3f(0, 0, 4), Vec3f(0, 0, 0), Vec3f(0, 1, 0));
   s->camera.width = s->camera.height = res;
   s->camera.tanHalfX = s->camera.tanHalfY = std::tan(0.5f * 35.f * kPi / 180.f);
-  s->camera.filter = FilterType::Box;
+  s->camera.filter = makeFilter(FilterType::Box);
   s->sampler.sampleCount = spp;
   s->sampler.type = SamplerType::Sobol;
   s->integrator.type = IntegratorType::Path;
@@ -43,7 +43,7 @@ inline std::unique_ptr<Scene> sphereOnFloor(const Bsdf& floor, const Bsdf& ball,
   s->camera.toWorld = lookAt(eye, target, Vec3f(0, 1, 0));
   s->camera.width = s->camera.height = res;
   s->camera.tanHalfX = s->camera.tanHalfY = std::tan(0.5f * fovDeg * kPi / 180.f);
-  s->camera.filter = FilterType::Box;
+  s->camera.filter = makeFilter(FilterType::Box);
   s->finalize();
   return s;
 }
