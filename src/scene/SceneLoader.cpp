@@ -910,10 +910,15 @@ class Loader {
       scene_.spheres.push_back(s);
     } else {
       TriangleMesh mesh;
+      const bool fromFile = type == "ply" || type == "obj";
+      bool faceNormals = getBool(f, p, "face_normals", false);
+      // Mitsuba's mesh loaders flip v by default: files give v up the image, bitmaps store rows down.
+      bool flipUv = fromFile && getBool(f, p, "flip_tex_coords", true);
       try {
-        if (type == "ply" || type == "obj") {
+        if (fromFile) {
           std::string file = getString(f, p, "filename", "");
           if (file.empty()) fail(f, n, type + " shape needs a 'filename'");
+          reportUnused(f, p, "shape", type);  // a misspelt property before a large mesh's load, not after
           fs::path path = fs::path(f->path).parent_path() / file;
           if (!fs::exists(path)) fail(f, n, fmt::format("mesh file '{}' does not exist", path.string()));
           mesh = type == "ply" ? loadPly(path.string()) : loadObj(path.string());
@@ -929,13 +934,11 @@ class Loader {
       } catch (const std::runtime_error& e) {
         rethrowAt(f, n, e);
       }
-      bool faceNormals = getBool(f, p, "face_normals", false);
-      // Mitsuba's mesh loaders flip v by default: files give v up the image, bitmaps store rows down.
-      if ((type == "ply" || type == "obj") && getBool(f, p, "flip_tex_coords", true))
+      if (flipUv)
         for (Vec2f& uv : mesh.uvs) uv.y = 1.f - uv.y;
       mesh.transform(toWorld);
       if (faceNormals) mesh.normals.clear();
-      else if (mesh.normals.empty() && (type == "ply" || type == "obj")) mesh.computeVertexNormals();
+      else if (mesh.normals.empty() && fromFile) mesh.computeVertexNormals();
       if (flip) {
         // Mitsuba flips the normals; reversing the winding keeps geometric and shading normals together.
         for (size_t i = 0; i < mesh.indices.size(); i += 3) std::swap(mesh.indices[i + 1], mesh.indices[i + 2]);

@@ -402,6 +402,9 @@ TEST(SceneLoader, APropertyMitsubaDoesNotKnowIsAnError) {
       // Said before the map is read: this one is not there at all.
       {R"(<emitter type="envmap"><string name="filename" value="missing.exr"/><float name="scal" value="2"/></emitter>)",
        "emitter 'envmap' has no property 'scal' (did you mean 'scale'?)"},
+      // And before a mesh file is read: this one is not there either.
+      {R"(<shape type="ply"><string name="filename" value="missing.ply"/><boolean name="face_normal" value="true"/></shape>)",
+       "shape 'ply' has no property 'face_normal' (did you mean 'face_normals'?)"},
       {R"(<shape type="sphere"><bsdf type="diffuse"><rgb name="reflectence" value="0.5"/></bsdf></shape>)",
        "bsdf 'diffuse' has no property 'reflectence' (did you mean 'reflectance'?)"},
       {R"(<shape type="sphere"><bsdf type="roughconductor"><float name="alpha_x" value="0.1"/></bsdf></shape>)",
