@@ -97,6 +97,10 @@ class CudaSppmExecutor final : public SppmPassExecutor {
     check(cudaMemset(px_.m, 0, n * sizeof(uint32_t)), "clearing SPPM state");
     check(cudaMemset(px_.tau, 0, n * sizeof(Color)), "clearing SPPM state");
     check(cudaMemset(px_.ld, 0, n * sizeof(Color)), "clearing SPPM state");
+    if (scene.view().camera.filter.hasNegativeLobes()) {
+      px_.weightSum = a.allocate<float>(n, "SPPM filter weights");
+      check(cudaMemset(px_.weightSum, 0, n * sizeof(float)), "clearing SPPM state");
+    }
     keptR2_ = a.allocate<float>(n, "SPPM grid");
     kept_ = a.allocate<int>(n, "SPPM grid");
     keys_[0] = a.allocate<int>(n, "SPPM grid");
@@ -140,6 +144,12 @@ class CudaSppmExecutor final : public SppmPassExecutor {
     out->sum.resize(n);
     out->sumSqLum.clear();
     for (size_t i = 0; i < n; ++i) out->sum[i] = sppmRadiance(ld[i], tau[i], r2[i], passes, photons) * float(passes);
+    out->weightSum.clear();
+    if (px_.weightSum) {
+      out->weightSum.resize(n);
+      check(cudaMemcpy(out->weightSum.data(), px_.weightSum, n * sizeof(float), cudaMemcpyDeviceToHost),
+            "reading the film");
+    }
   }
 
   SppmStats stats() const override {

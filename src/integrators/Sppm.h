@@ -108,6 +108,7 @@ struct SppmPixels {
   uint32_t* m = nullptr;
   Color* tau = nullptr;
   Color* ld = nullptr;
+  float* weightSum = nullptr;  // the filter's weights over the passes, for a filter with negative lobes
 };
 
 // Camera step for pixel i of pass `pass`: its visible point and direct light. Returns rays.
@@ -128,6 +129,7 @@ ENVGI_HD uint64_t sppmCameraStep(const SceneView& sc, const Tracer& tracer, cons
   // visible point's beta, the photons' flux gathered there.
   vp.beta *= w;
   if (isFiniteVec(L)) px.ld[i] += L * w;
+  if (px.weightSum) px.weightSum[i] += w;  // the film then divides by it, as for path (FilmSums)
   px.vp[i] = vp;
   px.vpPos[i] = vp.p;
   px.vpValid[i] = vp.valid && isFiniteVec(vp.beta) && !isBlack(vp.beta);

@@ -37,6 +37,7 @@ SppmExecutor<Tracer>::SppmExecutor(const Scene& scene, Tracer tracer, const Sppm
   vps_.resize(np);
   vpPos_.resize(np);
   vpValid_.assign(np, 0);
+  if (scene.view().camera.filter.hasNegativeLobes()) weightSum_.assign(np, 0.f);
 }
 
 template <class Tracer>
@@ -52,7 +53,8 @@ void SppmExecutor<Tracer>::iteration(int pass, PassCounters* counters) {
   const SceneView& sc = scene_.view();
   const int N = W_ * H_;
   SppmPixels px{vps_.data(), vpPos_.data(), vpValid_.data(), r2_.data(), n_.data(),
-                phi_.data(),  m_.data(),     tau_.data(),     ld_.data()};
+                phi_.data(),  m_.data(),     tau_.data(),     ld_.data(),
+                weightSum_.empty() ? nullptr : weightSum_.data()};
   std::atomic<uint64_t> rays{0}, hits{0};
   auto tc = Clock::now();
   arena_.execute([&] {
@@ -99,6 +101,7 @@ void SppmExecutor<Tracer>::readFilm(FilmSums* out) {
   out->sum.resize(np);
   out->sumSqLum.clear();
   for (size_t i = 0; i < np; ++i) out->sum[i] = sppmRadiance(ld_[i], tau_[i], r2_[i], passes, photons) * float(passes);
+  out->weightSum = weightSum_;
 }
 
 template <class Tracer>

@@ -38,6 +38,7 @@ class SppmExecutor final : public SppmPassExecutor {
   int W_, H_;
   std::vector<float> r2_, n_, phi_;
   std::vector<Color> tau_, ld_;
+  std::vector<float> weightSum_;  // empty unless the filter has negative lobes
   std::vector<uint32_t> m_;
   std::vector<VisiblePoint> vps_;
   std::vector<Vec3f> vpPos_;
