@@ -38,7 +38,6 @@ ReconstructionFilter makeFilter(FilterType type, const FilterParams& params) {
   const int n = ReconstructionFilter::kBins;
   const double width = double(f.radius) / n;
   double absSum = 0.0, sum = 0.0;
-  f.cdf[0] = 0.f;
   double acc[ReconstructionFilter::kBins + 1] = {0.0};
   for (int i = 0; i < n; ++i) {
     double a = 0.0;

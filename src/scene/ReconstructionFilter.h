@@ -1,8 +1,9 @@
 // Mitsuba 3's pixel reconstruction filters (its `rfilter` plugins): box, tent, gaussian,
 // mitchell, catmullrom and lanczos, with their parameters. Each pixel's samples are drawn from
-// its filter (filter importance sampling), so a sample lands where the filter is and the film
-// divides by the sample count alone. The separable filters with negative lobes are drawn from
-// a table of |f| and carry a weight f / (pdf * integral of f), +-1 or so, whose mean is one.
+// its filter (filter importance sampling): box, tent and gaussian exactly, with weight one. The
+// separable filters with negative lobes are drawn from a table of |f| and carry a weight
+// f / (pdf * integral of f), negative in the lobes, whose mean is one; the film then divides
+// each pixel by its sum of weights rather than its sample count (FilmSums::weightSum).
 #pragma once
 
 #include <cmath>
