@@ -67,6 +67,10 @@ ENVGI_HD float bsdfCameraValue(const Camera& cam, const FilterSet& filters, int 
     setBsdfCoatTable(b, coat);
     b.coatNodes = kCoatAlphaNodes;
   }
+  if ((i / 128) % 2 == 1) {  // under a normal map (texture 0 is never read here: bsdfAt is not called)
+    b.normalMapTexture = 0;
+    b.mappedNormal = normalize(Vec3f(0.4f, -0.3f, 0.85f));
+  }
   Vec3f wo = normalize(Vec3f(0.3f, 0.2f, (i % 3 == 0) ? -0.8f : 0.8f));
   // Draws into named values: the order in which a call's arguments are evaluated is the
   // compiler's choice, and g++ and nvcc's device side choose differently.

@@ -4,6 +4,7 @@
 // f(wo, wi) |cos theta_i| of the non-delta lobes; delta lobes are reached only by sample().
 #pragma once
 
+#include "core/Frame.h"
 #include "materials/Fresnel.h"
 #include "materials/Microfacet.h"
 #include "materials/RoughCoat.h"
@@ -32,6 +33,8 @@ struct Bsdf {
   bool twoSided = false;
   bool perfectMirror = false;            // conductor material "none"
   bool nonlinear = false;                // plastics: Mitsuba's `nonlinear`, the base's colour saturates under the coat
+  bool flipInvalidNormals = true;        // normalmap (below): Mitsuba's flip_invalid_normals
+  bool bumpShadowing = true;             // normalmap: use_shadowing_function, Estevez et al.'s terminator term
   MicrofacetType distribution = MicrofacetType::GGX;  // of the rough BSDFs
   Color reflectance{0.5f};               // diffuse (and plastic base) albedo
   Color specularReflectance{1.f};
@@ -53,6 +56,12 @@ struct Bsdf {
   // aligned: a pointer member cost the path kernel 7 registers on sm_90 (96 to 103).
   uint32_t coatTableLo = 0, coatTableHi = 0;
   int coatNodes = 0;
+  // Mitsuba's normalmap adapter around this BSDF: a texture of normals relative to the shading
+  // frame (rgb = (n + 1) / 2) tilts the frame this BSDF is evaluated in; -1: none. mappedNormal
+  // is its unit normal at the hit, which SceneView::bsdfAt fills in (local z where unmapped).
+  // Its two flags sit with the other bools above.
+  int normalMapTexture = -1;
+  Vec3f mappedNormal{0.f, 0.f, 1.f};
 };
 
 ENVGI_INLINE const float* bsdfCoatTable(const Bsdf& b) {
@@ -75,20 +84,27 @@ struct BsdfSample {
 // dielectric (1 for reflection and for thin sheets): the 1/eta^2 by which radiance was
 // compressed, which Russian roulette should not count as lost throughput (pbrt-v4's etaScale,
 // Mitsuba 3's eta^2 in its roulette).
-ENVGI_INLINE float bsdfEtaSquared(const Bsdf& b, Vec3f wo, Vec3f wi) {
+namespace detail {
+ENVGI_INLINE float etaSquaredInFrame(const Bsdf& b, Vec3f wo, Vec3f wi) {
   if ((b.type != BsdfType::Dielectric && b.type != BsdfType::RoughDielectric) || wo.z * wi.z >= 0.f) return 1.f;
   float etap = wo.z > 0.f ? b.ior : 1.f / b.ior;
   return etap * etap;
 }
+}  // namespace detail
 
 ENVGI_INLINE bool bsdfIsAnisotropic(const Bsdf& b) { return b.alphaV >= 0.f; }
 ENVGI_INLINE MicrofacetDistribution microfacet(const Bsdf& b) {
   return {b.alpha, bsdfIsAnisotropic(b) ? b.alphaV : b.alpha, b.distribution};
 }
 
+ENVGI_INLINE bool bsdfIsNormalMapped(const Bsdf& b) { return b.normalMapTexture >= 0; }
+// Hits on this material build their shading frame along dp/du (Mitsuba's): an anisotropic
+// lobe is oriented by it, and a normal map's tangent space is that frame.
+ENVGI_INLINE bool bsdfNeedsTangentFrame(const Bsdf& b) { return bsdfIsAnisotropic(b) || bsdfIsNormalMapped(b); }
+
 ENVGI_INLINE bool bsdfHasTexture(const Bsdf& b) {
   return b.reflectanceTexture >= 0 || b.specularReflectanceTexture >= 0 || b.specularTransmittanceTexture >= 0 ||
-         b.alphaTexture >= 0 || b.alphaVTexture >= 0;
+         b.alphaTexture >= 0 || b.alphaVTexture >= 0 || b.normalMapTexture >= 0;
 }
 
 // True when every lobe is a delta: next-event estimation is pointless there.
@@ -201,7 +217,8 @@ ENVGI_INLINE float roughPlasticPdf(const Bsdf& b, const RoughPlasticShared& r, V
 
 }  // namespace detail
 
-ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
+namespace detail {
+ENVGI_INLINE Color evalInFrame(const Bsdf& b, Vec3f wo, Vec3f wi) {
   detail::toFrontSide(b, &wo, &wi);
   switch (b.type) {
     case BsdfType::Diffuse:
@@ -240,7 +257,7 @@ ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
   return Color(0.f);
 }
 
-ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
+ENVGI_INLINE float pdfInFrame(const Bsdf& b, Vec3f wo, Vec3f wi) {
   detail::toFrontSide(b, &wo, &wi);
   switch (b.type) {
     case BsdfType::Diffuse:
@@ -280,10 +297,10 @@ ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
 // bsdfEval and bsdfPdf of one pair of directions, with the very values of the two calls apart.
 // Next-event estimation and BSDF sampling both want both (Mitsuba's eval_pdf); rough plastic,
 // the example scenes' glossy BSDF, then computes what the two share once instead of twice.
-ENVGI_INLINE Color bsdfEvalPdf(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
+ENVGI_INLINE Color evalPdfInFrame(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
   if (b.type != BsdfType::RoughPlastic) {
-    *pdf = bsdfPdf(b, wo, wi);
-    return bsdfEval(b, wo, wi);
+    *pdf = pdfInFrame(b, wo, wi);
+    return evalInFrame(b, wo, wi);
   }
   detail::toFrontSide(b, &wo, &wi);
   if (wo.z <= 0.f || wi.z <= 0.f) {
@@ -295,10 +312,9 @@ ENVGI_INLINE Color bsdfEvalPdf(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
   return detail::roughPlasticEval(b, r, wo, wi);
 }
 
-namespace detail {
 // Non-delta lobes: the pdf of the sampled direction over all lobes, and weight = eval / pdf.
 ENVGI_INLINE bool finishSample(const Bsdf& b, Vec3f wo, BsdfSample* s) {
-  Color f = bsdfEvalPdf(b, wo, s->wi, &s->pdf);
+  Color f = evalPdfInFrame(b, wo, s->wi, &s->pdf);
   if (!(s->pdf > 0.f)) return false;
   s->weight = f / s->pdf;
   return true;
@@ -311,8 +327,8 @@ ENVGI_INLINE bool bsdfPicksALobe(const Bsdf& b) {
   return b.type != BsdfType::Diffuse && b.type != BsdfType::Conductor && b.type != BsdfType::RoughConductor;
 }
 
-// uc picks a lobe, u the direction within it. Returns false when no direction is produced.
-ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s) {
+namespace detail {
+ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s) {
   bool flip = b.twoSided && wo.z < 0.f;
   if (flip) wo.z = -wo.z;
   bool ok = false;
@@ -426,16 +442,96 @@ ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSam
   if (ok && flip) s->wi.z = -s->wi.z;
   return ok && isFiniteVec(s->weight);
 }
+}  // namespace detail
 
 // Probability that bsdfSample picks a delta lobe from wo when the BSDF also has a smooth one
 // (smooth plastic's coat); 0 for BSDFs without delta lobes, 1 for purely delta ones. Callers
 // that follow delta lobes themselves (SPPM, the photon integrator) split on it.
-ENVGI_INLINE float bsdfDeltaProb(const Bsdf& b, Vec3f wo) {
+namespace detail {
+ENVGI_INLINE float deltaProbInFrame(const Bsdf& b, Vec3f wo) {
   if (bsdfIsDelta(b)) return 1.f;
   if (b.type != BsdfType::Plastic) return 0.f;
   float c = b.twoSided ? std::fabs(wo.z) : wo.z;
   if (c <= 0.f) return 0.f;
   return detail::plasticSpecularProb(b, fresnelDielectric(c, b.ior));
+}
+}  // namespace detail
+
+// --- The BSDF as the integrators see it: wo and wi in the hit's shading frame. Without a
+// normal map these are the functions above; with one, Mitsuba's normalmap adapter
+// (src/bsdfs/normalmap.cpp): directions go into the tilted frame, a direction on different
+// sides of the two frames gets nothing, and the shadowing term scales the value.
+
+namespace detail {
+// The normal map's frame as seen from wo: with flip_invalid_normals, a normal that wo sees from
+// the other side than the unmapped frame's is mirrored about z (Schuessler et al. 2017, as
+// Mitsuba does); s is local x made orthogonal to it.
+ENVGI_INLINE Frame mappedFrame(const Bsdf& b, Vec3f wo) {
+  Vec3f n = b.mappedNormal;
+  if (b.flipInvalidNormals && wo.z * dot(wo, n) <= 0.f) n = Vec3f(-n.x, -n.y, n.z);
+  return Frame::fromNormalAndTangent(n, Vec3f(1.f, 0.f, 0.f));
+}
+// Estevez et al. 2019 ("A microfacet-based shadowing function to solve the bump terminator
+// problem"): a Smith-like term from the tilt of the mapped normal n, for the light direction wi
+// (both in the unmapped frame), which softens the hard edge where a tilted normal's light ends.
+ENVGI_INLINE float bumpShadowingTerm(Vec3f n, Vec3f wi) {
+  auto tan2 = [](Vec3f v) { return fmaxf(0.f, 1.f - v.z * v.z) / (v.z * v.z); };
+  float alpha2 = fminf(0.125f * tan2(n), 1.f);
+  return 2.f / (1.f + std::sqrt(1.f + alpha2 * tan2(wi)));
+}
+
+}  // namespace detail
+
+ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
+  if (!bsdfIsNormalMapped(b)) return detail::evalInFrame(b, wo, wi);
+  Frame f = detail::mappedFrame(b, wo);
+  Vec3f mi = f.toLocal(wi);
+  if (!(wi.z * mi.z > 0.f)) return Color(0.f);
+  Color v = detail::evalInFrame(b, f.toLocal(wo), mi);
+  return b.bumpShadowing ? v * detail::bumpShadowingTerm(f.n, wi) : v;
+}
+
+ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
+  if (!bsdfIsNormalMapped(b)) return detail::pdfInFrame(b, wo, wi);
+  Frame f = detail::mappedFrame(b, wo);
+  Vec3f mi = f.toLocal(wi);
+  return wi.z * mi.z > 0.f ? detail::pdfInFrame(b, f.toLocal(wo), mi) : 0.f;
+}
+
+// Both at once, as evalPdfInFrame.
+ENVGI_INLINE Color bsdfEvalPdf(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
+  if (!bsdfIsNormalMapped(b)) return detail::evalPdfInFrame(b, wo, wi, pdf);
+  Frame f = detail::mappedFrame(b, wo);
+  Vec3f mi = f.toLocal(wi);
+  if (!(wi.z * mi.z > 0.f)) {
+    *pdf = 0.f;
+    return Color(0.f);
+  }
+  Color v = detail::evalPdfInFrame(b, f.toLocal(wo), mi, pdf);
+  return b.bumpShadowing ? v * detail::bumpShadowingTerm(f.n, wi) : v;
+}
+
+// uc picks a lobe, u the direction within it. Returns false when no direction is produced.
+ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s) {
+  if (!bsdfIsNormalMapped(b)) return detail::sampleInFrame(b, wo, uc, u, s);
+  Frame f = detail::mappedFrame(b, wo);
+  if (!detail::sampleInFrame(b, f.toLocal(wo), uc, u, s)) return false;
+  Vec3f mi = s->wi;
+  s->wi = f.toWorld(mi);
+  if (!(s->wi.z * mi.z > 0.f)) return false;
+  if (b.bumpShadowing) s->weight *= detail::bumpShadowingTerm(f.n, s->wi);
+  return true;
+}
+
+ENVGI_INLINE float bsdfEtaSquared(const Bsdf& b, Vec3f wo, Vec3f wi) {
+  if (!bsdfIsNormalMapped(b) || !bsdfTransmits(b)) return detail::etaSquaredInFrame(b, wo, wi);
+  Frame f = detail::mappedFrame(b, wo);
+  return detail::etaSquaredInFrame(b, f.toLocal(wo), f.toLocal(wi));
+}
+
+ENVGI_INLINE float bsdfDeltaProb(const Bsdf& b, Vec3f wo) {
+  if (!bsdfIsNormalMapped(b) || b.type != BsdfType::Plastic) return detail::deltaProbInFrame(b, wo);
+  return detail::deltaProbInFrame(b, detail::mappedFrame(b, wo).toLocal(wo));
 }
 
 }  // namespace envgi

@@ -72,6 +72,8 @@ const PluginProperties kMitsuba[] = {
      {"base_color", "roughness", "anisotropic", "metallic", "spec_trans", "eta", "specular", "spec_tint", "sheen",
       "sheen_tint", "flatness", "clearcoat", "clearcoat_gloss"}},
     {"bsdf", {"mask"}, {"opacity"}},
+    {"bsdf", {"normalmap", "bumpmap"}, {"flip_invalid_normals", "use_shadowing_function"}},
+    {"bsdf", {"bumpmap"}, {"scale"}},
     // Textures
     {"texture",
      {"bitmap"},

@@ -48,7 +48,7 @@ void Scene::finalize() {
       v.indices = m.indices.data();
       v.triangleCount = int(m.triangleCount());
       v.bsdf = s.bsdf;
-      v.anisotropic = s.bsdf >= 0 && size_t(s.bsdf) < bsdfs.size() && bsdfIsAnisotropic(bsdfs[size_t(s.bsdf)]);
+      v.anisotropic = s.bsdf >= 0 && size_t(s.bsdf) < bsdfs.size() && bsdfNeedsTangentFrame(bsdfs[size_t(s.bsdf)]);
       for (const Vec3f& p : m.positions) {
         lo = vmin(lo, p);
         hi = vmax(hi, p);

@@ -696,6 +696,7 @@ class Loader {
       scene_.bsdfs[size_t(id)].twoSided = true;
       return id;
     }
+    if (type == "normalmap") return normalMap(f, n, p);
     // Textured properties, by name: nested <texture name=...> or <ref id=... name=...>.
     std::map<std::string, std::pair<int, pugi::xml_node>> textures;
     for (pugi::xml_node c : n.children()) {
@@ -751,7 +752,7 @@ class Loader {
       finishPlastic(b);
     } else {
       fail(f, n, fmt::format("unknown BSDF type '{}' (diffuse, conductor, roughconductor, dielectric, thindielectric, "
-                             "roughdielectric, plastic, roughplastic, twosided)",
+                             "roughdielectric, plastic, roughplastic, twosided, normalmap)",
                              type));
     }
     for (const auto& [name, tex] : textures) {
@@ -780,6 +781,57 @@ class Loader {
     reportUnused(f, p, "bsdf", type);
     scene_.bsdfs.push_back(b);
     return int(scene_.bsdfs.size() - 1);
+  }
+
+  // Mitsuba's normalmap adapter: one nested BSDF (<bsdf> or a <ref> to one) and a texture named
+  // `normalmap`. The result is the nested BSDF with the map attached (a copy where referenced).
+  int normalMap(const SourceFile* f, pugi::xml_node n, Props& p) {
+    int inner = -1, map = -1;
+    auto setInner = [&](pugi::xml_node c, int id) {
+      if (inner >= 0) fail(f, c, "normalmap takes one nested BSDF");
+      inner = id;
+    };
+    auto setMap = [&](pugi::xml_node c, int id) {
+      std::string name = c.attribute("name").as_string();
+      if (name != "normalmap")
+        fail(f, c, fmt::format("normalmap has no texture property '{}' (its texture is named 'normalmap')", name));
+      if (map >= 0) fail(f, c, "property 'normalmap' given twice");
+      map = id;
+    };
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element) continue;
+      std::string tag = c.name();
+      if (tag == "bsdf") {
+        setInner(c, bsdf(f, c));
+      } else if (tag == "texture") {
+        setMap(c, texture(f, c));
+      } else if (tag == "ref") {
+        checkAttrs(f, c, {"id", "name"});
+        std::string id = attr(f, c, "id");
+        // A texture when it is named as one or only a texture has the id; a BSDF otherwise.
+        auto b = bsdfIds_.find(id);
+        auto t = textureIds_.find(id);
+        if (t != textureIds_.end() && (b == bsdfIds_.end() || c.attribute("name"))) {
+          setMap(c, t->second.index);
+        } else if (b != bsdfIds_.end()) {
+          scene_.bsdfs.push_back(scene_.bsdfs[size_t(b->second.index)]);
+          setInner(c, int(scene_.bsdfs.size() - 1));
+        } else {
+          fail(f, c, fmt::format("unknown BSDF or texture id '{}'", id));
+        }
+      } else if (!isPropTag(tag)) {
+        fail(f, c, fmt::format("unexpected <{}> in <bsdf>", tag));
+      }
+    }
+    if (inner < 0) fail(f, n, "normalmap needs a nested <bsdf>");
+    if (map < 0) fail(f, n, "normalmap needs a texture named 'normalmap'");
+    Bsdf& b = scene_.bsdfs[size_t(inner)];
+    if (bsdfIsNormalMapped(b)) fail(f, n, "a normalmap inside a normalmap is not supported");
+    b.normalMapTexture = map;
+    b.flipInvalidNormals = getBool(f, p, "flip_invalid_normals", true);
+    b.bumpShadowing = getBool(f, p, "use_shadowing_function", true);
+    reportUnused(f, p, "bsdf", "normalmap");
+    return inner;
   }
 
   // Where a texture for property `name` goes in b (the colours, and the roughness of the rough

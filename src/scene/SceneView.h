@@ -22,7 +22,7 @@ struct MeshView {
   int triangleCount = 0;
   int bsdf = 0;
   int lightOffset = -1;  // index of triangle 0 in the light list, -1 when not emissive
-  bool anisotropic = false;  // its material is: hits then build their frame along dp/du
+  bool anisotropic = false;  // its material needs a frame along dp/du (bsdfNeedsTangentFrame)
 };
 
 struct SphereView {
@@ -130,7 +130,7 @@ struct SceneView {
       if (s.flipNormals) n = -n;
       si.ng = n;
       si.shading = Frame::fromNormal(n);
-      if (bsdfIsAnisotropic(bsdfs[s.bsdf])) {
+      if (bsdfNeedsTangentFrame(bsdfs[s.bsdf])) {
         // dp/du runs along the azimuth about the sphere's own z, as Mitsuba's.
         Vec3f l = s.axes.toLocal(radial);
         si.shading = Frame::fromNormalAndTangent(n, s.axes.toWorld(Vec3f(-l.y, l.x, 0.f)));
@@ -154,7 +154,16 @@ struct SceneView {
     auto roughness = [&](int t) { return fminf(fmaxf(luminance(textureEval(textures[t], uv)), kMinAlpha), kMaxAlpha); };
     if (b.alphaTexture >= 0) b.alpha = roughness(b.alphaTexture);
     if (b.alphaVTexture >= 0) b.alphaV = roughness(b.alphaVTexture);
+    if (b.normalMapTexture >= 0) b.mappedNormal = mappedNormalAt(textures[b.normalMapTexture], uv);
     return b;
+  }
+  // A normal map's texel as a unit normal: rgb = (n + 1) / 2, relative to the shading frame; one
+  // that decodes to no direction at all leaves the frame as it is.
+  ENVGI_HD static Vec3f mappedNormalAt(const TextureView& t, Vec2f uv) {
+    Color c = textureEval(t, uv);
+    Vec3f n(2.f * c.x - 1.f, 2.f * c.y - 1.f, 2.f * c.z - 1.f);
+    float l2 = lengthSq(n);
+    return l2 > 0.f && l2 < INFINITY ? n * (1.f / std::sqrt(l2)) : Vec3f(0.f, 0.f, 1.f);
   }
   // The same, without a copy where the material has no texture: the scene's own entry, read a
   // field at a time where used. A copy kept whole through a bounce held ~60 more registers a

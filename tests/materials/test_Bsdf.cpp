@@ -72,6 +72,26 @@ std::vector<BsdfCase> cases() {
   textured.twoSided = true;
   textured.nonlinear = true;
   out.push_back({"RoughPlasticTexturedAlphaBack", textured, -0.4f});
+  // Under a normal map (Mitsuba's normalmap, with its defaults: the flip and the shadowing
+  // term): the lobes in the tilted frame, cut where a direction lies on different sides of the
+  // two frames. The tilt is about y, the histogram's pole, by six of its 64 columns, so that both
+  // horizons run along cell edges: a cut across a cell leaves slivers its midpoints can miss.
+  auto mapped = [&](Bsdf b) {
+    b.normalMapTexture = 0;
+    const float tilt = 6.f * 2.f * kPi / 64.f;
+    b.mappedNormal = Vec3f(std::sin(tilt), 0.f, std::cos(tilt));
+    return b;
+  };
+  for (float c : {0.9f, 0.3f}) {
+    std::string cs = std::to_string(int(c * 100));
+    out.push_back({"NormalMappedDiffuse" + cs, mapped(make(BsdfType::Diffuse, 0.1f)), c});
+    out.push_back({"NormalMappedRoughPlastic" + cs, mapped(make(BsdfType::RoughPlastic, 0.2f)), c});
+    out.push_back({"NormalMappedRoughDielectric" + cs, mapped(make(BsdfType::RoughDielectric, 0.3f)), c});
+    out.push_back({"NormalMappedRoughDielectricInside" + cs, mapped(make(BsdfType::RoughDielectric, 0.3f)), -c});
+  }
+  Bsdf twoMapped = mapped(make(BsdfType::RoughConductor, 0.2f, "Cu"));
+  twoMapped.twoSided = true;
+  out.push_back({"NormalMappedTwoSidedConductorBack", twoMapped, -0.5f});
   return out;
 }
 
@@ -270,3 +290,74 @@ TEST(Bsdf, ConductorPresetsAndFresnel) {
 }
 
 }  // namespace
+
+// A normal map whose normal is the frame's own z leaves every BSDF as it was, to the bit: the
+// tilted frame is then the frame itself and the shadowing term is 1.
+TEST(Bsdf, NormalMapAlongZIsNoMap) {
+  Pcg32 rng(41);
+  for (const BsdfCase& c : cases()) {
+    if (bsdfIsNormalMapped(c.bsdf)) continue;
+    Bsdf m = c.bsdf;
+    m.normalMapTexture = 0;
+    attachRoughCoat(m);
+    Bsdf plain = m;
+    plain.normalMapTexture = -1;
+    for (int i = 0; i < 500; ++i) {
+      Vec3f wo = sampleUniformSphere({rng.nextFloat(), rng.nextFloat()});
+      Vec3f wi = sampleUniformSphere({rng.nextFloat(), rng.nextFloat()});
+      Color a = bsdfEval(m, wo, wi), b = bsdfEval(plain, wo, wi);
+      ASSERT_EQ(a.x, b.x) << c.name;
+      ASSERT_EQ(a.z, b.z) << c.name;
+      ASSERT_EQ(bsdfPdf(m, wo, wi), bsdfPdf(plain, wo, wi)) << c.name;
+      BsdfSample sm, sp;
+      float uc = rng.nextFloat();
+      Vec2f u(rng.nextFloat(), rng.nextFloat());
+      bool okM = bsdfSample(m, wo, uc, u, &sm), okP = bsdfSample(plain, wo, uc, u, &sp);
+      ASSERT_EQ(okM, okP) << c.name;
+      if (okM) {
+        ASSERT_EQ(sm.wi.z, sp.wi.z) << c.name;
+        ASSERT_EQ(sm.weight.y, sp.weight.y) << c.name;
+      }
+    }
+  }
+}
+
+// A Lambertian surface whose normal map tilts its normal by theta, under light from the whole
+// upper hemisphere: the tilted cosine, cut at the surface, integrates to (1 + cos theta) / 2 of
+// the albedo (the sky a tilted plane sees). With Mitsuba's shadowing term on, less: the term is
+// at most 1 and falls towards the horizon. Pointwise, the value is the tilted cosine times it.
+TEST(Bsdf, NormalMappedDiffuseIsTheTiltedCosine) {
+  for (float tilt : {0.3f, 0.8f, 1.2f}) {
+    Bsdf b = make(BsdfType::Diffuse, 0.1f);
+    b.normalMapTexture = 0;
+    b.mappedNormal = Vec3f(std::sin(tilt), 0.f, std::cos(tilt));
+    b.bumpShadowing = false;
+    Vec3f wo = normalize(Vec3f(0.2f, 0.1f, 1.f));  // sees the tilted normal's side: no flip
+    double expect = b.reflectance.y * (1.0 + std::cos(tilt)) / 2.0;
+    EXPECT_NEAR(hemisphereIntegral(b, wo), expect, 2e-3) << "tilt " << tilt;
+    b.bumpShadowing = true;
+    double shadowed = hemisphereIntegral(b, wo);
+    EXPECT_LT(shadowed, expect - 1e-3) << "tilt " << tilt;
+    EXPECT_GT(shadowed, 0.5 * expect) << "tilt " << tilt;
+    Pcg32 rng(5);
+    for (int i = 0; i < 1000; ++i) {
+      Vec3f wi = sampleUniformSphere({rng.nextFloat(), rng.nextFloat()});
+      float cosT = dot(wi, b.mappedNormal);
+      float want = wi.z > 0.f && cosT > 0.f ? b.reflectance.y * kInvPi * cosT * detail::bumpShadowingTerm(b.mappedNormal, wi) : 0.f;
+      ASSERT_NEAR(bsdfEval(b, wo, wi).y, want, 1e-6f);
+    }
+  }
+}
+
+// Mitsuba's flip_invalid_normals: a viewer on the far side of the tilted normal (wo below its
+// plane, above the surface's) sees the normal mirrored about z, so the surface is not black there.
+TEST(Bsdf, NormalMapFlipsANormalTheViewerCannotSee) {
+  Bsdf b = make(BsdfType::Diffuse, 0.1f);
+  b.normalMapTexture = 0;
+  b.mappedNormal = normalize(Vec3f(0.9f, 0.f, 0.3f));
+  Vec3f wo = normalize(Vec3f(-0.9f, 0.f, 0.2f));  // above the surface, behind the tilted plane
+  ASSERT_LT(dot(wo, b.mappedNormal), 0.f);
+  EXPECT_GT(hemisphereIntegral(b, wo), 0.1);
+  b.flipInvalidNormals = false;
+  EXPECT_EQ(hemisphereIntegral(b, wo), 0.0) << "the unflipped frame has wo below it";
+}

@@ -53,6 +53,21 @@ std::string loadError(const std::string& path, std::map<std::string, std::string
   return "";
 }
 
+// Each scene body (after kSensor) must fail to load with its message, naming the file and line.
+template <size_t N>
+void expectErrors(Fixture& f, const std::pair<const char*, const char*> (&bad)[N]) {
+  for (const auto& [xml, message] : bad) {
+    Scene s;
+    try {
+      loadScene(f.scene(std::string(kSensor) + xml), {}, s);
+      ADD_FAILURE() << "accepted: " << xml;
+    } catch (const std::runtime_error& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(".xml:"), std::string::npos) << "names the file and line: " << e.what();
+    }
+  }
+}
+
 }  // namespace
 
 TEST(SceneLoader, SensorFilmSamplerIntegrator) {
@@ -414,16 +429,7 @@ TEST(SceneLoader, APropertyMitsubaDoesNotKnowIsAnError) {
       {R"(<integrator type="photon"><integer name="global_photon" value="1000"/></integrator>)",
        "integrator 'photon' has no property 'global_photon' (did you mean 'global_photons'?)"},
   };
-  for (const auto& [xml, message] : bad) {
-    Scene s;
-    try {
-      loadScene(f.scene(std::string(kSensor) + xml), {}, s);
-      ADD_FAILURE() << "accepted: " << xml;
-    } catch (const std::runtime_error& e) {
-      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(".xml:"), std::string::npos) << "names the file and line: " << e.what();
-    }
-  }
+  expectErrors(f, bad);
   // The sensor's own type counts: a thin lens takes an aperture, a pinhole does not.
   std::string pinhole = kSensor;
   const std::string fovTag = "<float name=\"fov\"";
@@ -677,4 +683,64 @@ TEST(SceneLoader, EnvmapReadsALightProbe) {
   loadScene(f.scene(std::string(kSensor) + R"(<emitter type="envmap"><string name="filename" value="probe.exr"/></emitter>)"), {},
             plain);
   EXPECT_EQ(plain.env->image().width, 16) << "without a layout the file is the lat-long map";
+}
+
+// Mitsuba's normalmap adapter: its texture nested or referenced, its BSDF nested or
+// referenced (then copied, so the referenced one stays unmapped), inside twosided, with its two
+// switches; the map's value at a hit becomes the unit normal the BSDF is evaluated about, and
+// meshes under it build their frame along dp/du.
+TEST(SceneLoader, NormalMap) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <texture type="checkerboard" id="tilt"><rgb name="color0" value="0.5, 0.5, 1"/><rgb name="color1" value="1, 0.5, 0.5"/></texture>
+    <bsdf type="roughplastic" id="coat"><float name="alpha" value="0.2"/></bsdf>
+    <shape type="sphere"><bsdf type="normalmap"><ref id="tilt" name="normalmap"/><ref id="coat"/></bsdf></shape>
+    <shape type="ply"><string name="filename" value="tri.ply"/>
+      <bsdf type="twosided"><bsdf type="normalmap">
+        <texture type="checkerboard" name="normalmap"><rgb name="color0" value="0.5"/></texture>
+        <boolean name="flip_invalid_normals" value="false"/><boolean name="use_shadowing_function" value="false"/>
+        <bsdf type="diffuse"/></bsdf></bsdf></shape>
+    <shape type="sphere"><ref id="coat"/></shape>)"),
+            {}, s);
+  const Bsdf &a = s.bsdfs[size_t(s.shapes[0].bsdf)], &b = s.bsdfs[size_t(s.shapes[1].bsdf)];
+  EXPECT_EQ(a.type, BsdfType::RoughPlastic);
+  EXPECT_EQ(a.normalMapTexture, 0);
+  EXPECT_TRUE(a.flipInvalidNormals);
+  EXPECT_TRUE(a.bumpShadowing);
+  EXPECT_FALSE(bsdfIsNormalMapped(s.bsdfs[size_t(s.shapes[2].bsdf)])) << "the referenced BSDF itself is unmapped";
+  EXPECT_EQ(b.type, BsdfType::Diffuse);
+  EXPECT_TRUE(b.twoSided);
+  EXPECT_EQ(b.normalMapTexture, 1);
+  EXPECT_FALSE(b.flipInvalidNormals);
+  EXPECT_FALSE(b.bumpShadowing);
+  EXPECT_TRUE(bsdfHasTexture(a));
+  EXPECT_TRUE(s.view().meshes[0].anisotropic) << "a normal-mapped mesh builds its frame along dp/du";
+  // color0 (0.5, 0.5, 1) decodes to +z; color1 (1, 0.5, 0.5) to +x; (0.5, 0.5, 0.5) to no
+  // direction, which leaves the frame alone.
+  const SceneView& v = s.view();
+  Vec3f up = v.bsdfAt(s.shapes[0].bsdf, Vec2f(0.25f, 0.25f)).mappedNormal;
+  Vec3f side = v.bsdfAt(s.shapes[0].bsdf, Vec2f(0.75f, 0.25f)).mappedNormal;
+  EXPECT_NEAR(up.z, 1.f, 1e-6f);
+  EXPECT_NEAR(side.x, 1.f, 1e-6f);
+  EXPECT_NEAR(side.z, 0.f, 1e-6f);
+  EXPECT_EQ(v.bsdfAt(s.shapes[1].bsdf, Vec2f(0.25f, 0.25f)).mappedNormal.z, 1.f);
+
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<shape type="sphere"><bsdf type="normalmap"><bsdf type="diffuse"/></bsdf></shape>)",
+       "normalmap needs a texture named 'normalmap'"},
+      {R"(<shape type="sphere"><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/></bsdf></shape>)",
+       "normalmap needs a nested <bsdf>"},
+      {R"(<shape type="sphere"><bsdf type="normalmap"><texture type="checkerboard" name="normal"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "normalmap has no texture property 'normal'"},
+      {R"(<shape type="sphere"><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "normalmap takes one nested BSDF"},
+      {R"(<shape type="sphere"><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/><bsdf type="diffuse"/></bsdf></bsdf></shape>)",
+       "a normalmap inside a normalmap is not supported"},
+      {R"(<shape type="sphere"><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/><ref id="nothing"/></bsdf></shape>)",
+       "unknown BSDF or texture id 'nothing'"},
+      {R"(<shape type="sphere"><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/><boolean name="flip_invalid_normal" value="true"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "bsdf 'normalmap' has no property 'flip_invalid_normal' (did you mean 'flip_invalid_normals'?)"},
+  };
+  expectErrors(f, bad);
 }

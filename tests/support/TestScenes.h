@@ -7,10 +7,12 @@
 
 namespace envgi::test {
 
-// A sphere of radius 1 at the origin seen by a camera on +z, under a constant environment.
-inline std::unique_ptr<Scene> furnaceScene(const Bsdf& b, int res, int spp) {
+// A sphere of radius 1 at the origin seen by a camera on +z, under a constant environment;
+// `texture`, where given, is the scene's texture 0 (for b's texture indices).
+inline std::unique_ptr<Scene> furnaceScene(const Bsdf& b, int res, int spp, const Texture* texture = nullptr) {
   auto s = std::make_unique<Scene>();
   s->bsdfs.push_back(b);
+  if (texture) s->textures.push_back(*texture);
   s->spheres.push_back({Vec3f(0.f), 1.f, false});
   s->shapes.push_back({true, 0, 0, false, Color(0.f)});
   s->env = std::make_unique<EnvironmentMap>(EnvironmentMap::constant(Color(1.f)));
