@@ -126,4 +126,10 @@ std::string nearestName(std::string_view name, const std::vector<std::string>& c
   return best;
 }
 
+std::string didYouMean(std::string_view name, const std::vector<std::string>& candidates, std::string_view open,
+                       std::string_view close) {
+  std::string near = nearestName(name, candidates);
+  return near.empty() ? "" : " (did you mean " + std::string(open) + near + std::string(close) + "?)";
+}
+
 }  // namespace envgi

@@ -18,6 +18,10 @@ bool mitsubaPluginTakes(std::string_view kind, std::string_view type, std::strin
 // most 2 edits away and fewer than half the longer name's letters; empty otherwise ("did you
 // mean ...?").
 std::string nearestName(std::string_view name, const std::vector<std::string>& candidates);
+// The hint an error or warning ends with: " (did you mean 'radius'?)" for the nearest name,
+// quoted between `open` and `close` (<bsdf> for elements); empty when none is near.
+std::string didYouMean(std::string_view name, const std::vector<std::string>& candidates, std::string_view open = "'",
+                       std::string_view close = "'");
 
 // The names mitsubaPluginTakes accepts for one plugin, for nearestName.
 std::vector<std::string> mitsubaPluginProperties(std::string_view kind, std::string_view type);

@@ -79,9 +79,8 @@ class Loader {
     std::vector<std::string> names(paramNames_.begin(), paramNames_.end());
     for (const auto& [name, value] : cliDefines_) {
       if (paramNames_.count(name)) continue;
-      std::string near = nearestName(name, names);
       warnOnce(fmt::format("-D {}={}: {} has no parameter '{}'{}, so the value is not used", name, value,
-                           files_.front()->path, name, near.empty() ? "" : " (did you mean '" + near + "'?)"));
+                           files_.front()->path, name, didYouMean(name, names)));
     }
   }
 
@@ -304,9 +303,7 @@ class Loader {
     if (mitsubaPluginTakes(kind, type, name)) return "";
     std::vector<std::string> known = mitsubaPluginProperties(kind, type);
     known.insert(known.end(), asked.begin(), asked.end());
-    std::string near = nearestName(name, known);
-    return fmt::format("{} '{}' has no property '{}'{}", kind, type, name,
-                       near.empty() ? "" : fmt::format(" (did you mean '{}'?)", near));
+    return fmt::format("{} '{}' has no property '{}'{}", kind, type, name, didYouMean(name, known));
   }
 
   // Mitsuba composes the operations in order: each one applies after the ones before it.
@@ -404,9 +401,9 @@ class Loader {
     } else if (tag == "medium" || tag == "phase") {
       warnOnce(fmt::format("{}:{}: <{}> is not supported and was ignored", f->path, f->lineOf(n.offset_debug()), tag));
     } else {
-      std::string near = nearestName(tag, {"default", "include", "integrator", "sensor", "emitter", "shape", "bsdf",
-                                           "texture", "medium", "phase"});
-      fail(f, n, fmt::format("unknown element <{}>{}", tag, near.empty() ? "" : " (did you mean <" + near + ">?)"));
+      const std::vector<std::string> elements = {"default", "include", "integrator", "sensor", "emitter",
+                                                 "shape",   "bsdf",    "texture",    "medium", "phase"};
+      fail(f, n, fmt::format("unknown element <{}>{}", tag, didYouMean(tag, elements, "<", ">")));
     }
   }
 

@@ -35,3 +35,11 @@ TEST(MitsubaPlugins, NearestNameIsAtMostTwoEditsAwayAndNeverTheNameItself) {
   EXPECT_EQ(nearestName("sp", {"spp", "res"}), "spp") << "one edit of three letters";
   EXPECT_EQ(nearestName("x", {}), "");
 }
+
+// The hint the loader's errors and warnings end with, in one form for each.
+TEST(MitsubaPlugins, DidYouMeanQuotesTheNearestName) {
+  const std::vector<std::string> names = {"radius", "center", "to_world"};
+  EXPECT_EQ(didYouMean("radus", names), " (did you mean 'radius'?)");
+  EXPECT_EQ(didYouMean("shap", {"shape", "bsdf"}, "<", ">"), " (did you mean <shape>?)");
+  EXPECT_EQ(didYouMean("velvet", names), "");
+}
