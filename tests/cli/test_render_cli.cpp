@@ -624,4 +624,10 @@ TEST(CliRender, NormalMapSceneRenders) {
     EXPECT_LT(mean[0], 0.8 * mean[1]) << integ << ": the domes should darken the image";
     EXPECT_GT(mean[0], 0.4 * mean[1]) << integ;
   }
+  // A map that is not there: one error line naming the scene, exit 1, no image.
+  CliResult missing = runCli("render " + scene + " -D normalmap=" + d.file("nothing.png") + " -o " + d.file("m.exr"));
+  EXPECT_EQ(missing.code, 1) << missing.output;
+  EXPECT_NE(missing.output.find("envgi: error: "), std::string::npos) << missing.output;
+  EXPECT_NE(missing.output.find("normal-map.xml:"), std::string::npos) << missing.output;
+  EXPECT_FALSE(fs::exists(d.file("m.exr")));
 }
