@@ -140,6 +140,29 @@ def normal_mapped(domes):
                 + '<boolean name="flip_invalid_normals" value="false"/>' + nested[2][1] + '</bsdf>'))
     return out
 
+def principled():
+    """Mitsuba's principled BSDF: its lobes alone and together, and with textured base colour,
+    roughness and metallic."""
+    base = '<rgb name="base_color" value="0.8, 0.5, 0.2"/>'
+    sets = [
+        ('principled default', ''),
+        ('principled roughness 0.2', base + '<float name="roughness" value="0.2"/>'),
+        ('principled metallic aniso', base + '<float name="metallic" value="1"/><float name="roughness" value="0.4"/>'
+         '<float name="anisotropic" value="0.6"/>'),
+        ('principled clearcoat sheen', base + '<float name="clearcoat" value="1"/><float name="clearcoat_gloss" value="0.5"/>'
+         '<float name="sheen" value="0.8"/><float name="sheen_tint" value="0.5"/><float name="spec_tint" value="0.5"/>'),
+        ('principled glass', '<float name="spec_trans" value="1"/><float name="roughness" value="0.3"/>'
+         '<float name="eta" value="1.5"/>'),
+        ('principled everything', base + '<float name="metallic" value="0.3"/><float name="spec_trans" value="0.4"/>'
+         '<float name="roughness" value="0.45"/><float name="clearcoat" value="0.5"/><float name="sheen" value="0.5"/>'
+         '<float name="flatness" value="0.5"/><float name="spec_tint" value="0.3"/><float name="specular" value="0.6"/>'),
+    ]
+    checks = ('<texture type="checkerboard" name="{}"><rgb name="color0" value="{}"/><rgb name="color1" value="{}"/>'
+              '<transform name="to_uv"><scale x="8" y="4"/></transform></texture>')
+    sets.append(('principled textured', checks.format('base_color', '0.9, 0.6, 0.2', '0.2, 0.4, 0.8')
+                 + checks.format('roughness', 0.15, 0.7) + checks.format('metallic', 1, 0)))
+    return [(n, f'<bsdf type="principled">{b}</bsdf>') for n, b in sets]
+
 THINLENS = ('<sensor type="thinlens"><float name="aperture_radius" value="0.2"/>'
             '<float name="focus_distance" value="6.1"/>')
 
@@ -212,7 +235,7 @@ def main():
     ap.add_argument('--res', type=int, default=48)
     ap.add_argument('--only', default='', help='substring of the configurations to run')
     ap.add_argument('--all-regions', action='store_true', help='print every region of each configuration, not the worst')
-    ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,textured,microfacets,brushed,bunny-sunrise,normal-map',
+    ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,textured,microfacets,brushed,bunny-sunrise,normal-map,principled',
                     help='comma-separated scenes (XML files in --scenes, without .xml)')
     args = ap.parse_args()
     rows = []
@@ -222,7 +245,7 @@ def main():
     import make_normal_map
     domes = os.path.join(tmp, 'domes.png')
     make_normal_map.write_png(domes, 256)
-    for name, b in bsdfs() + normal_mapped(domes):
+    for name, b in bsdfs() + normal_mapped(domes) + principled():
         path = os.path.join(tmp, re.sub(r'[^a-z0-9]+', '_', name) + '.xml')
         open(path, 'w').write(FURNACE.format(res=args.res, spp=args.spp, bsdf=b))
         # The centre of the sphere: regions over the middle third of the image.

@@ -71,6 +71,13 @@ ENVGI_HD float bsdfCameraValue(const Camera& cam, const FilterSet& filters, int 
     b.normalMapTexture = 0;
     b.mappedNormal = normalize(Vec3f(0.4f, -0.3f, 0.85f));
   }
+  if ((i / 256) % 4 == 1) {  // Mitsuba's principled, every lobe on: glass, metal, clearcoat, sheen
+    b.type = BsdfType::Principled;
+    b.reflectance = Color(0.8f, 0.5f, 0.2f);
+    PrincipledParams& p = b.principled;
+    p.roughness = 0.2f + 0.1f * float(i % 5), p.metallic = 0.3f, p.specTrans = 0.4f, p.clearcoat = 0.5f;
+    p.sheen = 0.5f, p.flatness = 0.5f, p.specTint = 0.3f, p.anisotropic = 0.4f * float((i / 32) % 2);
+  }
   Vec3f wo = normalize(Vec3f(0.3f, 0.2f, (i % 3 == 0) ? -0.8f : 0.8f));
   // Draws into named values: the order in which a call's arguments are evaluated is the
   // compiler's choice, and g++ and nvcc's device side choose differently.

@@ -29,6 +29,13 @@ ENVGI_INLINE bool isDiffuseLike(const Bsdf& b, float glossyThreshold) {
     // on its surface cannot stand for.
     // An anisotropic one must be rough both ways: sharp along one axis, it still mirrors.
     case BsdfType::RoughConductor: return fminf(b.alpha, microfacet(b).alphaY) >= glossyThreshold;
+    // Principled: where most of it is the diffuse base, or its specular lobe is rough enough.
+    case BsdfType::Principled: {
+      const PrincipledParams& p = b.principled;
+      if (p.specTrans > 0.f) return false;  // glass, as rough glass
+      MicrofacetDistribution d = principled::specularLobe(p);
+      return p.metallic < 0.5f || fminf(d.alphaX, d.alphaY) >= glossyThreshold;
+    }
     case BsdfType::Conductor:
     case BsdfType::Dielectric:
     case BsdfType::ThinDielectric:
@@ -56,6 +63,8 @@ ENVGI_INLINE Color diffuseAlbedo(const Bsdf& b) {
     }
     case BsdfType::RoughConductor:
       return b.specularReflectance * (b.perfectMirror ? Color(1.f) : fresnelConductor(1.f, b.eta, b.k));
+    case BsdfType::Principled:  // the base and the metal's colour, each by its weight
+      return b.reflectance * ((1.f - b.principled.metallic) * (1.f - b.principled.specTrans) + b.principled.metallic);
     case BsdfType::Conductor:
     case BsdfType::Dielectric:
     case BsdfType::ThinDielectric:

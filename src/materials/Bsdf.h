@@ -7,6 +7,7 @@
 #include "core/Frame.h"
 #include "materials/Fresnel.h"
 #include "materials/Microfacet.h"
+#include "materials/Principled.h"
 #include "materials/RoughCoat.h"
 #include "sampling/Warp.h"
 
@@ -21,6 +22,7 @@ enum class BsdfType : int {
   RoughDielectric, // microfacet glass (Walter et al. 2007)
   Plastic,         // smooth dielectric coating over a diffuse base
   RoughPlastic,    // microfacet coating over a diffuse base
+  Principled,      // Mitsuba 3's principled (materials/Principled.h)
 };
 
 // Roughness bounds: the scene format accepts alpha in (0, 4], and below kMinAlpha microfacet
@@ -62,6 +64,8 @@ struct Bsdf {
   // Its two flags sit with the other bools above.
   int normalMapTexture = -1;
   Vec3f mappedNormal{0.f, 0.f, 1.f};
+  PrincipledParams principled;
+  int roughnessTexture = -1, metallicTexture = -1;  // principled: its roughness and metallic, as luminance
 };
 
 ENVGI_INLINE const float* bsdfCoatTable(const Bsdf& b) {
@@ -86,7 +90,9 @@ struct BsdfSample {
 // Mitsuba 3's eta^2 in its roulette).
 namespace detail {
 ENVGI_INLINE float etaSquaredInFrame(const Bsdf& b, Vec3f wo, Vec3f wi) {
-  if ((b.type != BsdfType::Dielectric && b.type != BsdfType::RoughDielectric) || wo.z * wi.z >= 0.f) return 1.f;
+  if ((b.type != BsdfType::Dielectric && b.type != BsdfType::RoughDielectric && b.type != BsdfType::Principled) ||
+      wo.z * wi.z >= 0.f)
+    return 1.f;
   float etap = wo.z > 0.f ? b.ior : 1.f / b.ior;
   return etap * etap;
 }
@@ -100,11 +106,14 @@ ENVGI_INLINE MicrofacetDistribution microfacet(const Bsdf& b) {
 ENVGI_INLINE bool bsdfIsNormalMapped(const Bsdf& b) { return b.normalMapTexture >= 0; }
 // Hits on this material build their shading frame along dp/du (Mitsuba's): an anisotropic
 // lobe is oriented by it, and a normal map's tangent space is that frame.
-ENVGI_INLINE bool bsdfNeedsTangentFrame(const Bsdf& b) { return bsdfIsAnisotropic(b) || bsdfIsNormalMapped(b); }
+ENVGI_INLINE bool bsdfNeedsTangentFrame(const Bsdf& b) {
+  return bsdfIsAnisotropic(b) || bsdfIsNormalMapped(b) || (b.type == BsdfType::Principled && b.principled.anisotropic != 0.f);
+}
 
 ENVGI_INLINE bool bsdfHasTexture(const Bsdf& b) {
   return b.reflectanceTexture >= 0 || b.specularReflectanceTexture >= 0 || b.specularTransmittanceTexture >= 0 ||
-         b.alphaTexture >= 0 || b.alphaVTexture >= 0 || b.normalMapTexture >= 0;
+         b.alphaTexture >= 0 || b.alphaVTexture >= 0 || b.normalMapTexture >= 0 || b.roughnessTexture >= 0 ||
+         b.metallicTexture >= 0;
 }
 
 // True when every lobe is a delta: next-event estimation is pointless there.
@@ -112,7 +121,8 @@ ENVGI_INLINE bool bsdfIsDelta(const Bsdf& b) {
   return b.type == BsdfType::Conductor || b.type == BsdfType::Dielectric || b.type == BsdfType::ThinDielectric;
 }
 ENVGI_INLINE bool bsdfTransmits(const Bsdf& b) {
-  return b.type == BsdfType::Dielectric || b.type == BsdfType::ThinDielectric || b.type == BsdfType::RoughDielectric;
+  return b.type == BsdfType::Dielectric || b.type == BsdfType::ThinDielectric || b.type == BsdfType::RoughDielectric ||
+         (b.type == BsdfType::Principled && b.principled.specTrans > 0.f);
 }
 
 namespace detail {
@@ -249,6 +259,7 @@ ENVGI_INLINE Color evalInFrame(const Bsdf& b, Vec3f wo, Vec3f wi) {
     case BsdfType::RoughPlastic:
       if (wo.z <= 0.f || wi.z <= 0.f) return Color(0.f);
       return detail::roughPlasticEval(b, detail::roughPlasticShared(b, wo, wi), wo, wi);
+    case BsdfType::Principled: return principled::eval(b.principled, b.reflectance, b.ior, wo, wi);
     case BsdfType::Conductor:
     case BsdfType::Dielectric:
     case BsdfType::ThinDielectric:
@@ -286,6 +297,7 @@ ENVGI_INLINE float pdfInFrame(const Bsdf& b, Vec3f wo, Vec3f wi) {
     case BsdfType::RoughPlastic:
       if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
       return detail::roughPlasticPdf(b, detail::roughPlasticShared(b, wo, wi), wo, wi);
+    case BsdfType::Principled: return principled::pdf(b.principled, b.ior, wo, wi);
     case BsdfType::Conductor:
     case BsdfType::Dielectric:
     case BsdfType::ThinDielectric:
@@ -324,6 +336,7 @@ ENVGI_INLINE bool finishSample(const Bsdf& b, Vec3f wo, BsdfSample* s) {
 // Whether bsdfSample reads its uc, the choice between lobes (reflection or transmission, coat or
 // base); a diffuse or metal BSDF has one lobe, and its draw can be skipped.
 ENVGI_INLINE bool bsdfPicksALobe(const Bsdf& b) {
+  if (b.type == BsdfType::Principled) return principled::picksALobe(b.principled);
   return b.type != BsdfType::Diffuse && b.type != BsdfType::Conductor && b.type != BsdfType::RoughConductor;
 }
 
@@ -438,6 +451,10 @@ ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, Bsdf
       ok = detail::finishSample(b, wo, s);
       break;
     }
+    case BsdfType::Principled:
+      if (!principled::sampleDirection(b.principled, b.ior, wo, uc, u, &s->wi)) return false;
+      ok = detail::finishSample(b, wo, s);
+      break;
   }
   if (ok && flip) s->wi.z = -s->wi.z;
   return ok && isFiniteVec(s->weight);

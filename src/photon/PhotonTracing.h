@@ -90,11 +90,7 @@ struct PhotonEmitter {
 
 // Importance (flux) transport through refraction keeps the eta^2 that radiance loses.
 ENVGI_INLINE Color adjointWeight(const Bsdf& b, Vec3f woLocal, const BsdfSample& bs) {
-  if ((b.type == BsdfType::Dielectric || b.type == BsdfType::RoughDielectric) && woLocal.z * bs.wi.z < 0.f) {
-    float etap = woLocal.z > 0.f ? b.ior : 1.f / b.ior;
-    return bs.weight * (etap * etap);
-  }
-  return bs.weight;
+  return bs.weight * bsdfEtaSquared(b, woLocal, bs.wi);
 }
 
 // store(si, wiWorld, power, caustic, depth) is called at each non-specular hit after the

@@ -747,9 +747,11 @@ class Loader {
       b.nonlinear = getBool(f, p, "nonlinear", false);
       if (type == "roughplastic") roughness(f, n, p, textures, b, type);
       finishPlastic(b);
+    } else if (type == "principled") {
+      principled(f, n, p, b);
     } else {
       fail(f, n, fmt::format("unknown BSDF type '{}' (diffuse, conductor, roughconductor, dielectric, thindielectric, "
-                             "roughdielectric, plastic, roughplastic, twosided, normalmap)",
+                             "roughdielectric, plastic, roughplastic, principled, twosided, normalmap)",
                              type));
     }
     for (const auto& [name, tex] : textures) {
@@ -778,6 +780,51 @@ class Loader {
     reportUnused(f, p, "bsdf", type);
     scene_.bsdfs.push_back(b);
     return int(scene_.bsdfs.size() - 1);
+  }
+
+  // Mitsuba 3's principled BSDF, its properties as Mitsuba reads them; a value outside its range
+  // is an error here (Mitsuba takes it and renders something unphysical).
+  void principled(const SourceFile* f, pugi::xml_node n, Props& p, Bsdf& b) {
+    b.type = BsdfType::Principled;
+    b.reflectance = getColor(f, p, "base_color", Color(0.5f));
+    PrincipledParams& q = b.principled;
+    auto unit = [&](const char* name, float def) {
+      float v = getFloat(f, p, name, def);
+      if (!(v >= 0.f && v <= 1.f)) fail(f, n, fmt::format("principled '{}' must lie in [0, 1] (got {})", name, v));
+      return v;
+    };
+    q.roughness = unit("roughness", 0.5f);
+    q.anisotropic = unit("anisotropic", 0.f);
+    q.metallic = unit("metallic", 0.f);
+    q.specTrans = unit("spec_trans", 0.f);
+    q.specTint = unit("spec_tint", 0.f);
+    q.sheen = unit("sheen", 0.f);
+    q.sheenTint = unit("sheen_tint", 0.f);
+    q.flatness = unit("flatness", 0.f);
+    q.clearcoat = unit("clearcoat", 0.f);
+    q.clearcoatGloss = unit("clearcoat_gloss", 0.f);
+    auto rate = [&](const char* name) {
+      float v = getFloat(f, p, name, 1.f);
+      if (!(v >= 0.f && v < INFINITY)) fail(f, n, fmt::format("principled '{}' must be finite and >= 0 (got {})", name, v));
+      return v;
+    };
+    q.specularRate = rate("main_specular_sampling_rate");
+    q.clearcoatRate = rate("clearcoat_sampling_rate");
+    q.diffuseRate = rate("diffuse_reflectance_sampling_rate");
+    if (q.specularRate + q.clearcoatRate + q.diffuseRate <= 0.f) fail(f, n, "principled: every sampling rate is 0");
+    // Either eta or specular (the reflectance at normal incidence is 0.08 specular), as Mitsuba.
+    if (p.count("eta") && p.count("specular")) fail(f, n, "principled takes 'eta' or 'specular', not both");
+    if (p.count("eta")) {
+      b.ior = getFloat(f, p, "eta", 1.5f);
+      if (!(b.ior > 0.f && b.ior < INFINITY)) fail(f, n, fmt::format("principled 'eta' must be > 0 (got {})", b.ior));
+      if (b.ior == 1.f && q.specTrans > 0.f) b.ior = 1.001f;  // Mitsuba's: glass of index 1 refracts nothing
+    } else {
+      float specular = getFloat(f, p, "specular", 0.5f);
+      if (!(specular >= 0.f && specular < 12.5f))
+        fail(f, n, fmt::format("principled 'specular' must lie in [0, 12.5) (got {})", specular));
+      if (specular == 0.f && q.specTrans > 0.f) specular = 1e-3f;  // as Mitsuba
+      b.ior = principledEtaFromSpecular(specular);
+    }
   }
 
   // Mitsuba's normalmap adapter: one nested BSDF (<bsdf> or a <ref> to one) and a texture named
@@ -834,6 +881,12 @@ class Loader {
   // Where a texture for property `name` goes in b (the colours, and the roughness of the rough
   // BSDFs); null for a property envgi reads as a constant only.
   static int* textureSlot(Bsdf& b, const std::string& name) {
+    if (b.type == BsdfType::Principled) {
+      if (name == "base_color") return &b.reflectanceTexture;
+      if (name == "roughness") return &b.roughnessTexture;
+      if (name == "metallic") return &b.metallicTexture;
+      return nullptr;
+    }
     bool plastic = b.type == BsdfType::Plastic || b.type == BsdfType::RoughPlastic;
     if ((b.type == BsdfType::Diffuse && name == "reflectance") || (plastic && name == "diffuse_reflectance"))
       return &b.reflectanceTexture;

@@ -155,6 +155,10 @@ struct SceneView {
     if (b.alphaTexture >= 0) b.alpha = roughness(b.alphaTexture);
     if (b.alphaVTexture >= 0) b.alphaV = roughness(b.alphaVTexture);
     if (b.normalMapTexture >= 0) b.mappedNormal = mappedNormalAt(textures[b.normalMapTexture], uv);
+    // The principled BSDF's roughness and metallic: luminance within [0, 1] (NaN: 0).
+    auto unit = [&](int t) { return fminf(fmaxf(luminance(textureEval(textures[t], uv)), 0.f), 1.f); };
+    if (b.roughnessTexture >= 0) b.principled.roughness = unit(b.roughnessTexture);
+    if (b.metallicTexture >= 0) b.principled.metallic = unit(b.metallicTexture);
     return b;
   }
   // A normal map's texel as a unit normal: rgb = (n + 1) / 2, relative to the shading frame; one

@@ -631,3 +631,30 @@ TEST(CliRender, NormalMapSceneRenders) {
   EXPECT_NE(missing.output.find("normal-map.xml:"), std::string::npos) << missing.output;
   EXPECT_FALSE(fs::exists(d.file("m.exr")));
 }
+
+// The bundled principled scene, end to end with path, sppm and direct: no warning (every
+// property is read), a finite image that is not black; path and sppm, both consistent, agree on
+// its mean. (photon and grid take 8-10 s here for their maps; test_Principled.cpp checks what
+// they read of the BSDF.)
+TEST(CliRender, PrincipledSceneRenders) {
+  TempDir d;
+  const std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/principled.xml";
+  double means[2] = {0.0, 0.0};
+  int k = 0;
+  for (std::string integ : {"path", "sppm", "direct"}) {
+    CliResult r = runCli("render " + scene + " -o " + d.file(integ + ".exr") + " --integrator " + integ +
+                         " --spp 16 -D res=32 --seed 3 --no-progress");
+    ASSERT_EQ(r.code, 0) << integ << ": " << r.output;
+    EXPECT_EQ(r.output.find("warn"), std::string::npos) << integ << ": " << r.output;
+    envgi::Image img = envgi::loadImage(d.file(integ + ".exr"));
+    double mean = 0.0;
+    for (float v : img.rgb) {
+      ASSERT_TRUE(std::isfinite(v)) << integ;
+      mean += v;
+    }
+    mean /= double(img.rgb.size());
+    EXPECT_GT(mean, 0.02) << integ;
+    if (k < 2) means[k++] = mean;
+  }
+  EXPECT_NEAR(means[0], means[1], 0.1 * means[0]) << "path against sppm";
+}

@@ -89,6 +89,31 @@ std::vector<BsdfCase> cases() {
     out.push_back({"NormalMappedRoughDielectric" + cs, mapped(make(BsdfType::RoughDielectric, 0.3f)), c});
     out.push_back({"NormalMappedRoughDielectricInside" + cs, mapped(make(BsdfType::RoughDielectric, 0.3f)), -c});
   }
+  // Mitsuba's principled: its lobes apart and together (roughness 0.5 is alpha 0.25).
+  auto principled = [&](auto set) {
+    Bsdf b = make(BsdfType::Principled, 0.1f);
+    b.ior = 1.5f;
+    set(b.principled);
+    return b;
+  };
+  for (float c : {0.9f, 0.3f}) {
+    std::string cs = std::to_string(int(c * 100));
+    out.push_back({"PrincipledBase" + cs, principled([](PrincipledParams&) {}), c});
+    out.push_back({"PrincipledMetalAniso" + cs, principled([](PrincipledParams& p) {
+                     p.metallic = 1.f, p.roughness = 0.4f, p.anisotropic = 0.6f;
+                   }), c});
+    out.push_back({"PrincipledClearcoat" + cs, principled([](PrincipledParams& p) {
+                     p.clearcoat = 1.f, p.clearcoatGloss = 0.2f, p.roughness = 0.6f, p.sheen = 1.f;
+                   }), c});
+    for (float side : {1.f, -1.f})
+      out.push_back({std::string(side > 0 ? "PrincipledGlass" : "PrincipledGlassInside") + cs,
+                     principled([](PrincipledParams& p) { p.specTrans = 1.f; }), side * c});
+    out.push_back({"PrincipledEverything" + cs, principled([](PrincipledParams& p) {
+                     p.metallic = 0.3f, p.specTrans = 0.4f, p.roughness = 0.45f, p.clearcoat = 0.5f, p.sheen = 0.5f;
+                     p.flatness = 0.5f, p.specTint = 0.3f, p.anisotropic = 0.3f;
+                     p.specularRate = 0.7f, p.clearcoatRate = 1.3f, p.diffuseRate = 1.1f;
+                   }), c});
+  }
   Bsdf twoMapped = mapped(make(BsdfType::RoughConductor, 0.2f, "Cu"));
   twoMapped.twoSided = true;
   out.push_back({"NormalMappedTwoSidedConductorBack", twoMapped, -0.5f});

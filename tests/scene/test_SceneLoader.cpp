@@ -744,3 +744,69 @@ TEST(SceneLoader, NormalMap) {
   };
   expectErrors(f, bad);
 }
+
+// Mitsuba 3's principled BSDF: its properties as Mitsuba names them, eta from specular where
+// eta is not given, textures for base_color, roughness and metallic, and errors for values out
+// of range, for eta and specular together and for a misspelt name.
+TEST(SceneLoader, Principled) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <shape type="sphere"><bsdf type="principled">
+      <rgb name="base_color" value="0.8, 0.2, 0.1"/><float name="roughness" value="0.3"/>
+      <float name="metallic" value="0.7"/><float name="anisotropic" value="0.4"/><float name="spec_trans" value="0.2"/>
+      <float name="spec_tint" value="0.1"/><float name="sheen" value="0.6"/><float name="sheen_tint" value="0.5"/>
+      <float name="flatness" value="0.25"/><float name="clearcoat" value="0.9"/><float name="clearcoat_gloss" value="0.8"/>
+      <float name="eta" value="1.33"/><float name="clearcoat_sampling_rate" value="2"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="principled">
+      <texture type="checkerboard" name="roughness"><rgb name="color0" value="0.2"/><rgb name="color1" value="0.9"/></texture>
+      <texture type="checkerboard" name="metallic"><rgb name="color0" value="1"/><rgb name="color1" value="0"/></texture>
+      <texture type="checkerboard" name="base_color"><rgb name="color0" value="0.1, 0.2, 0.3"/></texture>
+      <float name="specular" value="0.5"/></bsdf></shape>)"),
+            {}, s);
+  const Bsdf &a = s.bsdfs[size_t(s.shapes[0].bsdf)], &b = s.bsdfs[size_t(s.shapes[1].bsdf)];
+  ASSERT_EQ(a.type, BsdfType::Principled);
+  EXPECT_EQ(a.reflectance.x, 0.8f);
+  EXPECT_EQ(a.principled.roughness, 0.3f);
+  EXPECT_EQ(a.principled.metallic, 0.7f);
+  EXPECT_EQ(a.principled.anisotropic, 0.4f);
+  EXPECT_EQ(a.principled.specTrans, 0.2f);
+  EXPECT_EQ(a.principled.specTint, 0.1f);
+  EXPECT_EQ(a.principled.sheen, 0.6f);
+  EXPECT_EQ(a.principled.sheenTint, 0.5f);
+  EXPECT_EQ(a.principled.flatness, 0.25f);
+  EXPECT_EQ(a.principled.clearcoat, 0.9f);
+  EXPECT_EQ(a.principled.clearcoatGloss, 0.8f);
+  EXPECT_EQ(a.principled.clearcoatRate, 2.f);
+  EXPECT_EQ(a.ior, 1.33f);
+  EXPECT_TRUE(bsdfTransmits(a));
+  EXPECT_TRUE(bsdfNeedsTangentFrame(a)) << "anisotropic: the lobe follows dp/du";
+  EXPECT_NEAR(b.ior, 1.5f, 1e-6f);
+  EXPECT_FALSE(bsdfTransmits(b));
+  EXPECT_TRUE(bsdfHasTexture(b));
+  const SceneView& v = s.view();
+  Bsdf t0 = v.bsdfAt(s.shapes[1].bsdf, Vec2f(0.25f, 0.25f)), t1 = v.bsdfAt(s.shapes[1].bsdf, Vec2f(0.75f, 0.25f));
+  EXPECT_NEAR(t0.principled.roughness, 0.2f, 1e-6f);
+  EXPECT_NEAR(t1.principled.roughness, 0.9f, 1e-6f);
+  EXPECT_NEAR(t0.principled.metallic, 1.f, 1e-6f);
+  EXPECT_NEAR(t1.principled.metallic, 0.f, 1e-6f);
+  EXPECT_NEAR(t0.reflectance.z, 0.3f, 1e-6f);
+
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<shape type="sphere"><bsdf type="principled"><float name="metallic" value="1.5"/></bsdf></shape>)",
+       "principled 'metallic' must lie in [0, 1] (got 1.5)"},
+      {R"(<shape type="sphere"><bsdf type="principled"><float name="roughness" value="-0.1"/></bsdf></shape>)",
+       "principled 'roughness' must lie in [0, 1] (got -0.1)"},
+      {R"(<shape type="sphere"><bsdf type="principled"><float name="eta" value="1.4"/><float name="specular" value="0.3"/></bsdf></shape>)",
+       "principled takes 'eta' or 'specular', not both"},
+      {R"(<shape type="sphere"><bsdf type="principled"><float name="eta" value="0"/></bsdf></shape>)",
+       "principled 'eta' must be > 0 (got 0)"},
+      {R"(<shape type="sphere"><bsdf type="principled"><float name="specular" value="20"/></bsdf></shape>)",
+       "principled 'specular' must lie in [0, 12.5) (got 20)"},
+      {R"(<shape type="sphere"><bsdf type="principled"><float name="clearcoat_sampling_rate" value="-1"/></bsdf></shape>)",
+       "principled 'clearcoat_sampling_rate' must be finite and >= 0 (got -1)"},
+      {R"(<shape type="sphere"><bsdf type="principled"><float name="metalic" value="1"/></bsdf></shape>)",
+       "bsdf 'principled' has no property 'metalic' (did you mean 'metallic'?)"},
+  };
+  expectErrors(f, bad);
+}
