@@ -791,6 +791,17 @@ TEST(SceneLoader, Principled) {
   EXPECT_NEAR(t0.principled.metallic, 1.f, 1e-6f);
   EXPECT_NEAR(t1.principled.metallic, 0.f, 1e-6f);
   EXPECT_NEAR(t0.reflectance.z, 0.3f, 1e-6f);
+  // Under Mitsuba's normalmap adapter, as any BSDF.
+  Scene m;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <shape type="sphere"><bsdf type="normalmap">
+      <texture type="checkerboard" name="normalmap"><rgb name="color0" value="0.5, 0.5, 1"/></texture>
+      <bsdf type="principled"><float name="clearcoat" value="1"/></bsdf></bsdf></shape>)"),
+            {}, m);
+  const Bsdf& mapped = m.bsdfs[size_t(m.shapes[0].bsdf)];
+  EXPECT_EQ(mapped.type, BsdfType::Principled);
+  EXPECT_TRUE(bsdfIsNormalMapped(mapped));
+  EXPECT_EQ(mapped.principled.clearcoat, 1.f);
 
   const std::pair<const char*, const char*> bad[] = {
       {R"(<shape type="sphere"><bsdf type="principled"><float name="metallic" value="1.5"/></bsdf></shape>)",
