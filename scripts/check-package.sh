@@ -2,7 +2,7 @@
 # Checks a relocatable package (scripts/package.sh, or cpack in a build folder): under 48 MB
 # (the device tool carries 64 MB: the rest is room for A/B benchmark builds beside it),
 # needing nothing from the system but the C library, and rendering from where it was unpacked.
-# Usage: scripts/check-package.sh PATH/envgi-*.tar.gz
+# Usage: scripts/check-package.sh PATH/envgi-*.tar.xz
 set -euo pipefail
 pkg=$(realpath "$1")
 size=$(stat -c %s "$pkg")

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # A/B of GPU benchmark builds on a device machine, alternating so that drift hits all alike.
 #
-#   bash scripts/device-ab.sh PACKAGE.tar.gz ROUNDS NAME=BENCH[.gz|.xz] ... [-- BENCH ARGS]
+#   bash scripts/device-ab.sh PACKAGE.tar.xz ROUNDS NAME=BENCH[.gz|.xz] ... [-- BENCH ARGS]
 #
-# PACKAGE is envgi's relocatable package (cpack -G TGZ); it supplies the libraries. Each BENCH
+# PACKAGE is envgi's relocatable package (cpack -G TXZ); it supplies the libraries. Each BENCH
 # is an envgi_bench_gpu built here for one variant (e.g. -DCMAKE_CUDA_ARCHITECTURES=90, one
 # build folder, a variant at a time), compressed to fit the carry limit. Each round runs every
 # variant once and prints its buddha rows and its path kernel's registers. Arguments after --
@@ -16,7 +16,7 @@ shift 2
 names=() args=(--no-cpu)
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-tar xzf "$package" -C "$work"
+tar xf "$package" -C "$work"
 root=$(echo "$work"/envgi-*)
 while [[ $# -gt 0 ]]; do
   if [[ $1 == -- ]]; then shift; args=("$@"); break; fi

@@ -4,14 +4,14 @@
 # server, the GPU test suite, the GPU benchmark, and the study on the GPU against the CPU. Each step has its own time limit, so one hang cannot eat the
 # machine's time. A summary line per step goes to stdout; into LOGDIR go device-check.log (every
 # step's whole log) and device-check-images.tar (the renders).
-#   bash scripts/device-check.sh build-package/envgi-*-cuda.tar.gz [DRAGON.ply]
+#   bash scripts/device-check.sh build-package/envgi-*-cuda.tar.xz [DRAGON.ply]
 # LOGDIR defaults to $OUT (the device tool's folder) or out/device-check. STEPS picks steps by
 # name (default: "check render view interrupt tests bench study"; also bench_perpixel, the path
 # kernel without path regeneration); a failed step is followed by a compute-sanitizer
 # run of a tiny render when `compute-sanitizer` is on the PATH.
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-pkg=${1:?usage: device-check.sh PACKAGE.tar.gz [DRAGON.ply]}
+pkg=${1:?usage: device-check.sh PACKAGE.tar.xz [DRAGON.ply]}
 dragon=${2:-}
 logdir=${LOGDIR:-${OUT:-out/device-check}}
 steps=${STEPS:-check render view interrupt tests bench study}

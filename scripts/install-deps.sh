@@ -10,6 +10,8 @@ PKGS=(
   libfmt-dev libspdlog-dev libnanoflann-dev
   libgtest-dev libbenchmark-dev
   libboost-dev
+  # The relocatable package is a .tar.xz (scripts/package.sh).
+  xz-utils
   # The viewer's browser test drives a real headless Chromium.
   chromium
 )
