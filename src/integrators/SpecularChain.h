@@ -64,7 +64,7 @@ ENVGI_INLINE Color diffuseAlbedo(const Bsdf& b) {
     case BsdfType::RoughConductor:
       return b.specularReflectance * (b.perfectMirror ? Color(1.f) : fresnelConductor(1.f, b.eta, b.k));
     case BsdfType::Principled:  // the base and the metal's colour, each by its weight
-      return b.reflectance * ((1.f - b.principled.metallic) * (1.f - b.principled.specTrans) + b.principled.metallic);
+      return b.reflectance * (principled::baseWeight(b.principled) + b.principled.metallic);
     case BsdfType::Conductor:
     case BsdfType::Dielectric:
     case BsdfType::ThinDielectric:

@@ -68,6 +68,10 @@ ENVGI_INLINE float clearcoatG1(Vec3f v, Vec3f h) {
   return 2.f / (1.f + std::sqrt(1.f + 0.0625f * tan2));
 }
 
+// The weights of the diffuse base (with its sheen) and of the glass; the metal takes the rest.
+ENVGI_INLINE float baseWeight(const PrincipledParams& p) { return (1.f - p.metallic) * (1.f - p.specTrans); }
+ENVGI_INLINE float glassWeight(const PrincipledParams& p) { return (1.f - p.metallic) * p.specTrans; }
+
 // What eval and pdf share for one pair of directions: the half vector (generalised for
 // refraction, facing +z), the dielectric Fresnel there, and which lobes the pair can belong to.
 struct Pair {
@@ -100,7 +104,7 @@ struct LobeProbs {
   float specReflect, specTransmit, clearcoat, diffuse;
 };
 ENVGI_INLINE LobeProbs lobeProbs(const PrincipledParams& p, bool front, float F) {
-  float btdf = (1.f - p.metallic) * p.specTrans, brdf = (1.f - p.metallic) * (1.f - p.specTrans);
+  float btdf = glassWeight(p), brdf = baseWeight(p);
   LobeProbs l;
   if (front) {
     l.specReflect = p.specularRate * (1.f - btdf * (1.f - F));
@@ -123,20 +127,20 @@ ENVGI_INLINE LobeProbs lobeProbs(const PrincipledParams& p, bool front, float F)
 
 // Whether sampling chooses between lobes (a pure metal without clearcoat has one).
 ENVGI_INLINE bool picksALobe(const PrincipledParams& p) {
-  float btdf = (1.f - p.metallic) * p.specTrans, brdf = (1.f - p.metallic) * (1.f - p.specTrans);
+  float btdf = glassWeight(p), brdf = baseWeight(p);
   int lobes = int(brdf * p.diffuseRate > 0.f) + int(p.clearcoat * p.clearcoatRate > 0.f) + int(p.specularRate > 0.f);
   return btdf > 0.f || lobes > 1;
 }
 
 // Seen from inside, only a transmitting principled BSDF has anything.
 ENVGI_INLINE bool hasSide(const PrincipledParams& p, float co) {
-  return co > 0.f || (co < 0.f && (1.f - p.metallic) * p.specTrans > 0.f);
+  return co > 0.f || (co < 0.f && glassWeight(p) > 0.f);
 }
 
 ENVGI_INLINE Color eval(const PrincipledParams& p, Color base, float eta, Vec3f o, Vec3f i) {
   Pair q;
   if (!hasSide(p, o.z) || !pairOf(eta, o, i, &q)) return Color(0.f);
-  float brdf = (1.f - p.metallic) * (1.f - p.specTrans), btdf = (1.f - p.metallic) * p.specTrans;
+  float brdf = baseWeight(p), btdf = glassWeight(p);
   float co = std::fabs(o.z), ci = std::fabs(i.z);
   MicrofacetDistribution d = specularLobe(p);
   float DG = d.D(q.h) * d.G(o, i);
@@ -191,12 +195,13 @@ ENVGI_INLINE float pdf(const PrincipledParams& p, float eta, Vec3f o, Vec3f i) {
   float ih = dot(i, q.h);
   float dhdi = q.reflect ? 1.f / (4.f * std::fabs(ih)) : std::fabs(q.etaPath * q.etaPath * ih / sqr(dot(o, q.h) + q.etaPath * ih));
   Vec3f up = q.front ? o : -o;
+  float visible = q.specReflect || q.specTransmit ? specularLobe(p).visiblePdf(up, q.h) : 0.f;
   float pr = 0.f;
   if (q.specReflect) {
-    pr += l.specReflect * specularLobe(p).visiblePdf(up, q.h) * dhdi;
+    pr += l.specReflect * visible * dhdi;
     pr += l.clearcoat * q.h.z * gtr1D(clearcoatAlpha(p), q.h.z) * dhdi;
   }
-  if (q.specTransmit) pr += l.specTransmit * specularLobe(p).visiblePdf(up, q.h) * dhdi;
+  if (q.specTransmit) pr += l.specTransmit * visible * dhdi;
   if (q.reflect) pr += l.diffuse * cosineHemispherePdf(i.z);
   return pr;
 }
