@@ -25,8 +25,8 @@ Bsdf make(BsdfType t, float alpha, const char* metal = "none", MicrofacetType di
   if (t == BsdfType::Conductor || t == BsdfType::RoughConductor) conductorPreset(metal, &b.eta, &b.k, &b.perfectMirror);
   if (t == BsdfType::Plastic || t == BsdfType::RoughPlastic) {
     b.ior = 1.49f;
-    // Its Fresnel terms only: the rough coat's tables (0.1 s of CPU, 0.4 s under ASan) come from
-    // coated() in the test that reads them, not from gtest's registration in every test process.
+    // Its Fresnel terms only: the rough coat's tables (0.2 s of CPU, most of a test process's
+    // start) come from coated() in the test that reads them, not from gtest's registration.
     b.type = BsdfType::Plastic;
     finishPlastic(b);
     b.type = t;
