@@ -51,7 +51,6 @@ void finishPlastic(Bsdf& b) {
   float dMean = (b.reflectance.x + b.reflectance.y + b.reflectance.z) / 3.f;
   float sMean = (b.specularReflectance.x + b.specularReflectance.y + b.specularReflectance.z) / 3.f;
   b.specularSamplingWeight = sMean + dMean > 0.f ? sMean / (sMean + dMean) : 0.5f;
-  attachRoughCoat(b);
 }
 
 }  // namespace envgi

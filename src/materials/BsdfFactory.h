@@ -13,8 +13,9 @@ void conductorPreset(const std::string& name, Color* eta, Color* k, bool* perfec
 // Hemispherical average of the dielectric Fresnel reflectance, 2 * integral F(mu) mu dmu.
 float fresnelDiffuseReflectance(float eta);
 
-// Fills the derived plastic terms (internal diffuse reflectance, sampling weight and, for
-// rough plastic, its coat's tables).
+// Fills the derived plastic terms (internal diffuse reflectance, sampling weight). A rough
+// plastic's coat tables depend on its alpha texture, known only later: Scene::finalize (or
+// attachRoughCoat) attaches them.
 void finishPlastic(Bsdf& b);
 
 // The tables of a rough plastic's coat (materials/RoughCoat.h) at roughness alpha, or over all

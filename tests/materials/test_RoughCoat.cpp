@@ -101,3 +101,16 @@ TEST(RoughCoat, TablesAreSharedAndAttachedToRoughPlasticOnly) {
   EXPECT_EQ(d.coatNodes, 0);
   EXPECT_EQ(bsdfCoatTable(d), nullptr);
 }
+
+// finishPlastic leaves the coat to attachRoughCoat: the loader calls it before the alpha's
+// texture is known, where a table for the untextured alpha would be built for nothing.
+TEST(RoughCoat, FinishPlasticLeavesTheTablesToAttach) {
+  Bsdf b;
+  b.type = BsdfType::RoughPlastic;
+  b.alpha = 0.2f;
+  b.ior = 1.5f;
+  finishPlastic(b);
+  EXPECT_GT(b.fdrInt, 0.f);
+  EXPECT_EQ(b.coatNodes, 0);
+  EXPECT_EQ(bsdfCoatTable(b), nullptr);
+}
