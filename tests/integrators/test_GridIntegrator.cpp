@@ -47,6 +47,15 @@ void expectQuadrantsNear(const Image& ref, const Image& img, double tolerance) {
     }
   EXPECT_GT(total, 0.0);
 }
+
+// The grid these tests compare with the path tracer: 16 cells across, 64 gather rays a point.
+Image runSmallGrid(Scene& scene) {
+  scene.integrator.grid.resolution = 16;
+  scene.integrator.grid.gatherRays = 64;
+  scene.integrator.grid.globalPhotons = 50000;
+  scene.integrator.grid.causticPhotons = 1000;
+  return run(scene, IntegratorType::Grid, 64);
+}
 }  // namespace
 
 // A white ball on a coloured floor under a sky with a bright band: direct light is exact
@@ -55,11 +64,7 @@ void expectQuadrantsNear(const Image& ref, const Image& img, double tolerance) {
 TEST(GridIntegrator, MatchesPathOnASphereOnAFloor) {
   auto scene = sphereOnFloorScene();
   Image ref = run(*scene, IntegratorType::Path, 1024);
-  scene->integrator.grid.resolution = 16;
-  scene->integrator.grid.gatherRays = 64;
-  scene->integrator.grid.globalPhotons = 50000;
-  scene->integrator.grid.causticPhotons = 1000;
-  Image grid = run(*scene, IntegratorType::Grid, 64);
+  Image grid = runSmallGrid(*scene);
   expectQuadrantsNear(ref, grid, 0.05);
 }
 
@@ -93,6 +98,30 @@ TEST(GridIntegrator, RefinementAddsRaysUpToTheLimit) {
   expectQuadrantsNear(ref, img, 0.05);
 }
 
+// A floor whose normal map tilts it 45 degrees: the BSDF is evaluated in the tilted frame, but
+// the grid's irradiance is read about the untilted normal. Its L1 irradiance has no horizon, so
+// about the tilted normal it counted the floor's own light from below as arriving (the lower
+// quadrants came out 8.9% and 5.1% over the path tracer's; untilted, within 3.1%).
+TEST(GridIntegrator, NormalMappedFloorReadsTheGridAboutItsOwnNormal) {
+  auto scene = sphereOnFloorScene();
+  Image plain = run(*scene, IntegratorType::Path, 256);
+  Texture tilt;
+  tilt.params.type = TextureType::Checkerboard;
+  Vec3f n = normalize(Vec3f(0.7f, 0.f, 0.7f));
+  tilt.params.color0 = tilt.params.color1 = Color(0.5f * (n.x + 1.f), 0.5f * (n.y + 1.f), 0.5f * (n.z + 1.f));
+  scene->textures.push_back(tilt);
+  scene->bsdfs[0].normalMapTexture = 0;
+  Image ref = run(*scene, IntegratorType::Path, 1024);
+  double plainFloor = 0, mappedFloor = 0;  // the map matters: the floor darkens under it
+  for (int y = 8; y < 16; ++y)
+    for (int x = 0; x < 16; ++x) {
+      plainFloor += luminance(plain.at(x, y));
+      mappedFloor += luminance(ref.at(x, y));
+    }
+  EXPECT_LT(mappedFloor, 0.9 * plainFloor);
+  Image grid = runSmallGrid(*scene);
+  expectQuadrantsNear(ref, grid, 0.045);
+}
 
 // Without any indirect light (a diffuse ball alone under a constant sky, seen from outside)
 // the grid adds only what the ball reflects onto itself through nearby grid points: the
