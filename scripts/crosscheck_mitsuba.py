@@ -117,10 +117,10 @@ def bsdfs():
                     '<boolean name="nonlinear" value="true"/></bsdf>'))
     return out
 
-def normal_mapped(domes):
+def normal_mapped(domes, heights):
     """Mitsuba's normalmap adapter around five BSDFs, with the domes of
     scripts/make_normal_map.py (`domes`: the PNG's path) 8 x 4 times over the sphere, and its two
-    switches off one at a time."""
+    switches off one at a time; its bumpmap around two, from the domes' heights (`heights`)."""
     tex = (f'<texture type="bitmap" name="normalmap"><string name="filename" value="{domes}"/>'
            '<boolean name="raw" value="true"/><transform name="to_uv"><scale x="2" y="1"/></transform></texture>')
     nested = [
@@ -138,6 +138,13 @@ def normal_mapped(domes):
                 + '<boolean name="use_shadowing_function" value="false"/>' + nested[0][1] + '</bsdf>'))
     out.append(('normalmap roughconductor, no flip', '<bsdf type="normalmap">' + tex
                 + '<boolean name="flip_invalid_normals" value="false"/>' + nested[2][1] + '</bsdf>'))
+    bump = (f'<texture type="bitmap" name="height"><string name="filename" value="{heights}"/>'
+            '<boolean name="raw" value="true"/><transform name="to_uv"><scale x="2" y="1"/></transform></texture>'
+            '<float name="scale" value="0.05"/>')
+    for n, b in (nested[0], nested[1]):
+        out.append((f'bumpmap {n}', f'<bsdf type="bumpmap">{bump}{b}</bsdf>'))
+    out.append(('bumpmap diffuse 0.8, no shadowing term', f'<bsdf type="bumpmap">{bump}'
+                '<boolean name="use_shadowing_function" value="false"/>' + nested[0][1] + '</bsdf>'))
     return out
 
 def principled():
@@ -245,7 +252,9 @@ def main():
     import make_normal_map
     domes = os.path.join(tmp, 'domes.png')
     make_normal_map.write_png(domes, 256)
-    for name, b in bsdfs() + normal_mapped(domes) + principled():
+    heights = os.path.join(tmp, 'heights.png')
+    make_normal_map.write_height_png(heights, 256)
+    for name, b in bsdfs() + normal_mapped(domes, heights) + principled():
         path = os.path.join(tmp, re.sub(r'[^a-z0-9]+', '_', name) + '.xml')
         open(path, 'w').write(FURNACE.format(res=args.res, spp=args.spp, bsdf=b))
         # The centre of the sphere: regions over the middle third of the image.
@@ -264,6 +273,11 @@ def main():
         path = os.path.join(tmp, re.sub(r'[^a-z0-9]+', '_', name) + '.xml')
         open(path, 'w').write(text)
         configs.append((f'scene: {name}', path, {'res': str(args.res), 'spp': str(args.spp)}, 4, False))
+    # Mitsuba's bumpmap on spheres and a rectangle (their dp/du and dp/dv): the normal-map
+    # scene with the domes' heights in place of their normals.
+    variant('normal-map as bumpmap', 'normal-map',
+            lambda t: t.replace('<bsdf type="normalmap">', '<bsdf type="bumpmap"><float name="scale" value="0.05"/>')
+            .replace('value="$normalmap"', f'value="{heights}"'))
     # Depth of field: the textured scene through a thin lens focused on the globe.
     variant('textured thinlens', 'textured', lambda t: t.replace('<sensor type="perspective">', THINLENS))
     # The brushed sphere alone, the map behind it hidden (the open row placement shifts the

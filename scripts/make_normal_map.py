@@ -23,13 +23,23 @@ def normal(x, y, cells=4, radius=0.42, height=0.22):
     return tuple(c / length for c in n)
 
 
-def write_png(path, size):
+def height(x, y, cells=4, radius=0.42):
+    """The same domes' height at (x, y), scaled to [0, 1]: (1 - (d / r)^2)^2 inside each dome
+    (a bump map of it, read raw, with scale 0.22 / cells, has the normals above)."""
+    cx, cy = (x * cells) % 1.0 - 0.5, (y * cells) % 1.0 - 0.5
+    d2 = (cx * cx + cy * cy) / (radius * radius)
+    return (1.0 - d2) ** 2 if d2 < 1.0 else 0.0
+
+
+def write_png(path, size, texel=None):
+    """The normal map, or with texel=f(x, y) -> (r, g, b) in [0, 1] any other image."""
+    texel = texel or (lambda x, y: tuple((c + 1.0) * 0.5 for c in normal(x, y)))
     rows = []
     for j in range(size):
         row = bytearray([0])  # filter type 0 for each scanline
         for i in range(size):
-            n = normal((i + 0.5) / size, (j + 0.5) / size)
-            row += bytes(max(0, min(255, round((c + 1.0) * 0.5 * 255.0))) for c in n)
+            c = texel((i + 0.5) / size, (j + 0.5) / size)
+            row += bytes(max(0, min(255, round(v * 255.0))) for v in c)
         rows.append(bytes(row))
     def chunk(tag, data):
         return struct.pack('>I', len(data)) + tag + data + struct.pack('>I', zlib.crc32(tag + data) & 0xffffffff)
@@ -37,6 +47,11 @@ def write_png(path, size):
     png += chunk(b'IDAT', zlib.compress(b''.join(rows), 9)) + chunk(b'IEND', b'')
     with open(path, 'wb') as f:
         f.write(png)
+
+
+def write_height_png(path, size):
+    """The domes as a height field (grey), for Mitsuba's bumpmap."""
+    write_png(path, size, lambda x, y: (height(x, y),) * 3)
 
 
 if __name__ == '__main__':

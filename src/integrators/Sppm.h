@@ -21,6 +21,7 @@ struct VisiblePoint {
   Frame shading;
   Color beta;
   Vec2f uv;  // where the material's textures are read
+  Vec2f dpdu, dpdv;  // and its bump map's derivatives (SurfaceInteraction's)
   int bsdf = 0;
   bool valid = false;
 };
@@ -57,6 +58,8 @@ ENVGI_HD VisiblePoint sppmCameraPath(const SceneView& sc, const Tracer& tracer, 
       vp.beta = beta;
       vp.bsdf = si.bsdf;
       vp.uv = si.uv;
+      vp.dpdu = si.dpdu;
+      vp.dpdv = si.dpdv;
       vp.valid = true;
       return vp;
     }
@@ -74,7 +77,7 @@ ENVGI_HD VisiblePoint sppmCameraPath(const SceneView& sc, const Tracer& tracer, 
 // A photon's contribution f(wo, wi) beta_vp Phi at one visible point within its radius.
 ENVGI_INLINE Color sppmContribution(const SceneView& sc, const VisiblePoint& vp, Vec3f wi, Color power) {
   BsdfScratch textured;
-  const Bsdf& b = sc.bsdfAt(vp.bsdf, vp.uv, &textured);
+  const Bsdf& b = sc.bsdfAt(vp.bsdf, vp.uv, vp.dpdu, vp.dpdv, &textured);
   Vec3f wiLocal = vp.shading.toLocal(wi);
   float c = std::fabs(wiLocal.z);
   if (c <= 0.f) return Color(0.f);

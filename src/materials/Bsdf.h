@@ -64,6 +64,11 @@ struct Bsdf {
   // Its two flags sit with the other bools above.
   int normalMapTexture = -1;
   Vec3f mappedNormal{0.f, 0.f, 1.f};
+  // Mitsuba's bumpmap adapter: a height texture (its luminance) whose (u, v) gradient, times
+  // bumpScale, tilts the normal as a displaced surface's would; -1: none. bsdfAt fills in
+  // mappedNormal from it; from there on it is a normal map (its two flags included).
+  int bumpTexture = -1;
+  float bumpScale = 1.f;
   PrincipledParams principled;
   int roughnessTexture = -1, metallicTexture = -1;  // principled: its roughness and metallic, as luminance
 };
@@ -103,7 +108,7 @@ ENVGI_INLINE MicrofacetDistribution microfacet(const Bsdf& b) {
   return {b.alpha, bsdfIsAnisotropic(b) ? b.alphaV : b.alpha, b.distribution};
 }
 
-ENVGI_INLINE bool bsdfIsNormalMapped(const Bsdf& b) { return b.normalMapTexture >= 0; }
+ENVGI_INLINE bool bsdfIsNormalMapped(const Bsdf& b) { return b.normalMapTexture >= 0 || b.bumpTexture >= 0; }
 // Hits on this material build their shading frame along dp/du (Mitsuba's): an anisotropic
 // lobe is oriented by it, and a normal map's tangent space is that frame.
 ENVGI_INLINE bool bsdfNeedsTangentFrame(const Bsdf& b) {
@@ -113,7 +118,7 @@ ENVGI_INLINE bool bsdfNeedsTangentFrame(const Bsdf& b) {
 ENVGI_INLINE bool bsdfHasTexture(const Bsdf& b) {
   return b.reflectanceTexture >= 0 || b.specularReflectanceTexture >= 0 || b.specularTransmittanceTexture >= 0 ||
          b.alphaTexture >= 0 || b.alphaVTexture >= 0 || b.normalMapTexture >= 0 || b.roughnessTexture >= 0 ||
-         b.metallicTexture >= 0;
+         b.metallicTexture >= 0 || b.bumpTexture >= 0;
 }
 
 // True when every lobe is a delta: next-event estimation is pointless there.

@@ -65,4 +65,24 @@ ENVGI_INLINE Color textureEval(const TextureView& t, Vec2f uvIn) {
          (at(x0, y0 + 1) * (1.f - fx) + at(x0 + 1, y0 + 1) * fx) * fy;
 }
 
+// d/du and d/dv of the texture's luminance at uv (Mitsuba's eval_1_grad, which bumpmap reads):
+// the bilinear interpolant's partials in texels, times the resolution, through to_uv's
+// transpose. Piecewise-constant textures (checkerboard, nearest filtering) have none.
+ENVGI_INLINE Vec2f textureLuminanceGradient(const TextureView& t, Vec2f uvIn) {
+  if (t.type != TextureType::Bitmap || !t.bilinear) return Vec2f(0.f, 0.f);
+  Vec2f uv(t.toUv[0] * uvIn.x + t.toUv[1] * uvIn.y + t.toUv[2], t.toUv[3] * uvIn.x + t.toUv[4] * uvIn.y + t.toUv[5]);
+  auto at = [&](int x, int y) {
+    return luminance(t.texels[size_t(textureWrap(y, t.height, t.wrap)) * size_t(t.width) + size_t(textureWrap(x, t.width, t.wrap))]);
+  };
+  float x = uv.x * float(t.width) - 0.5f, y = uv.y * float(t.height) - 0.5f;
+  int x0 = textureFloor(x), y0 = textureFloor(y);
+  float fx = x - floorf(x), fy = y - floorf(y);
+  if (!(fx >= 0.f && fx <= 1.f)) fx = 0.f;
+  if (!(fy >= 0.f && fy <= 1.f)) fy = 0.f;
+  float f00 = at(x0, y0), f10 = at(x0 + 1, y0), f01 = at(x0, y0 + 1), f11 = at(x0 + 1, y0 + 1);
+  float dx = ((1.f - fy) * (f10 - f00) + fy * (f11 - f01)) * float(t.width);
+  float dy = ((1.f - fx) * (f01 - f00) + fx * (f11 - f10)) * float(t.height);
+  return Vec2f(t.toUv[0] * dx + t.toUv[3] * dy, t.toUv[1] * dx + t.toUv[4] * dy);
+}
+
 }  // namespace envgi

@@ -693,7 +693,7 @@ class Loader {
       scene_.bsdfs[size_t(id)].twoSided = true;
       return id;
     }
-    if (type == "normalmap") return normalMap(f, n, p);
+    if (type == "normalmap" || type == "bumpmap") return normalMap(f, n, p, type == "bumpmap");
     // Textured properties, by name: nested <texture name=...> or <ref id=... name=...>.
     std::map<std::string, std::pair<int, pugi::xml_node>> textures;
     for (pugi::xml_node c : n.children()) {
@@ -751,7 +751,7 @@ class Loader {
       principled(f, n, p, b);
     } else {
       fail(f, n, fmt::format("unknown BSDF type '{}' (diffuse, conductor, roughconductor, dielectric, thindielectric, "
-                             "roughdielectric, plastic, roughplastic, principled, twosided, normalmap)",
+                             "roughdielectric, plastic, roughplastic, principled, twosided, normalmap, bumpmap)",
                              type));
     }
     for (const auto& [name, tex] : textures) {
@@ -827,19 +827,25 @@ class Loader {
     }
   }
 
-  // Mitsuba's normalmap adapter: one nested BSDF (<bsdf> or a <ref> to one) and a texture named
-  // `normalmap`. The result is the nested BSDF with the map attached (a copy where referenced).
-  int normalMap(const SourceFile* f, pugi::xml_node n, Props& p) {
+  // Mitsuba's normalmap and bumpmap adapters: one nested BSDF (<bsdf> or a <ref> to one) and a
+  // texture (named `normalmap`; bumpmap's may have any name). The result is the nested BSDF with
+  // the map attached (a copy where referenced).
+  int normalMap(const SourceFile* f, pugi::xml_node n, Props& p, bool bump) {
+    const char* adapter = bump ? "bumpmap" : "normalmap";
     int inner = -1, map = -1;
     auto setInner = [&](pugi::xml_node c, int id) {
-      if (inner >= 0) fail(f, c, "normalmap takes one nested BSDF");
+      if (inner >= 0) fail(f, c, fmt::format("{} takes one nested BSDF", adapter));
       inner = id;
     };
     auto setMap = [&](pugi::xml_node c, int id) {
       std::string name = c.attribute("name").as_string();
-      if (name != "normalmap")
-        fail(f, c, fmt::format("normalmap has no texture property '{}' (its texture is named 'normalmap')", name));
-      if (map >= 0) fail(f, c, "property 'normalmap' given twice");
+      if (bump) {
+        if (map >= 0) fail(f, c, "bumpmap takes one texture");
+      } else {
+        if (name != "normalmap")
+          fail(f, c, fmt::format("normalmap has no texture property '{}' (its texture is named 'normalmap')", name));
+        if (map >= 0) fail(f, c, "property 'normalmap' given twice");
+      }
       map = id;
     };
     for (pugi::xml_node c : n.children()) {
@@ -867,14 +873,21 @@ class Loader {
         fail(f, c, fmt::format("unexpected <{}> in <bsdf>", tag));
       }
     }
-    if (inner < 0) fail(f, n, "normalmap needs a nested <bsdf>");
-    if (map < 0) fail(f, n, "normalmap needs a texture named 'normalmap'");
+    if (inner < 0) fail(f, n, fmt::format("{} needs a nested <bsdf>", adapter));
+    if (map < 0) fail(f, n, bump ? "bumpmap needs a nested texture (its height)" : "normalmap needs a texture named 'normalmap'");
     Bsdf& b = scene_.bsdfs[size_t(inner)];
-    if (bsdfIsNormalMapped(b)) fail(f, n, "a normalmap inside a normalmap is not supported");
-    b.normalMapTexture = map;
+    if (bsdfIsNormalMapped(b)) fail(f, n, fmt::format("a {} around a normalmap or bumpmap is not supported", adapter));
+    if (bump) {
+      b.bumpTexture = map;
+      b.bumpScale = getFloat(f, p, "scale", 1.f);
+      if (!std::isfinite(b.bumpScale)) fail(f, n, "bumpmap's scale must be finite");
+    } else {
+      b.normalMapTexture = map;
+    }
+    // Mitsuba 3.9 gives both adapters the same two flags (its perturbed_bsdf).
     b.flipInvalidNormals = getBool(f, p, "flip_invalid_normals", true);
     b.bumpShadowing = getBool(f, p, "use_shadowing_function", true);
-    reportUnused(f, p, "bsdf", "normalmap");
+    reportUnused(f, p, "bsdf", adapter);
     return inner;
   }
 

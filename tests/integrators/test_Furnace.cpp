@@ -67,6 +67,25 @@ TEST(Furnace, NormalMappedDiffuseSeesATiltedSky) {
   EXPECT_GT(shadowed, 0.3);
 }
 
+// A bump map whose height rises linearly with v (the polar angle over pi) on the unit sphere:
+// dp/dv has length pi everywhere, so a gradient of tan 60 pi tilts every normal by 60 degrees
+// and the sphere reflects (1 + cos 60) / 2 of its albedo, as the normal map above.
+TEST(Furnace, BumpMappedDiffuseSeesATiltedSky) {
+  Texture t;  // one column of 64 rows, luminance y / 63: dh/dv = 64 / 63 between row centres
+  t.params.width = 1;
+  t.params.height = 64;
+  t.params.wrap = TextureWrap::Clamp;
+  for (int y = 0; y < 64; ++y) t.texels.push_back(Color(float(y) / 63.f));
+  Bsdf b;
+  b.reflectance = Color(0.8f);
+  b.bumpTexture = 0;
+  b.bumpScale = std::tan(kPi / 3.f) * kPi * 63.f / 64.f;
+  b.bumpShadowing = false;
+  EXPECT_NEAR(furnace(b, 64, nullptr, &t), 0.8 * 0.75, 0.008);
+  b.bumpScale = 0.f;  // no slope: the plain albedo
+  EXPECT_NEAR(furnace(b, 64, nullptr, &t), 0.8, 0.008);
+}
+
 TEST(Furnace, SmoothDielectricConservesEnergy) {
   Bsdf b;
   b.type = BsdfType::Dielectric;

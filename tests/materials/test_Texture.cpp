@@ -113,3 +113,33 @@ TEST(Texture, AnyCoordinateReadsInsideTheTexture) {
         }
     }
 }
+
+// Bump maps read the luminance's gradient (Mitsuba's eval_1_grad): against central differences
+// of the lookup itself, inside texels, through a to_uv that scales, turns and shifts, and with
+// a wrap; piecewise-constant textures have none.
+TEST(Texture, LuminanceGradientIsTheLookupsDerivative) {
+  std::vector<Color> texels;
+  for (int i = 0; i < 15; ++i) texels.push_back(Color(0.1f * float(i % 4), 0.05f * float(i * i % 7), 0.3f * float(i % 3)));
+  TextureView t;
+  t.texels = texels.data();
+  t.width = 5;
+  t.height = 3;
+  float m[6] = {0.8f, -1.3f, 0.2f, 1.1f, 0.6f, -0.4f};
+  std::copy(m, m + 6, t.toUv);
+  const float h = 1e-3f;
+  auto lum = [&](Vec2f uv) { return double(luminance(textureEval(t, uv))); };
+  int checked = 0;
+  for (Vec2f uv : {Vec2f(0.13f, 0.27f), Vec2f(0.61f, 0.42f), Vec2f(0.92f, 0.77f), Vec2f(-0.35f, 1.8f)}) {
+    Vec2f g = textureLuminanceGradient(t, uv);
+    double du = (lum(Vec2f(uv.x + h, uv.y)) - lum(Vec2f(uv.x - h, uv.y))) / (2 * h);
+    double dv = (lum(Vec2f(uv.x, uv.y + h)) - lum(Vec2f(uv.x, uv.y - h))) / (2 * h);
+    EXPECT_NEAR(g.x, du, 2e-2 * (1.0 + std::fabs(du))) << uv.x << "," << uv.y;
+    EXPECT_NEAR(g.y, dv, 2e-2 * (1.0 + std::fabs(dv))) << uv.x << "," << uv.y;
+    checked += std::fabs(du) + std::fabs(dv) > 0.1;
+  }
+  EXPECT_GE(checked, 3) << "the texture varies where it is probed";
+  t.bilinear = false;
+  EXPECT_EQ(textureLuminanceGradient(t, Vec2f(0.13f, 0.27f)).x, 0.f);
+  t.type = TextureType::Checkerboard;
+  EXPECT_EQ(textureLuminanceGradient(t, Vec2f(0.13f, 0.27f)).y, 0.f);
+}

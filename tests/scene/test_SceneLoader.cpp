@@ -736,11 +736,51 @@ TEST(SceneLoader, NormalMap) {
       {R"(<shape type="sphere"><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></shape>)",
        "normalmap takes one nested BSDF"},
       {R"(<shape type="sphere"><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/><bsdf type="diffuse"/></bsdf></bsdf></shape>)",
-       "a normalmap inside a normalmap is not supported"},
+       "a normalmap around a normalmap or bumpmap is not supported"},
       {R"(<shape type="sphere"><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/><ref id="nothing"/></bsdf></shape>)",
        "unknown BSDF or texture id 'nothing'"},
       {R"(<shape type="sphere"><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/><boolean name="flip_invalid_normal" value="true"/><bsdf type="diffuse"/></bsdf></shape>)",
        "bsdf 'normalmap' has no property 'flip_invalid_normal' (did you mean 'flip_invalid_normals'?)"},
+  };
+  expectErrors(f, bad);
+}
+
+// Mitsuba's bumpmap adapter: one texture of any name (the height), its scale, the same two
+// switches as normalmap; errors for a missing or second texture, a bump map around a normal
+// map, a misspelt property.
+TEST(SceneLoader, BumpMap) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <shape type="sphere"><bsdf type="bumpmap"><texture type="checkerboard" name="height"/>
+      <float name="scale" value="0.25"/><boolean name="use_shadowing_function" value="false"/>
+      <bsdf type="roughplastic"/></bsdf></shape>
+    <shape type="ply"><string name="filename" value="tri.ply"/>
+      <bsdf type="bumpmap"><texture type="checkerboard"/><bsdf type="diffuse"/></bsdf></shape>)"),
+            {}, s);
+  const Bsdf &a = s.bsdfs[size_t(s.shapes[0].bsdf)], &b = s.bsdfs[size_t(s.shapes[1].bsdf)];
+  EXPECT_EQ(a.type, BsdfType::RoughPlastic);
+  EXPECT_EQ(a.bumpTexture, 0);
+  EXPECT_EQ(a.normalMapTexture, -1);
+  EXPECT_FLOAT_EQ(a.bumpScale, 0.25f);
+  EXPECT_TRUE(a.flipInvalidNormals);
+  EXPECT_FALSE(a.bumpShadowing);
+  EXPECT_EQ(b.bumpTexture, 1);
+  EXPECT_FLOAT_EQ(b.bumpScale, 1.f);
+  EXPECT_TRUE(b.bumpShadowing);
+  EXPECT_TRUE(s.view().meshes[0].anisotropic) << "a bump-mapped mesh builds its frame along dp/du";
+
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<shape type="sphere"><bsdf type="bumpmap"><bsdf type="diffuse"/></bsdf></shape>)",
+       "bumpmap needs a nested texture (its height)"},
+      {R"(<shape type="sphere"><bsdf type="bumpmap"><texture type="checkerboard"/></bsdf></shape>)",
+       "bumpmap needs a nested <bsdf>"},
+      {R"(<shape type="sphere"><bsdf type="bumpmap"><texture type="checkerboard"/><texture type="checkerboard"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "bumpmap takes one texture"},
+      {R"(<shape type="sphere"><bsdf type="bumpmap"><texture type="checkerboard"/><bsdf type="normalmap"><texture type="checkerboard" name="normalmap"/><bsdf type="diffuse"/></bsdf></bsdf></shape>)",
+       "a bumpmap around a normalmap or bumpmap is not supported"},
+      {R"(<shape type="sphere"><bsdf type="bumpmap"><texture type="checkerboard"/><float name="scales" value="2"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "bsdf 'bumpmap' has no property 'scales' (did you mean 'scale'?)"},
   };
   expectErrors(f, bad);
 }

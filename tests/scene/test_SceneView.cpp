@@ -83,3 +83,65 @@ TEST(SceneView, AnisotropicFramesFollowDpDu) {
     EXPECT_NEAR(dot(si.shading.s, n), 0.f, 1e-6f);
   }
 }
+
+// A bump-mapped material: interaction() gives dp/du and dp/dv in the shading frame (a square
+// of side 3 whose (u, v) run along x and y; a sphere's Mitsuba coordinates, 2 pi r sin theta
+// along s and pi r against t), and bsdfAt turns a height rising linearly along u into the
+// normal of the surface it displaces to, (-dh/du, 0, 3) normalised.
+TEST(SceneView, BumpMapTiltsTheNormalByTheHeightsGradient) {
+  Scene s;
+  Texture ramp;  // luminance 0.1 x in texel x: dh/du = 0.1 * width within the interior
+  ramp.params.width = 8;
+  ramp.params.height = 2;
+  ramp.params.wrap = TextureWrap::Clamp;
+  for (int y = 0; y < 2; ++y)
+    for (int x = 0; x < 8; ++x) ramp.texels.push_back(Color(0.1f * float(x)));
+  s.textures = {ramp};
+  Bsdf bumped;
+  bumped.bumpTexture = 0;
+  bumped.bumpScale = 2.f;
+  s.bsdfs = {bumped};
+  TriangleMesh m;
+  m.positions = {Vec3f(0.f, 0.f, 0.f), Vec3f(3.f, 0.f, 0.f), Vec3f(0.f, 3.f, 0.f)};
+  m.uvs = {Vec2f(0.f, 0.f), Vec2f(1.f, 0.f), Vec2f(0.f, 1.f)};
+  m.indices = {0, 1, 2};
+  s.meshes = {m};
+  Sphere sp;
+  sp.radius = 2.f;
+  s.spheres = {sp};
+  s.shapes = {{false, 0, 0, false, Color(0.f)}, {true, 0, 0, false, Color(0.f)}};
+  s.finalize();
+  const SceneView& v = s.view();
+
+  Hit h;
+  h.geomId = 0;
+  h.primId = 0;
+  h.u = 0.4f;  // u = 0.4: between texel centres 2.5 and 3.5
+  h.v = 0.2f;
+  h.t = 1.f;
+  SurfaceInteraction si = v.interaction(Ray{Vec3f(1.2f, 0.6f, 1.f), Vec3f(0.f, 0.f, -1.f), 10.f}, h);
+  EXPECT_NEAR(si.dpdu.x, 3.f, 1e-5f);
+  EXPECT_NEAR(si.dpdu.y, 0.f, 1e-5f);
+  EXPECT_NEAR(si.dpdv.x, 0.f, 1e-5f);
+  EXPECT_NEAR(si.dpdv.y, 3.f, 1e-5f);  // t = n x s = y
+  BsdfScratch scratch;
+  const Bsdf& b = v.bsdfAt(si, &scratch);
+  Vec3f want = normalize(Vec3f(-2.f * 0.1f * 8.f, 0.f, 3.f));
+  Vec3f got = si.shading.toWorld(b.mappedNormal);
+  expectNear(got, want, "bumped mesh normal, world");
+  EXPECT_TRUE(bsdfIsNormalMapped(b));
+
+  Vec3f dir = normalize(Vec3f(0.3f, -0.2f, -1.f));
+  Ray rs{-dir * 10.f, dir, 100.f};
+  Hit hs;
+  hs.geomId = 1;
+  hs.primId = 0;
+  hs.t = 8.f;
+  SurfaceInteraction ss = v.interaction(rs, hs);
+  Vec3f n = ss.shading.n;
+  float sinTheta = std::sqrt(n.x * n.x + n.y * n.y);
+  EXPECT_NEAR(ss.dpdu.x, 2.f * kPi * 2.f * sinTheta, 1e-4f);
+  EXPECT_NEAR(ss.dpdu.y, 0.f, 1e-4f);
+  EXPECT_NEAR(ss.dpdv.x, 0.f, 1e-4f);
+  EXPECT_NEAR(ss.dpdv.y, -kPi * 2.f, 1e-4f);
+}
