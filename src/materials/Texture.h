@@ -43,26 +43,40 @@ ENVGI_INLINE int textureFloor(float x) {
   return f < 16777216.f ? int(f) : 16777216;
 }
 
+// to_uv applied: where in the texture a surface's (u, v) reads.
+ENVGI_INLINE Vec2f textureCoords(const TextureView& t, Vec2f uv) {
+  return Vec2f(t.toUv[0] * uv.x + t.toUv[1] * uv.y + t.toUv[2], t.toUv[3] * uv.x + t.toUv[4] * uv.y + t.toUv[5]);
+}
+
+// A bitmap's texel (x, y), wrapped into the image.
+ENVGI_INLINE const Color& textureTexel(const TextureView& t, int x, int y) {
+  return t.texels[size_t(textureWrap(y, t.height, t.wrap)) * size_t(t.width) + size_t(textureWrap(x, t.width, t.wrap))];
+}
+
+// The four texels a bilinear lookup at texture coordinates uv blends: the lower corner and the
+// weights of the upper ones. Texel centres sit at half-integer coordinates.
+struct BilinearCell {
+  int x0, y0;
+  float fx, fy;
+};
+ENVGI_INLINE BilinearCell textureBilinearCell(const TextureView& t, Vec2f uv) {
+  float x = uv.x * float(t.width) - 0.5f, y = uv.y * float(t.height) - 0.5f;
+  BilinearCell c{textureFloor(x), textureFloor(y), x - floorf(x), y - floorf(y)};
+  if (!(c.fx >= 0.f && c.fx <= 1.f)) c.fx = 0.f;  // NaN or an infinite coordinate
+  if (!(c.fy >= 0.f && c.fy <= 1.f)) c.fy = 0.f;
+  return c;
+}
+
 ENVGI_INLINE Color textureEval(const TextureView& t, Vec2f uvIn) {
-  Vec2f uv(t.toUv[0] * uvIn.x + t.toUv[1] * uvIn.y + t.toUv[2], t.toUv[3] * uvIn.x + t.toUv[4] * uvIn.y + t.toUv[5]);
+  Vec2f uv = textureCoords(t, uvIn);
   if (t.type == TextureType::Checkerboard) {
     bool even = ((textureFloor(2.f * uv.x) + textureFloor(2.f * uv.y)) & 1) == 0;
     return even ? t.color0 : t.color1;
   }
-  auto at = [&](int x, int y) {
-    return t.texels[size_t(textureWrap(y, t.height, t.wrap)) * size_t(t.width) + size_t(textureWrap(x, t.width, t.wrap))];
-  };
-  float x = uv.x * float(t.width), y = uv.y * float(t.height);
-  if (!t.bilinear) return at(textureFloor(x), textureFloor(y));
-  // Texel centres sit at half-integer coordinates.
-  x -= 0.5f;
-  y -= 0.5f;
-  int x0 = textureFloor(x), y0 = textureFloor(y);
-  float fx = x - floorf(x), fy = y - floorf(y);
-  if (!(fx >= 0.f && fx <= 1.f)) fx = 0.f;  // NaN or an infinite coordinate
-  if (!(fy >= 0.f && fy <= 1.f)) fy = 0.f;
-  return (at(x0, y0) * (1.f - fx) + at(x0 + 1, y0) * fx) * (1.f - fy) +
-         (at(x0, y0 + 1) * (1.f - fx) + at(x0 + 1, y0 + 1) * fx) * fy;
+  if (!t.bilinear) return textureTexel(t, textureFloor(uv.x * float(t.width)), textureFloor(uv.y * float(t.height)));
+  BilinearCell c = textureBilinearCell(t, uv);
+  auto at = [&](int dx, int dy) { return textureTexel(t, c.x0 + dx, c.y0 + dy); };
+  return (at(0, 0) * (1.f - c.fx) + at(1, 0) * c.fx) * (1.f - c.fy) + (at(0, 1) * (1.f - c.fx) + at(1, 1) * c.fx) * c.fy;
 }
 
 // d/du and d/dv of the texture's luminance at uv (Mitsuba's eval_1_grad, which bumpmap reads):
@@ -70,18 +84,11 @@ ENVGI_INLINE Color textureEval(const TextureView& t, Vec2f uvIn) {
 // transpose. Piecewise-constant textures (checkerboard, nearest filtering) have none.
 ENVGI_INLINE Vec2f textureLuminanceGradient(const TextureView& t, Vec2f uvIn) {
   if (t.type != TextureType::Bitmap || !t.bilinear) return Vec2f(0.f, 0.f);
-  Vec2f uv(t.toUv[0] * uvIn.x + t.toUv[1] * uvIn.y + t.toUv[2], t.toUv[3] * uvIn.x + t.toUv[4] * uvIn.y + t.toUv[5]);
-  auto at = [&](int x, int y) {
-    return luminance(t.texels[size_t(textureWrap(y, t.height, t.wrap)) * size_t(t.width) + size_t(textureWrap(x, t.width, t.wrap))]);
-  };
-  float x = uv.x * float(t.width) - 0.5f, y = uv.y * float(t.height) - 0.5f;
-  int x0 = textureFloor(x), y0 = textureFloor(y);
-  float fx = x - floorf(x), fy = y - floorf(y);
-  if (!(fx >= 0.f && fx <= 1.f)) fx = 0.f;
-  if (!(fy >= 0.f && fy <= 1.f)) fy = 0.f;
-  float f00 = at(x0, y0), f10 = at(x0 + 1, y0), f01 = at(x0, y0 + 1), f11 = at(x0 + 1, y0 + 1);
-  float dx = ((1.f - fy) * (f10 - f00) + fy * (f11 - f01)) * float(t.width);
-  float dy = ((1.f - fx) * (f01 - f00) + fx * (f11 - f10)) * float(t.height);
+  BilinearCell c = textureBilinearCell(t, textureCoords(t, uvIn));
+  auto at = [&](int dx, int dy) { return luminance(textureTexel(t, c.x0 + dx, c.y0 + dy)); };
+  float f00 = at(0, 0), f10 = at(1, 0), f01 = at(0, 1), f11 = at(1, 1);
+  float dx = ((1.f - c.fy) * (f10 - f00) + c.fy * (f11 - f01)) * float(t.width);
+  float dy = ((1.f - c.fx) * (f01 - f00) + c.fx * (f11 - f10)) * float(t.height);
   return Vec2f(t.toUv[0] * dx + t.toUv[3] * dy, t.toUv[1] * dx + t.toUv[4] * dy);
 }
 

@@ -55,6 +55,9 @@ struct SurfaceInteraction {
   float t = 0.f;
 };
 
+// A vector's components along a frame's s and t.
+ENVGI_INLINE Vec2f tangentPart(const Frame& f, Vec3f v) { return Vec2f(dot(v, f.s), dot(v, f.t)); }
+
 // Mitsuba's bumpmap normal in the shading frame (local): dp/du and dp/dv keep their tangential
 // parts and take the height's gradient g as their normal parts; the normal is their cross
 // product, on the unmapped normal's side. A surface without (u, v) derivatives stays as it is.
@@ -128,8 +131,8 @@ struct SceneView {
           si.shading = Frame::fromNormalAndTangent(ns, dpdu);
           if (bsdfs[m.bsdf].bumpTexture >= 0) {
             Vec3f dpdv = ((p2 - p0) * d1.x - (p1 - p0) * d2.x) / det;
-            si.dpdu = Vec2f(dot(dpdu, si.shading.s), dot(dpdu, si.shading.t));
-            si.dpdv = Vec2f(dot(dpdv, si.shading.s), dot(dpdv, si.shading.t));
+            si.dpdu = tangentPart(si.shading, dpdu);
+            si.dpdv = tangentPart(si.shading, dpdv);
           }
         }
       }
@@ -162,8 +165,8 @@ struct SceneView {
           float sinTheta = std::sqrt(fmaxf(0.f, l.x * l.x + l.y * l.y));
           Vec3f dpdv = sinTheta > 0.f ? s.axes.toWorld(Vec3f(l.x * l.z / sinTheta, l.y * l.z / sinTheta, -sinTheta)) * (kPi * s.radius)
                                       : Vec3f(0.f, 0.f, 0.f);
-          si.dpdu = Vec2f(dot(dpdu, si.shading.s), dot(dpdu, si.shading.t));
-          si.dpdv = Vec2f(dot(dpdv, si.shading.s), dot(dpdv, si.shading.t));
+          si.dpdu = tangentPart(si.shading, dpdu);
+          si.dpdv = tangentPart(si.shading, dpdv);
         }
       }
       si.bsdf = s.bsdf;
