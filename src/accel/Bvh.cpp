@@ -88,6 +88,7 @@ Bvh::Bvh(const Scene& scene) {
   spheres_ = sv.spheres;
   sphereCount_ = sv.sphereCount;
   sphereGeomOffset_ = sv.meshCount;
+  if (sv.hasMasks) masks_ = std::make_unique<SceneView>(sv);
 
   std::vector<BvhTriangle> tris;
   std::vector<RTCBuildPrimitive> prims;
@@ -165,6 +166,7 @@ BvhView Bvh::view() const {
   v.spheres = spheres_;
   v.sphereCount = sphereCount_;
   v.sphereGeomOffset = sphereGeomOffset_;
+  v.masks = masks_.get();
   return v;
 }
 

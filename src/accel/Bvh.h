@@ -2,6 +2,7 @@
 // SAH builder (rtcBuildBVH), flattened depth-first into 32-byte nodes with siblings adjacent.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "accel/BvhView.h"
@@ -19,7 +20,8 @@ struct BvhBuildStats {
 class Bvh {
  public:
   explicit Bvh(const Scene& scene);
-  // The view points into this object and into the scene's spheres.
+  // The view points into this object and into the scene's spheres (and, where the scene has
+  // masks, its materials and textures).
   BvhView view() const;
   const BvhBuildStats& stats() const { return stats_; }
   const std::vector<BvhNode>& nodes() const { return nodes_; }
@@ -30,6 +32,7 @@ class Bvh {
   std::vector<BvhTriangle> triangles_;
   const SphereView* spheres_ = nullptr;
   int sphereCount_ = 0, sphereGeomOffset_ = 0;
+  std::unique_ptr<SceneView> masks_;  // a copy of the scene's view where it has masks (BvhView::masks)
   BvhBuildStats stats_;
 };
 

@@ -32,6 +32,9 @@ struct BvhView {
   const SphereView* spheres = nullptr;  // tested one by one: scenes hold a handful
   int sphereCount = 0;
   int sphereGeomOffset = 0;  // geometry id of sphere 0 (meshes come first)
+  // The scene, where it has masks: a hit that stopsAtMask turns down is passed through, by
+  // intersect() and occluded() (intersectSurface() sees every surface). Null: none.
+  const SceneView* masks = nullptr;
 
   // Box slab test against [tMin, tMax]; returns the entry distance or INFINITY on a miss.
   ENVGI_HD static float boxEntry(const BvhNode& n, Vec3f o, Vec3f invD, float tMax) {
@@ -72,7 +75,7 @@ struct BvhView {
 
   // Nearest root in (0, tMax), computed from the closest approach to the centre so that
   // rays from far away keep their precision.
-  ENVGI_HD static bool sphereHit(const SphereView& s, const Ray& r, float tMax, float* t) {
+  ENVGI_HD static bool sphereRoots(const SphereView& s, const Ray& r, float* t0, float* t1) {
     Vec3f oc = r.o - s.center;
     float dd = dot(r.d, r.d);
     float b = dot(oc, r.d) / dd;
@@ -80,20 +83,46 @@ struct BvhView {
     float h = s.radius * s.radius - dot(closest, closest);
     if (h < 0.f) return false;
     float q = std::sqrt(h / dd);
-    float t0 = -b - q, t1 = -b + q;
+    *t0 = -b - q, *t1 = -b + q;
+    return true;
+  }
+  ENVGI_HD static bool sphereHit(const SphereView& s, const Ray& r, float tMax, float* t) {
+    float t0, t1;
+    if (!sphereRoots(s, r, &t0, &t1)) return false;
     float tt = t0 > 0.f ? t0 : t1;
     if (!(tt > 0.f && tt < tMax)) return false;
     *t = tt;
     return true;
   }
+  // The nearest crossing in (0, tMax) that a mask does not let through: the far one where the
+  // near one passes, as Embree's sphere points report.
+  ENVGI_HD bool sphereStop(int i, const Ray& r, float tMax, const SceneView* masks, float* t) const {
+    if (!masks) return sphereHit(spheres[i], r, tMax, t);
+    float roots[2];
+    if (!sphereRoots(spheres[i], r, &roots[0], &roots[1])) return false;
+    for (float tt : roots)
+      if (tt > 0.f && tt < tMax && !passesMask(masks, r, tt, sphereGeomOffset + i, 0, 0.f, 0.f)) {
+        *t = tt;
+        return true;
+      }
+    return false;
+  }
+
+  // A candidate hit that a mask lets the ray through.
+  ENVGI_HD static bool passesMask(const SceneView* masks, const Ray& r, float t, int geomId, int primId, float u, float v) {
+    if (!masks) return false;
+    Hit h;
+    h.t = t, h.geomId = geomId, h.primId = primId, h.u = u, h.v = v;
+    return !masks->stopsAtMask(r, h);
+  }
 
   template <bool AnyHit>
-  ENVGI_HD bool traverse(const Ray& r, Hit* hit) const {
+  ENVGI_HD bool traverse(const Ray& r, Hit* hit, const SceneView* masks) const {
     float tMax = r.tMax;
     bool found = false;
     for (int i = 0; i < sphereCount; ++i) {
       float t;
-      if (sphereHit(spheres[i], r, tMax, &t)) {
+      if (sphereStop(i, r, tMax, masks, &t)) {
         if (AnyHit) return true;
         tMax = t;
         hit->t = t;
@@ -114,7 +143,8 @@ struct BvhView {
       if (n.count > 0) {
         for (int i = n.index; i < n.index + n.count; ++i) {
           float t, u, v;
-          if (triangleHit(triangles[i], r, tMax, &t, &u, &v)) {
+          if (triangleHit(triangles[i], r, tMax, &t, &u, &v) &&
+              !passesMask(masks, r, t, triangles[i].geomId, triangles[i].primId, u, v)) {
             if (AnyHit) return true;
             tMax = t;
             hit->t = t;
@@ -152,10 +182,11 @@ struct BvhView {
     }
   }
 
-  ENVGI_HD bool intersect(const Ray& r, Hit* hit) const { return traverse<false>(r, hit); }
+  ENVGI_HD bool intersect(const Ray& r, Hit* hit) const { return traverse<false>(r, hit, masks); }
+  ENVGI_HD bool intersectSurface(const Ray& r, Hit* hit) const { return traverse<false>(r, hit, nullptr); }
   ENVGI_HD bool occluded(Vec3f o, Vec3f d, float tMax) const {
     Hit h;
-    return traverse<true>(Ray{o, d, tMax}, &h);
+    return traverse<true>(Ray{o, d, tMax}, &h, masks);
   }
 };
 
@@ -165,6 +196,7 @@ struct BvhTracer {
   BvhView bvh;
   ENVGI_HD bool intersect(const Ray& r, Hit* h) const { return bvh.intersect(r, h); }
   ENVGI_HD bool occluded(Vec3f o, Vec3f d, float tMax) const { return bvh.occluded(o, d, tMax); }
+  ENVGI_HD bool intersectSurface(const Ray& r, Hit* h) const { return bvh.intersectSurface(r, h); }
 };
 
 }  // namespace envgi

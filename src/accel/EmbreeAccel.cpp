@@ -10,6 +10,35 @@ namespace {
 void embreeError(void*, RTCError code, const char* str) {
   spdlog::error("Embree error {}: {}", int(code), str ? str : "");
 }
+
+// On a masked geometry, for intersect and occluded alike: turns down the hits that the mask
+// lets the ray through, and Embree goes on to the next surface.
+void maskFilter(const RTCFilterFunctionNArguments* args) {
+  const auto* ctx = reinterpret_cast<const EmbreeAccel::Context*>(args->context);
+  if (!ctx->throughMasks) return;
+  const auto* sv = static_cast<const SceneView*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    Ray r{{RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i), RTCRayN_org_z(args->ray, args->N, i)},
+          {RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i)},
+          INFINITY};
+    Hit h;
+    h.t = RTCRayN_tfar(args->ray, args->N, i);  // the candidate's distance, while the filter runs
+    h.geomId = int(RTCHitN_geomID(args->hit, args->N, i));
+    h.primId = int(RTCHitN_primID(args->hit, args->N, i));
+    h.u = RTCHitN_u(args->hit, args->N, i);
+    h.v = RTCHitN_v(args->hit, args->N, i);
+    if (!sv->stopsAtMask(r, h)) args->valid[i] = 0;
+  }
+}
+
+// Hands the masked geometries their filter; the others stay without one.
+void attachMaskFilter(RTCGeometry g, const SceneView* masks, int bsdf) {
+  if (!masks || !bsdfIsMasked(masks->bsdfs[bsdf])) return;
+  rtcSetGeometryUserData(g, const_cast<SceneView*>(masks));
+  rtcSetGeometryIntersectFilterFunction(g, maskFilter);
+  rtcSetGeometryOccludedFilterFunction(g, maskFilter);
+}
 }  // namespace
 
 EmbreeAccel::EmbreeAccel(const Scene& scene) {
@@ -19,6 +48,7 @@ EmbreeAccel::EmbreeAccel(const Scene& scene) {
   scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
   const SceneView& sv = scene.view();
+  if (sv.hasMasks) masks_ = std::make_unique<SceneView>(sv);
   for (int i = 0; i < sv.meshCount; ++i) {
     const MeshView& m = sv.meshes[i];
     const TriangleMesh& tm = scene.meshes[size_t(i)];
@@ -29,6 +59,7 @@ EmbreeAccel::EmbreeAccel(const Scene& scene) {
                                tm.positions.size());
     rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.indices, 0, 3 * sizeof(uint32_t),
                                size_t(m.triangleCount));
+    attachMaskFilter(g, masks_.get(), m.bsdf);
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(scene_, g, unsigned(i));
     rtcReleaseGeometry(g);
@@ -41,6 +72,7 @@ EmbreeAccel::EmbreeAccel(const Scene& scene) {
     v[1] = s.center.y;
     v[2] = s.center.z;
     v[3] = s.radius;
+    attachMaskFilter(g, masks_.get(), s.bsdf);
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(scene_, g, unsigned(sv.meshCount + i));
     rtcReleaseGeometry(g);

@@ -4,6 +4,7 @@
 #include <embree3/rtcore.h>
 
 #include <cmath>
+#include <memory>
 
 #include "scene/Scene.h"
 
@@ -26,15 +27,24 @@ class EmbreeAccel {
            std::fabs(r.d.x) <= kLarge && std::fabs(r.d.y) <= kLarge && std::fabs(r.d.z) <= kLarge && r.tMax == r.tMax;
   }
 
-  bool intersect(const Ray& ray, Hit* hit) const {
+  // Embree's context with what the mask filter reads (Embree passes it to filter functions).
+  struct Context {
+    RTCIntersectContext rtc;
+    bool throughMasks;  // false: intersectSurface, which sees every surface
+  };
+
+  // The nearest hit; a masked surface that SceneView::stopsAtMask lets the ray through is
+  // passed unless throughMasks is false.
+  bool intersect(const Ray& ray, Hit* hit, bool throughMasks = true) const {
     if (!traceable(ray)) return false;
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    Context ctx;
+    rtcInitIntersectContext(&ctx.rtc);
+    ctx.throughMasks = throughMasks;
     RTCRayHit rh;
     fillRay(ray, rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-    rtcIntersect1(scene_, &ctx, &rh);
+    rtcIntersect1(scene_, &ctx.rtc, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     hit->t = rh.ray.tfar;
     hit->geomId = int(rh.hit.geomID);
@@ -47,14 +57,17 @@ class EmbreeAccel {
   bool occluded(Vec3f o, Vec3f d, float tMax) const {
     Ray ray{o, d, tMax};
     if (!traceable(ray)) return true;
-    RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
+    Context ctx;
+    rtcInitIntersectContext(&ctx.rtc);
+    ctx.throughMasks = true;
     RTCRay r;
     fillRay(ray, r);
-    rtcOccluded1(scene_, &ctx, &r);
+    rtcOccluded1(scene_, &ctx.rtc, &r);
     return r.tfar < 0.f;  // Embree sets tfar to -inf on a hit
   }
 
+  // For tracing with Embree's own calls (the benchmarks' plain loop): a scene with masks needs an
+  // EmbreeAccel::Context, which the mask filter reads, in place of a bare RTCIntersectContext.
   RTCScene handle() const { return scene_; }
 
  private:
@@ -75,6 +88,7 @@ class EmbreeAccel {
 
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  std::unique_ptr<SceneView> masks_;  // the scene's view, for the masked geometries' filter
 };
 
 // The interface the integrators are written against: a CPU tracer over Embree.
@@ -82,6 +96,8 @@ struct EmbreeTracer {
   const EmbreeAccel* accel;
   bool intersect(const Ray& r, Hit* h) const { return accel->intersect(r, h); }
   bool occluded(Vec3f o, Vec3f d, float tMax) const { return accel->occluded(o, d, tMax); }
+  // Every surface, masked ones included (photon tracing decides at those itself).
+  bool intersectSurface(const Ray& r, Hit* h) const { return accel->intersect(r, h, false); }
 };
 
 }  // namespace envgi

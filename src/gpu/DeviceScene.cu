@@ -81,6 +81,7 @@ DeviceScene::DeviceScene(const Scene& scene, const Bvh& hostBvh) {
   bvh.nodes = arena.upload(b.nodes, size_t(b.nodeCount), "BVH nodes");
   bvh.triangles = arena.upload(b.triangles, hostBvh.triangles().size(), "BVH triangles");
   bvh.spheres = view.spheres;
+  bvh.masks = hv.hasMasks ? deviceView : nullptr;
 }
 
 }  // namespace envgi::gpu

@@ -71,6 +71,12 @@ struct Bsdf {
   float bumpScale = 1.f;
   PrincipledParams principled;
   int roughnessTexture = -1, metallicTexture = -1;  // principled: its roughness and metallic, as luminance
+  // Mitsuba's mask adapter: the chance that a ray meeting the surface stops there (1: opaque),
+  // or a texture whose luminance it is. It is not a lobe: the tracers let a ray through with
+  // the chance 1 - opacity (SceneView::stopsAtMask), and where one stops, the BSDF above
+  // scatters at full strength.
+  float opacity = 1.f;
+  int opacityTexture = -1;
 };
 
 ENVGI_INLINE const float* bsdfCoatTable(const Bsdf& b) {
@@ -114,6 +120,8 @@ ENVGI_INLINE bool bsdfIsNormalMapped(const Bsdf& b) { return b.normalMapTexture 
 ENVGI_INLINE bool bsdfNeedsTangentFrame(const Bsdf& b) {
   return bsdfIsAnisotropic(b) || bsdfIsNormalMapped(b) || (b.type == BsdfType::Principled && b.principled.anisotropic != 0.f);
 }
+
+ENVGI_INLINE bool bsdfIsMasked(const Bsdf& b) { return b.opacityTexture >= 0 || b.opacity < 1.f; }
 
 ENVGI_INLINE bool bsdfHasTexture(const Bsdf& b) {
   return b.reflectanceTexture >= 0 || b.specularReflectanceTexture >= 0 || b.specularTransmittanceTexture >= 0 ||

@@ -93,24 +93,34 @@ ENVGI_INLINE Color adjointWeight(const Bsdf& b, Vec3f woLocal, const BsdfSample&
   return bs.weight * bsdfEtaSquared(b, woLocal, bs.wi);
 }
 
-// store(si, wiWorld, power, caustic, depth) is called at each non-specular hit after the
-// first; caustic is true when every bounce before it was specular (light -> S+ -> here).
+// store(si, wiWorld, power, caustic, bounces) is called at each non-specular hit after the
+// first bounce; caustic is true when every bounce before it was specular (light -> S+ -> here).
+// A masked surface is met by every photon that reaches it, which is stored there whole, as
+// the light arriving there (a camera ray that stops there reflects all of it); the photon then
+// goes on through with the chance 1 - opacity (SceneView::stopsAtMask), unscattered and not
+// counted as a bounce, or scatters. maxDepth counts both.
 template <class Tracer, class Store>
 ENVGI_HD int tracePhoton(const SceneView& sc, const Tracer& tracer, Ray ray, Color power, Sampler& smp, int maxDepth,
                          Store&& store) {
   bool specularOnly = true;
-  int stored = 0;
+  int stored = 0, bounces = 0;
   for (int depth = 0; depth < maxDepth; ++depth) {
     Hit h;
-    if (!tracer.intersect(ray, &h)) break;
+    if (!tracer.intersectSurface(ray, &h)) break;
     SurfaceInteraction si = sc.interaction(ray, h);
     BsdfScratch textured;
     const Bsdf& bsdf = sc.bsdfAt(si, &textured);
     Vec3f wi = -ray.d;
-    if (!bsdfIsDelta(bsdf) && depth > 0) {
-      store(si, wi, power, specularOnly, depth);
+    if (!bsdfIsDelta(bsdf) && bounces > 0) {
+      store(si, wi, power, specularOnly, bounces);
       ++stored;
     }
+    if (sc.hasMasks && !sc.stopsAtMask(ray, h)) {
+      ray.o = offsetRayOrigin(si.p, si.ng, ray.d, si.t);
+      ray.tMax = INFINITY;
+      continue;
+    }
+    ++bounces;
     Vec3f woLocal = si.shading.toLocal(wi);
     BsdfSample bs;
     float uc = smp.get1D();

@@ -88,6 +88,7 @@ void Scene::finalize() {
   view_.deltaLights = deltaLights.empty() ? nullptr : deltaLights.data();
   view_.deltaLightCount = int(deltaLights.size());
   view_.hasEnvironment = env != nullptr;
+  for (const Bsdf& b : bsdfs) view_.hasMasks = view_.hasMasks || bsdfIsMasked(b);
   if (env) view_.env = env->view();
   view_.camera = camera;
   view_.boundsMin = lo;

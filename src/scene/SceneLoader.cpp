@@ -694,6 +694,7 @@ class Loader {
       return id;
     }
     if (type == "normalmap" || type == "bumpmap") return normalMap(f, n, p, type == "bumpmap");
+    if (type == "mask") return mask(f, n, p);
     // Textured properties, by name: nested <texture name=...> or <ref id=... name=...>.
     std::map<std::string, std::pair<int, pugi::xml_node>> textures;
     for (pugi::xml_node c : n.children()) {
@@ -751,7 +752,7 @@ class Loader {
       principled(f, n, p, b);
     } else {
       fail(f, n, fmt::format("unknown BSDF type '{}' (diffuse, conductor, roughconductor, dielectric, thindielectric, "
-                             "roughdielectric, plastic, roughplastic, principled, twosided, normalmap, bumpmap)",
+                             "roughdielectric, plastic, roughplastic, principled, twosided, normalmap, bumpmap, mask)",
                              type));
     }
     for (const auto& [name, tex] : textures) {
@@ -827,26 +828,15 @@ class Loader {
     }
   }
 
-  // Mitsuba's normalmap and bumpmap adapters: one nested BSDF (<bsdf> or a <ref> to one) and a
-  // texture (named `normalmap`; bumpmap's may have any name). The result is the nested BSDF with
-  // the map attached (a copy where referenced).
-  int normalMap(const SourceFile* f, pugi::xml_node n, Props& p, bool bump) {
-    const char* adapter = bump ? "bumpmap" : "normalmap";
-    int inner = -1, map = -1;
+  // An adapter's children (normalmap, bumpmap, mask): one nested BSDF (<bsdf> or a <ref> to one,
+  // copied) and textures (nested, or a <ref> named as one or to an id only a texture has), each
+  // handed to onTexture(node, index). Returns the nested BSDF's index.
+  template <class OnTexture>
+  int adapterChildren(const SourceFile* f, pugi::xml_node n, const char* adapter, OnTexture&& onTexture) {
+    int inner = -1;
     auto setInner = [&](pugi::xml_node c, int id) {
       if (inner >= 0) fail(f, c, fmt::format("{} takes one nested BSDF", adapter));
       inner = id;
-    };
-    auto setMap = [&](pugi::xml_node c, int id) {
-      std::string name = c.attribute("name").as_string();
-      if (bump) {
-        if (map >= 0) fail(f, c, "bumpmap takes one texture");
-      } else {
-        if (name != "normalmap")
-          fail(f, c, fmt::format("normalmap has no texture property '{}' (its texture is named 'normalmap')", name));
-        if (map >= 0) fail(f, c, "property 'normalmap' given twice");
-      }
-      map = id;
     };
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element) continue;
@@ -854,15 +844,14 @@ class Loader {
       if (tag == "bsdf") {
         setInner(c, bsdf(f, c));
       } else if (tag == "texture") {
-        setMap(c, texture(f, c));
+        onTexture(c, texture(f, c));
       } else if (tag == "ref") {
         checkAttrs(f, c, {"id", "name"});
         std::string id = attr(f, c, "id");
-        // A texture when it is named as one or only a texture has the id; a BSDF otherwise.
         auto b = bsdfIds_.find(id);
         auto t = textureIds_.find(id);
         if (t != textureIds_.end() && (b == bsdfIds_.end() || c.attribute("name"))) {
-          setMap(c, t->second.index);
+          onTexture(c, t->second.index);
         } else if (b != bsdfIds_.end()) {
           scene_.bsdfs.push_back(scene_.bsdfs[size_t(b->second.index)]);
           setInner(c, int(scene_.bsdfs.size() - 1));
@@ -874,6 +863,50 @@ class Loader {
       }
     }
     if (inner < 0) fail(f, n, fmt::format("{} needs a nested <bsdf>", adapter));
+    return inner;
+  }
+
+  // Mitsuba's mask: a nested BSDF and its `opacity` (0.5 unless given), a number or a texture
+  // read as its luminance, clamped to [0, 1].
+  int mask(const SourceFile* f, pugi::xml_node n, Props& p) {
+    int map = -1;
+    int inner = adapterChildren(f, n, "mask", [&](pugi::xml_node c, int id) {
+      std::string name = c.attribute("name").as_string();
+      if (name != "opacity") fail(f, c, fmt::format("mask has no texture property '{}' (its texture is named 'opacity')", name));
+      if (map >= 0 || p.count("opacity")) fail(f, c, "property 'opacity' given twice");
+      map = id;
+    });
+    Bsdf& b = scene_.bsdfs[size_t(inner)];
+    if (bsdfIsMasked(b)) fail(f, n, "a mask around a mask is not supported");
+    if (map >= 0) {
+      b.opacityTexture = map;
+      b.opacity = 0.f;  // read from the texture at each hit
+    } else {
+      float a = getFloat(f, p, "opacity", 0.5f);
+      if (!(a >= 0.f && a <= 1.f)) fail(f, n, fmt::format("mask's opacity must be within [0, 1], not {}", a));
+      b.opacity = a;
+    }
+    reportUnused(f, p, "bsdf", "mask");
+    return inner;
+  }
+
+  // Mitsuba's normalmap and bumpmap adapters: one nested BSDF and a texture (named `normalmap`;
+  // bumpmap's may have any name). The result is the nested BSDF with the map attached (a copy
+  // where referenced).
+  int normalMap(const SourceFile* f, pugi::xml_node n, Props& p, bool bump) {
+    const char* adapter = bump ? "bumpmap" : "normalmap";
+    int map = -1;
+    int inner = adapterChildren(f, n, adapter, [&](pugi::xml_node c, int id) {
+      std::string name = c.attribute("name").as_string();
+      if (bump) {
+        if (map >= 0) fail(f, c, "bumpmap takes one texture");
+      } else {
+        if (name != "normalmap")
+          fail(f, c, fmt::format("normalmap has no texture property '{}' (its texture is named 'normalmap')", name));
+        if (map >= 0) fail(f, c, "property 'normalmap' given twice");
+      }
+      map = id;
+    });
     if (map < 0) fail(f, n, bump ? "bumpmap needs a nested texture (its height)" : "normalmap needs a texture named 'normalmap'");
     Bsdf& b = scene_.bsdfs[size_t(inner)];
     if (bsdfIsNormalMapped(b)) fail(f, n, fmt::format("a {} around a normalmap or bumpmap is not supported", adapter));
@@ -1089,6 +1122,10 @@ class Loader {
       scene_.bsdfs.push_back(b);
       entry.bsdf = int(scene_.bsdfs.size() - 1);
     }
+    // A masked light would be seen with the chance of its opacity while next-event estimation
+    // reached all of it.
+    if (entry.emissive && bsdfIsMasked(scene_.bsdfs[size_t(entry.bsdf)]))
+      fail(f, n, "an area emitter's shape cannot have a mask BSDF");
     reportUnused(f, p, "shape", type);
     scene_.shapes.push_back(entry);
   }

@@ -1,6 +1,7 @@
 // The scene as plain data that kernels read: meshes, spheres, materials, lights, camera.
 #pragma once
 
+#include <cstring>
 #include <new>
 
 #include "core/Atan2.h"
@@ -8,6 +9,7 @@
 #include "envmap/EnvironmentMapView.h"
 #include "materials/Bsdf.h"
 #include "materials/Texture.h"
+#include "sampling/Pcg32.h"
 #include "scene/Camera.h"
 #include "scene/DeltaLight.h"
 #include "scene/Ray.h"
@@ -69,6 +71,33 @@ ENVGI_INLINE Vec3f bumpedNormal(Vec2f g, Vec2f dpdu, Vec2f dpdv) {
   return n.z < 0.f ? -n : n;
 }
 
+// A triangle's (u, v) at barycentrics (b1, b2) of its vertices i1 and i2: the mesh's own where
+// it has them, the barycentrics themselves where it has none.
+ENVGI_INLINE Vec2f meshUv(const MeshView& m, uint32_t i0, uint32_t i1, uint32_t i2, float b1, float b2) {
+  return m.uvs ? m.uvs[i0] * (1.f - b1 - b2) + m.uvs[i1] * b1 + m.uvs[i2] * b2 : Vec2f(b1, b2);
+}
+// Mitsuba's sphere coordinates at the unit radial direction n: u the azimuth about local z from
+// local x, v the polar angle (two inverse trigonometric functions, so only where a texture reads them).
+ENVGI_INLINE Vec2f sphereUv(const SphereView& s, Vec3f n) {
+  Vec3f l = s.axes.toLocal(n);
+  float phi = polyAtan2(l.y, l.x);
+  return Vec2f((phi < 0.f ? phi + 2.f * kPi : phi) * (0.5f * kInvPi), acosf(fminf(fmaxf(l.z, -1.f), 1.f)) * kInvPi);
+}
+
+// A number in [0, 1) from a ray and a surface crossing it (a geometry's id and the triangle, or
+// which of a sphere's two crossings): the same on either tracer and device, and apart for each
+// crossing along one ray.
+ENVGI_INLINE float rayCrossingHash(const Ray& r, int geomId, uint32_t crossing) {
+  uint32_t w[6];
+  std::memcpy(&w[0], &r.o, sizeof(Vec3f));
+  std::memcpy(&w[3], &r.d, sizeof(Vec3f));
+  uint64_t x = mixBits((uint64_t(w[0]) << 32) | w[1]);
+  x = hashCombine(x, (uint64_t(w[2]) << 32) | w[3]);
+  x = hashCombine(x, (uint64_t(w[4]) << 32) | w[5]);
+  x = hashCombine(x, (uint64_t(uint32_t(geomId)) << 32) | crossing);
+  return float(x >> 40) * (1.f / 16777216.f);
+}
+
 // Room for a textured material's copy at a hit, left unwritten where the material has no
 // texture (a Bsdf would store its defaults there at every hit).
 struct BsdfScratch {
@@ -88,6 +117,7 @@ struct SceneView {
   const DeltaLight* deltaLights = nullptr;
   int deltaLightCount = 0;
   bool hasEnvironment = false;
+  bool hasMasks = false;  // some material has a mask (Bsdf::opacity): the tracers ask stopsAtMask
   EnvironmentMapView env;
   Camera camera;
   Vec3f boundsMin, boundsMax;
@@ -118,7 +148,7 @@ struct SceneView {
         if (dot(ns, ng) < 0.f) ng = -ng;  // geometric normal agrees with the mesh's own normals
       }
       si.ng = ng;
-      si.uv = m.uvs ? m.uvs[i0] * b0 + m.uvs[i1] * b1 + m.uvs[i2] * b2 : Vec2f(b1, b2);
+      si.uv = meshUv(m, i0, i1, i2, b1, b2);
       si.shading = Frame::fromNormal(ns);
       if (m.anisotropic) {
         // dp/du from the triangle's (u, v), the barycentric ones where the mesh has none.
@@ -143,14 +173,7 @@ struct SceneView {
       Vec3f p = ray.o + ray.d * h.t;
       Vec3f n = normalize(p - s.center);
       si.p = s.center + n * s.radius;  // re-projected: removes the hit point's float error
-      // Mitsuba's sphere coordinates: u the azimuth about local z from local x, v the polar angle
-      // (two inverse trigonometric functions, so only where a texture reads them).
-      si.uv = Vec2f(0.f, 0.f);
-      if (bsdfHasTexture(bsdfs[s.bsdf])) {
-        Vec3f l = s.axes.toLocal(n);
-        float phi = polyAtan2(l.y, l.x);
-        si.uv = Vec2f((phi < 0.f ? phi + 2.f * kPi : phi) * (0.5f * kInvPi), acosf(fminf(fmaxf(l.z, -1.f), 1.f)) * kInvPi);
-      }
+      si.uv = bsdfHasTexture(bsdfs[s.bsdf]) ? sphereUv(s, n) : Vec2f(0.f, 0.f);
       Vec3f radial = n;
       if (s.flipNormals) n = -n;
       si.ng = n;
@@ -173,6 +196,37 @@ struct SceneView {
       si.light = s.light;
     }
     return si;
+  }
+
+  // The material at a hit, without the rest of interaction().
+  ENVGI_HD int bsdfIndexAt(const Hit& h) const {
+    return h.geomId < meshCount ? meshes[h.geomId].bsdf : spheres[h.geomId - meshCount].bsdf;
+  }
+
+  // Whether a ray stops at hit h: always at an opaque surface, at a masked one with the chance
+  // of its opacity there (Mitsuba's mask), drawn from rayCrossingHash, as pbrt-v4's stochastic alpha
+  // test does, so that the tracers can decide it while they traverse and no sampler dimension
+  // depends on what a ray passed through.
+  ENVGI_HD bool stopsAtMask(const Ray& ray, const Hit& h) const {
+    const Bsdf& b = bsdfs[bsdfIndexAt(h)];
+    if (!bsdfIsMasked(b)) return true;
+    float a = b.opacity;
+    uint32_t crossing = uint32_t(h.primId);
+    if (h.geomId < meshCount) {
+      if (b.opacityTexture >= 0) {
+        const MeshView& m = meshes[h.geomId];
+        const uint32_t* ix = m.indices + 3 * size_t(h.primId);
+        a = luminance(textureEval(textures[b.opacityTexture], meshUv(m, ix[0], ix[1], ix[2], h.u, h.v)));
+      }
+    } else {
+      // A ray may cross a sphere twice: on the way in and on the way out, each decided apart.
+      const SphereView& s = spheres[h.geomId - meshCount];
+      Vec3f radial = ray.o + ray.d * h.t - s.center;
+      crossing = dot(radial, ray.d) > 0.f ? 1u : 0u;
+      if (b.opacityTexture >= 0) a = luminance(textureEval(textures[b.opacityTexture], sphereUv(s, normalize(radial))));
+    }
+    // An opacity of 1 or more always stops the ray, of 0 or less (or NaN) never, as Mitsuba clamps it.
+    return rayCrossingHash(ray, h.geomId, crossing) < a;
   }
 
   // Material `index` at surface coordinates uv: its textured colours looked up there, as a

@@ -96,7 +96,7 @@ void pointLightsToSpots(Scene* s) {
 
 TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
   std::vector<Case> cases;
-  for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured", "microfacets", "brushed", "sun-and-sky", "normal-map", "principled"})
+  for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured", "microfacets", "brushed", "sun-and-sky", "normal-map", "principled", "mask"})
     cases.push_back({sc, "path", "mis"});
   cases.push_back({"textured", "path", "mis", 0.2f});
   cases.push_back({"sun-and-sky", "path", "mis", 0.f, true});
@@ -138,7 +138,7 @@ TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
 // paths, up to traversal rounding, FMA contraction and the order of the atomics' float sums;
 // so the image means and the 8x8-region means agree closely.
 TEST(GpuRender, SppmMatchesTheCpuDriver) {
-  for (std::string name : {"cornell-box", "teapot-glass", "buddha", "sun-and-sky"}) {
+  for (std::string name : {"cornell-box", "teapot-glass", "buddha", "sun-and-sky", "mask"}) {
     Scene s;
     loadBundled(name, IntegratorType::Sppm, &s);
     s.integrator.sppm.photonCount = 200000;
@@ -165,7 +165,7 @@ TEST(GpuRender, SppmMatchesTheCpuDriver) {
 // rounding, so the counts, the stored power and its spatial histogram (8^3 cells over the
 // scene's bounds) agree closely.
 TEST(GpuRender, PhotonMapsMatchTheCpu) {
-  for (std::string name : {"cornell-box", "teapot-glass", "buddha", "sun-and-sky"}) {
+  for (std::string name : {"cornell-box", "teapot-glass", "buddha", "sun-and-sky", "mask"}) {
     Scene s;
     loadScene(test::bundledScenesDir() + "/" + name + ".xml", {}, s);
     s.finalize();

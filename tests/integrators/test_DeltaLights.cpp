@@ -57,17 +57,7 @@ double meanRadiance(Scene& s, const std::string& integrator) {
   s.integrator.grid.gatherRays = 16;
   s.integrator.grid.globalPhotons = 20000;
   s.integrator.grid.causticPhotons = 5000;
-  s.finalize();
-  EmbreeAccel accel(s);
-  RenderOptions o;
-  o.progress = false;
-  RenderStats st;
-  Image img = render(s, accel, o, &st);
-  EXPECT_EQ(st.nonFiniteSamples, 0u);
-  double sum = 0.0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) sum += img.at(x, y).y;
-  return sum / (img.width * img.height);
+  return test::renderedMean(s);
 }
 
 }  // namespace

@@ -785,6 +785,49 @@ TEST(SceneLoader, BumpMap) {
   expectErrors(f, bad);
 }
 
+// Mitsuba's mask: opacity as a number (0.5 unless given) or a texture named opacity, around
+// any BSDF (twosided included, either way round); errors for a wrong name, a value out of
+// [0, 1], two opacities, a missing BSDF, a mask on an area light.
+TEST(SceneLoader, Mask) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <shape type="sphere"><bsdf type="mask"><float name="opacity" value="0.25"/><bsdf type="roughplastic"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="mask"><bsdf type="twosided"><bsdf type="diffuse"/></bsdf></bsdf></shape>
+    <shape type="ply"><string name="filename" value="tri.ply"/>
+      <bsdf type="twosided"><bsdf type="mask"><texture type="checkerboard" name="opacity"/><bsdf type="diffuse"/></bsdf></bsdf></shape>)"),
+            {}, s);
+  const Bsdf &a = s.bsdfs[size_t(s.shapes[0].bsdf)], &b = s.bsdfs[size_t(s.shapes[1].bsdf)],
+             &c = s.bsdfs[size_t(s.shapes[2].bsdf)];
+  EXPECT_EQ(a.type, BsdfType::RoughPlastic);
+  EXPECT_FLOAT_EQ(a.opacity, 0.25f);
+  EXPECT_EQ(a.opacityTexture, -1);
+  EXPECT_FLOAT_EQ(b.opacity, 0.5f);
+  EXPECT_TRUE(b.twoSided);
+  EXPECT_EQ(c.opacityTexture, 0);
+  EXPECT_TRUE(c.twoSided);
+  EXPECT_TRUE(bsdfIsMasked(a) && bsdfIsMasked(b) && bsdfIsMasked(c));
+  EXPECT_TRUE(s.view().hasMasks);
+
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<shape type="sphere"><bsdf type="mask"><float name="opacity" value="1.5"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "mask's opacity must be within [0, 1], not 1.5"},
+      {R"(<shape type="sphere"><bsdf type="mask"><float name="opacity" value="0.5"/></bsdf></shape>)",
+       "mask needs a nested <bsdf>"},
+      {R"(<shape type="sphere"><bsdf type="mask"><texture type="checkerboard" name="alpha"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "mask has no texture property 'alpha' (its texture is named 'opacity')"},
+      {R"(<shape type="sphere"><bsdf type="mask"><float name="opacity" value="0.5"/><texture type="checkerboard" name="opacity"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "property 'opacity' given twice"},
+      {R"(<shape type="sphere"><bsdf type="mask"><bsdf type="mask"><bsdf type="diffuse"/></bsdf></bsdf></shape>)",
+       "a mask around a mask is not supported"},
+      {R"(<shape type="sphere"><bsdf type="mask"><float name="opacty" value="0.5"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "bsdf 'mask' has no property 'opacty' (did you mean 'opacity'?)"},
+      {R"(<shape type="sphere"><emitter type="area"><rgb name="radiance" value="1"/></emitter><bsdf type="mask"><bsdf type="diffuse"/></bsdf></shape>)",
+       "an area emitter's shape cannot have a mask BSDF"},
+  };
+  expectErrors(f, bad);
+}
+
 // Mitsuba 3's principled BSDF: its properties as Mitsuba names them, eta from specular where
 // eta is not given, textures for base_color, roughness and metallic, and errors for values out
 // of range, for eta and specular together and for a misspelt name.

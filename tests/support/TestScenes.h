@@ -1,6 +1,8 @@
 // Small scenes built in code for integrator tests.
 #pragma once
 
+#include <gtest/gtest.h>
+
 #include "accel/EmbreeAccel.h"
 #include "render/Renderer.h"
 #include "scene/Scene.h"
@@ -48,6 +50,22 @@ inline std::unique_ptr<Scene> sphereOnFloor(const Bsdf& floor, const Bsdf& ball,
   s->camera.filter = makeFilter(FilterType::Box);
   s->finalize();
   return s;
+}
+
+// The scene finalized and rendered on the CPU (no non-finite samples): the mean of its pixels'
+// luminance.
+inline double renderedMean(Scene& s) {
+  s.finalize();
+  EmbreeAccel accel(s);
+  RenderOptions o;
+  o.progress = false;
+  RenderStats st;
+  Image img = render(s, accel, o, &st);
+  EXPECT_EQ(st.nonFiniteSamples, 0u);
+  double sum = 0.0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) sum += img.at(x, y).y;
+  return sum / (double(img.width) * img.height);
 }
 
 // Mean of the pixels whose whole footprint sees the sphere (the four corner rays hit it).
