@@ -147,6 +147,20 @@ def normal_mapped(domes, heights):
                 '<boolean name="use_shadowing_function" value="false"/>' + nested[0][1] + '</bsdf>'))
     return out
 
+def masks():
+    """Mitsuba's mask around BSDFs: a constant opacity, one-sided and two-sided, and a
+    checkerboard of opacities (Mitsuba renders these with volpath: mitsuba_render)."""
+    diffuse = '<bsdf type="diffuse"><rgb name="reflectance" value="0.8"/></bsdf>'
+    checks = ('<texture type="checkerboard" name="opacity"><rgb name="color0" value="1"/><rgb name="color1" value="0.2"/>'
+              '<transform name="to_uv"><scale x="4" y="4"/></transform></texture>')
+    return [
+        ('mask 0.3 diffuse 0.8', f'<bsdf type="mask"><float name="opacity" value="0.3"/>{diffuse}</bsdf>'),
+        ('mask 0.5 twosided diffuse 0.8', f'<bsdf type="mask"><float name="opacity" value="0.5"/><bsdf type="twosided">{diffuse}</bsdf></bsdf>'),
+        ('mask 0.6 twosided roughplastic', '<bsdf type="mask"><float name="opacity" value="0.6"/><bsdf type="twosided">'
+         '<bsdf type="roughplastic"><float name="alpha" value="0.2"/></bsdf></bsdf></bsdf>'),
+        ('mask checkerboard twosided diffuse 0.8', f'<bsdf type="mask">{checks}<bsdf type="twosided">{diffuse}</bsdf></bsdf>'),
+    ]
+
 def principled():
     """Mitsuba's principled BSDF: its lobes alone and together, and with textured base colour,
     roughness and metallic."""
@@ -204,8 +218,27 @@ SAMPLER = re.compile(r'<sampler type="[a-z]+">')
 # highlight in teapot-glass's last column.
 FILM = re.compile(r'<film type="hdrfilm">')
 
+# Mitsuba's path treats a mask as a null lobe of its BSDF and blocks shadow rays there, so only
+# BSDF-sampled rays find light through a mask, and its MIS weighs those against the emitter's
+# density as if the null lobe had one; volpath carries shadow rays through null surfaces.
+# envgi's masks are what volpath converges to (docs/scene-format.md, "Masks").
+MASKED = 'type="mask"'
+
+# Mitsuba's checkerboard read as a float (Texture::eval_1: a mask's opacity, a roughness, a
+# metallic) puts color0 where u and v are in different halves of their period, the other way
+# round from its colour (eval); envgi's checkerboard is one pattern however it is read. Mitsuba
+# is given the two colours swapped in a checkerboard nested under a property it reads as a float.
+FLOAT_CHECKERBOARD = re.compile(r'(<texture type="checkerboard" name="(?:opacity|alpha|alpha_u|alpha_v|roughness|metallic)">)(.*?)(</texture>)', re.S)
+
+def swap_checker_colours(m):
+    body = m.group(2).replace('name="color0"', 'name="@c1"').replace('name="color1"', 'name="color0"').replace('name="@c1"', 'name="color1"')
+    return m.group(1) + body + m.group(3)
+
 def mitsuba_render(xml_path, spp, seed, defines, res):
     text = SAMPLER.sub('<sampler type="independent">', ENVGI_ONLY.sub('', open(xml_path).read()))
+    if MASKED in text:
+        text = text.replace('<integrator type="path">', '<integrator type="volpath">')
+    text = FLOAT_CHECKERBOARD.sub(swap_checker_colours, text)
     text = FILM.sub('<film type="hdrfilm"><boolean name="sample_border" value="true"/>', text)
     resolver = mi.Thread.thread().file_resolver()
     resolver.prepend(os.path.dirname(os.path.abspath(xml_path)))
@@ -242,7 +275,7 @@ def main():
     ap.add_argument('--res', type=int, default=48)
     ap.add_argument('--only', default='', help='substring of the configurations to run')
     ap.add_argument('--all-regions', action='store_true', help='print every region of each configuration, not the worst')
-    ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,textured,microfacets,brushed,bunny-sunrise,normal-map,principled',
+    ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,textured,microfacets,brushed,bunny-sunrise,normal-map,principled,mask',
                     help='comma-separated scenes (XML files in --scenes, without .xml)')
     args = ap.parse_args()
     rows = []
@@ -254,7 +287,7 @@ def main():
     make_normal_map.write_png(domes, 256)
     heights = os.path.join(tmp, 'heights.png')
     make_normal_map.write_height_png(heights, 256)
-    for name, b in bsdfs() + normal_mapped(domes, heights) + principled():
+    for name, b in bsdfs() + normal_mapped(domes, heights) + principled() + masks():
         path = os.path.join(tmp, re.sub(r'[^a-z0-9]+', '_', name) + '.xml')
         open(path, 'w').write(FURNACE.format(res=args.res, spp=args.spp, bsdf=b))
         # The centre of the sphere: regions over the middle third of the image.
