@@ -275,7 +275,7 @@ def main():
     ap.add_argument('--res', type=int, default=48)
     ap.add_argument('--only', default='', help='substring of the configurations to run')
     ap.add_argument('--all-regions', action='store_true', help='print every region of each configuration, not the worst')
-    ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,textured,microfacets,brushed,bunny-sunrise,normal-map,principled,mask',
+    ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,textured,microfacets,brushed,bunny-sunrise,normal-map,principled,mask,orthographic',
                     help='comma-separated scenes (XML files in --scenes, without .xml)')
     args = ap.parse_args()
     rows = []
@@ -311,6 +311,9 @@ def main():
     variant('normal-map as bumpmap', 'normal-map',
             lambda t: t.replace('<bsdf type="normalmap">', '<bsdf type="bumpmap"><float name="scale" value="0.05"/>')
             .replace('value="$normalmap"', f'value="{heights}"'))
+    # The orthographic view on a film of aspect 2, whose near plane is [-1, 1] x [-1/2, 1/2].
+    variant('orthographic, film 2:1', 'orthographic',
+            lambda t: t.replace('<integer name="height" value="$res"/>', f'<integer name="height" value="{args.res // 2}"/>'))
     # Depth of field: the textured scene through a thin lens focused on the globe.
     variant('textured thinlens', 'textured', lambda t: t.replace('<sensor type="perspective">', THINLENS))
     # The brushed sphere alone, the map behind it hidden (the open row placement shifts the

@@ -1,5 +1,5 @@
-// Mitsuba's perspective and thin-lens sensors: look along +z of their frame, +y up; to_world
-// places them.
+// Mitsuba's perspective, thin-lens and orthographic sensors: look along +z of their frame, +y
+// up; to_world places them (and scales an orthographic camera's view).
 #pragma once
 
 #include "core/Transform.h"
@@ -12,11 +12,15 @@ namespace envgi {
 struct Camera {
   Transform toWorld;
   int width = 512, height = 512;
-  float tanHalfX = 0.f, tanHalfY = 0.f;  // half extent of the image plane at distance 1
+  // Half extent of the image plane at distance 1; for an orthographic camera, of its near plane
+  // in camera space (Mitsuba's [-1, 1] x [-1/aspect, 1/aspect], which to_world's scale resizes).
+  float tanHalfX = 0.f, tanHalfY = 0.f;
   float nearClip = 1e-2f, farClip = 1e4f;
   ReconstructionFilter filter;  // Mitsuba's default: gaussian, stddev 0.5
   // Thin lens (Mitsuba's `thinlens`); a pinhole when the radius is 0.
   float apertureRadius = 0.f, focusDistance = 1e4f;
+  // Mitsuba's `orthographic`: parallel rays along the frame's +z from points of the near plane.
+  bool orthographic = false;
 
   // Whether a camera sample needs a point on the lens (a 2D draw after the filter's).
   ENVGI_HD bool hasLens() const { return apertureRadius > 0.f; }
@@ -30,6 +34,13 @@ struct Camera {
     // near and far planes into distances along the ray without normalising twice.
     Vec3f d(-sx * tanHalfX, sy * tanHalfY, 1.f);
     Ray r;
+    if (orthographic) {
+      // As Mitsuba's: the ray's length is far - near in world units, whatever to_world's scale.
+      r.o = toWorld.point(Vec3f(d.x, d.y, nearClip));
+      r.d = normalize(toWorld.vector(Vec3f(0.f, 0.f, 1.f)));
+      r.tMax = farClip - nearClip;
+      return r;
+    }
     if (hasLens()) {
       // Every ray through the pixel's point on the plane in focus, from a point of the lens.
       Vec2f a = sampleConcentricDisk(lens) * apertureRadius;
@@ -51,8 +62,9 @@ struct Camera {
 // Film position (pixels) of a world point, the inverse of generateRay; false behind the camera.
 ENVGI_INLINE bool projectToFilm(const Camera& c, Vec3f p, float* x, float* y) {
   Vec3f q = c.toWorld.inversePoint(p);
-  if (q.z <= 0.f) return false;
-  float sx = -(q.x / q.z) / c.tanHalfX, sy = (q.y / q.z) / c.tanHalfY;
+  if (c.orthographic ? !(q.z >= c.nearClip) : q.z <= 0.f) return false;
+  float w = c.orthographic ? 1.f : q.z;
+  float sx = -(q.x / w) / c.tanHalfX, sy = (q.y / w) / c.tanHalfY;
   *x = 0.5f * (sx + 1.f) * float(c.width);
   *y = 0.5f * (1.f - sy) * float(c.height);
   return *x >= 0.f && *y >= 0.f && *x < float(c.width) && *y < float(c.height);

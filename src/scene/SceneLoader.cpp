@@ -445,14 +445,17 @@ class Loader {
   void sensor(const SourceFile* f, pugi::xml_node n) {
     checkAttrs(f, n, {"type", "id", "name"});
     std::string type = attr(f, n, "type");
-    if (type != "perspective" && type != "thinlens")
-      fail(f, n, fmt::format("unknown sensor type '{}' (perspective, thinlens)", type));
+    if (type != "perspective" && type != "thinlens" && type != "orthographic")
+      fail(f, n, fmt::format("unknown sensor type '{}' (perspective, thinlens, orthographic)", type));
     haveSensor_ = true;
     Props p = collectProps(f, n);
     Camera& cam = scene_.camera;
-    float fov = getFloat(f, p, "fov", 45.f);
+    const bool ortho = type == "orthographic";
+    cam.orthographic = ortho;
+    // Mitsuba's orthographic camera has no field of view: to_world's scale sizes its view.
+    float fov = ortho ? 45.f : getFloat(f, p, "fov", 45.f);
     if (!(fov > 0.f && fov < 180.f)) fail(f, n, "fov must be between 0 and 180 degrees");
-    std::string axis = getString(f, p, "fov_axis", "x");
+    std::string axis = ortho ? "x" : getString(f, p, "fov_axis", "x");
     cam.nearClip = getFloat(f, p, "near_clip", 0.01f);
     cam.farClip = getFloat(f, p, "far_clip", 10000.f);
     if (!(cam.nearClip > 0.f && cam.farClip > cam.nearClip)) fail(f, n, "need 0 < near_clip < far_clip");
@@ -479,7 +482,7 @@ class Loader {
       else if (!isPropTag(tag)) fail(f, c, fmt::format("unexpected <{}> in <sensor>", tag));
     }
     float aspect = float(cam.width) / float(cam.height);
-    float t = std::tan(0.5f * fov * kPi / 180.f);
+    float t = ortho ? 1.f : std::tan(0.5f * fov * kPi / 180.f);
     if (axis == "x") {
       cam.tanHalfX = t;
       cam.tanHalfY = t / aspect;

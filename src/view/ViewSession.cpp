@@ -70,6 +70,7 @@ ViewSession::ViewSession(std::unique_ptr<Scene> scene, std::string scenePath, Vi
   float dist = std::max(dot(centre - s.origin, fwd), 1e-2f * length(sc.boundsMax - sc.boundsMin) + 1e-3f);
   s.target = s.origin + fwd * dist;
   s.up = normalize(t.vector(Vec3f(0.f, 1.f, 0.f)));
+  if (scene_->camera.orthographic) cameraShape_ = lookAt(s.origin, s.target, s.up).inverse() * t;
   s.strategy = scene_->integrator.env.strategy;
   s.integrator = integratorName(scene_->integrator.type);
   s.noiseThreshold = opts_.noiseThreshold;
@@ -275,7 +276,7 @@ void ViewSession::run() {
     }
     if (restart || rebuild) {
       Camera& cam = scene_->camera;
-      cam.toWorld = lookAt(s.origin, s.target, s.up);
+      cam.toWorld = lookAt(s.origin, s.target, s.up) * cameraShape_;
       cam.width = std::max(8, int(std::lround(baseW * s.resolutionScale)));
       cam.height = std::max(8, int(std::lround(baseH * s.resolutionScale)));
       try {

@@ -76,6 +76,9 @@ class ViewSession {
   std::string scenePath_;
   ViewOptions opts_;
   std::unique_ptr<EmbreeAccel> accel_;
+  // What the scene's to_world does before its rigid frame (an orthographic camera's scale,
+  // which sizes its view), kept when the page moves the camera.
+  Transform cameraShape_;
   std::unique_ptr<State> state_;  // guarded by mutex_
   mutable std::mutex mutex_;
   std::condition_variable wake_;

@@ -657,6 +657,29 @@ TEST(CliRender, MaskSceneRenders) {
   for (int open = 0; open < 2; ++open) EXPECT_NEAR(mean[1][open], mean[0][open], 0.1 * mean[0][open]) << "lattice " << 1 - open;
 }
 
+// The bundled orthographic scene, end to end with path and sppm: no warning, a finite image
+// that is not black, and the two integrators agree on its mean.
+TEST(CliRender, OrthographicSceneRenders) {
+  TempDir d;
+  const std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/orthographic.xml";
+  double mean[2] = {};
+  const char* integrators[] = {"path", "sppm"};
+  for (int i = 0; i < 2; ++i) {
+    std::string out = d.file(std::string(integrators[i]) + ".exr");
+    CliResult r = runCli("render " + scene + " -o " + out + " --integrator " + integrators[i] +
+                         " --spp 16 -D res=32 --no-progress");
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_EQ(r.output.find("warn"), std::string::npos) << r.output;
+    envgi::Image img = envgi::loadImage(out);
+    ASSERT_EQ(img.width, 32);
+    for (float v : img.rgb) ASSERT_TRUE(std::isfinite(v)) << integrators[i];
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) mean[i] += img.at(x, y).y / (img.height * img.width);
+    EXPECT_GT(mean[i], 0.05) << integrators[i];
+  }
+  EXPECT_NEAR(mean[1], mean[0], 0.1 * mean[0]);
+}
+
 // The bundled principled scene, end to end with path, sppm and direct: no warning (every
 // property is read), a finite image that is not black; path and sppm, both consistent, agree on
 // its mean. (photon and grid take 8-10 s here for their maps; test_Principled.cpp checks what

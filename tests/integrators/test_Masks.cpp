@@ -149,20 +149,6 @@ TEST(Mask, OpacityTextureIsReadAtTheHit) {
 
 namespace {
 
-// The image's mean, rendered by `type` with spp samples a pixel.
-double renderMean(Scene& s, IntegratorType type, int spp) {
-  s.integrator.type = type;
-  s.sampler.sampleCount = spp;
-  s.sampler.type = SamplerType::Sobol;
-  s.integrator.photon.globalPhotons = s.integrator.photon.causticPhotons = 20000;
-  s.integrator.sppm.photonCount = 20000;
-  s.integrator.sppm.passes = spp;
-  s.integrator.grid.resolution = 8;
-  s.integrator.grid.gatherRays = 64;
-  s.integrator.grid.globalPhotons = s.integrator.grid.causticPhotons = 20000;
-  return test::renderedMean(s);
-}
-
 void lookThrough(Scene& s, Vec3f eye, Vec3f target, Vec3f up, float fovDeg) {
   s.env = std::make_unique<EnvironmentMap>(EnvironmentMap::constant(Color(1.f)));
   s.camera.toWorld = lookAt(eye, target, up);
@@ -184,7 +170,7 @@ TEST(Mask, CameraSeesThroughByTheOpacity) {
     s.bsdfs = {masked(0.5f, kOpacity)};
     addMesh(s, plane(0.f), 0);
     lookThrough(s, Vec3f(0, 0, 4), Vec3f(0, 0, 0), Vec3f(0, 1, 0), 20.f);
-    EXPECT_NEAR(renderMean(s, type, 32), kOpacity * 0.5 + (1.0 - kOpacity), 0.012) << "integrator " << int(type);
+    EXPECT_NEAR(test::renderedMean(s, type, 32), kOpacity * 0.5 + (1.0 - kOpacity), 0.012) << "integrator " << int(type);
   }
 }
 
@@ -203,6 +189,6 @@ TEST(Mask, ShellShadowsByTheOpacity) {
     floor.transform(rotate(Vec3f(1, 0, 0), -90.f));  // facing +y
     addMesh(s, floor, 1);
     lookThrough(s, Vec3f(0, 2, 0), Vec3f(0, 0, 0), Vec3f(0, 0, 1), 40.f);
-    EXPECT_NEAR(renderMean(s, type, 32), 0.5 * (1.0 - kOpacity), 0.012) << "integrator " << int(type);
+    EXPECT_NEAR(test::renderedMean(s, type, 32), 0.5 * (1.0 - kOpacity), 0.012) << "integrator " << int(type);
   }
 }

@@ -77,3 +77,43 @@ TEST(Camera, ThinLensRaysMeetOnThePlaneInFocus) {
   // Uniform over the disk: E[r^2] = R^2 / 2.
   EXPECT_NEAR(meanR2 / n, 0.5 * 0.04, 0.02 * 0.04);
 }
+
+// Mitsuba's orthographic camera: every ray runs along the frame's +z, from the film position's
+// point of the near plane, [-1, 1] x [-1/aspect, 1/aspect] in camera space before to_world
+// (here scaled by 3 across and 2 up), image left at camera +x as for the perspective camera;
+// the ray is far - near long, and the point projects back to its film position.
+TEST(Camera, OrthographicRaysAreParallelFromTheNearPlane) {
+  Camera c;
+  c.width = 200;
+  c.height = 100;
+  c.orthographic = true;
+  c.tanHalfX = 1.f;
+  c.tanHalfY = 0.5f;
+  c.nearClip = 0.1f;
+  c.farClip = 50.f;
+  Transform frame = lookAt(Vec3f(1.f, 2.f, 6.f), Vec3f(0.f, 0.5f, 0.f), Vec3f(0.f, 1.f, 0.f));
+  c.toWorld = frame * scale(Vec3f(3.f, 2.f, 1.f));
+  const Vec3f axis = normalize(frame.vector(Vec3f(0.f, 0.f, 1.f)));
+  Pcg32 rng(5);
+  for (int i = 0; i < 2000; ++i) {
+    float x = rng.nextFloat() * 200.f, y = rng.nextFloat() * 100.f;
+    Ray r = c.generateRay(x, y);
+    ASSERT_NEAR(length(r.d - axis), 0.f, 1e-6f);
+    ASSERT_NEAR(r.tMax, 49.9f, 1e-5f);
+    Vec3f q = frame.inversePoint(r.o);
+    ASSERT_NEAR(q.x, 3.f * (1.f - 2.f * x / 200.f), 1e-4f);
+    ASSERT_NEAR(q.y, 2.f * 0.5f * (1.f - 2.f * y / 100.f), 1e-4f);
+    ASSERT_NEAR(q.z, 0.1f, 1e-5f);
+    float px, py;
+    ASSERT_TRUE(projectToFilm(c, r.o + r.d * 7.f, &px, &py));
+    ASSERT_NEAR(px, x, 2e-3f);
+    ASSERT_NEAR(py, y, 2e-3f);
+  }
+  // The film's corners are the near plane's, a ray's length from the image plane does not
+  // matter, and a point before the near plane is not seen.
+  EXPECT_NEAR(length(frame.inversePoint(c.generateRay(0.f, 0.f).o) - Vec3f(3.f, 1.f, 0.1f)), 0.f, 1e-5f);
+  EXPECT_NEAR(length(frame.inversePoint(c.generateRay(200.f, 100.f).o) - Vec3f(-3.f, -1.f, 0.1f)), 0.f, 1e-5f);
+  float px, py;
+  EXPECT_FALSE(projectToFilm(c, frame.point(Vec3f(0.f, 0.f, 0.05f)), &px, &py));
+  EXPECT_FALSE(c.hasLens());
+}

@@ -124,6 +124,40 @@ TEST(SceneLoader, SensorFilmSamplerIntegrator) {
   EXPECT_NE(loadError(f.scene(unfocused)).find("focus_distance must be positive"), std::string::npos);
 }
 
+// Mitsuba's orthographic sensor: the near plane's [-1, 1] x [-1/aspect, 1/aspect], sized by
+// to_world's scale, and no field of view (a fov is warned about and ignored, as the camera has
+// none); a thin lens's aperture is an error there, as in Mitsuba.
+TEST(SceneLoader, OrthographicSensor) {
+  Fixture f;
+  const std::string ortho = R"(<sensor type="orthographic">
+  <float name="fov" value="60"/>
+  <transform name="to_world"><scale x="4" y="4"/><lookat origin="0,0,5" target="0,0,0" up="0,1,0"/></transform>
+  <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="32"/></film>
+</sensor>)";
+  Scene s;
+  loadScene(f.scene(ortho), {}, s);
+  EXPECT_TRUE(s.camera.orthographic);
+  EXPECT_FLOAT_EQ(s.camera.tanHalfX, 1.f);
+  EXPECT_FLOAT_EQ(s.camera.tanHalfY, 0.5f);
+  // Image left is world -x for this camera (+x of its frame), 4 units from the axis; the top
+  // is 2 units up; every ray runs along -z.
+  Ray left = s.camera.generateRay(0.f, 16.f), top = s.camera.generateRay(32.f, 0.f);
+  EXPECT_NEAR(left.o.x, -4.f, 1e-4f);
+  EXPECT_NEAR(top.o.y, 2.f, 1e-4f);
+  EXPECT_NEAR(left.o.z, 5.f - 0.01f, 1e-4f);
+  EXPECT_NEAR(left.d.z, -1.f, 1e-6f);
+  EXPECT_NEAR(top.d.z, -1.f, 1e-6f);
+  EXPECT_FALSE(s.camera.hasLens());
+  std::string lens = ortho;
+  lens.replace(lens.find("<float name=\"fov\""), 0, "<float name=\"aperture_radius\" value=\"0.1\"/>");
+  std::string e = loadError(f.scene(lens));
+  EXPECT_NE(e.find("sensor 'orthographic' has no property 'aperture_radius'"), std::string::npos) << e;
+  // The same scene with a perspective sensor is not orthographic.
+  Scene p;
+  loadScene(f.scene(kSensor), {}, p);
+  EXPECT_FALSE(p.camera.orthographic);
+}
+
 // Each of Mitsuba's rfilters with the parameters its plugin takes, Mitsuba's defaults where none
 // is given; a value out of range, or a parameter of another filter, is an error with the line.
 TEST(SceneLoader, EveryMitsubaFilterWithItsParameters) {

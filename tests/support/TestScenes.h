@@ -68,6 +68,21 @@ inline double renderedMean(Scene& s) {
   return sum / (double(img.width) * img.height);
 }
 
+// The same, rendered by `type` with spp samples a pixel (passes for sppm), with photon maps and
+// grids small enough for a unit test.
+inline double renderedMean(Scene& s, IntegratorType type, int spp) {
+  s.integrator.type = type;
+  s.sampler.sampleCount = spp;
+  s.sampler.type = SamplerType::Sobol;
+  s.integrator.photon.globalPhotons = s.integrator.photon.causticPhotons = 20000;
+  s.integrator.sppm.photonCount = 20000;
+  s.integrator.sppm.passes = spp;
+  s.integrator.grid.resolution = 8;
+  s.integrator.grid.gatherRays = 64;
+  s.integrator.grid.globalPhotons = s.integrator.grid.causticPhotons = 20000;
+  return renderedMean(s);
+}
+
 // Mean of the pixels whose whole footprint sees the sphere (the four corner rays hit it).
 inline double meanOverObject(const Scene& scene, const EmbreeAccel& accel, const Image& img, int* count) {
   const Camera& c = scene.view().camera;

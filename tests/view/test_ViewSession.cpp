@@ -6,6 +6,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <filesystem>
+#include <fstream>
 #include <mutex>
 #include <nlohmann/json.hpp>
 
@@ -314,4 +315,38 @@ TEST(ViewSession, APageConnectingAfterTheLastSampleGetsTheFrame) {
   json again = sink.waitFor(sent);
   ASSERT_FALSE(again.is_null());
   EXPECT_EQ(again["spp"], 4);
+}
+
+// An orthographic camera keeps the view's size that to_world's scale gave it when the page moves
+// it: a black ball of radius 1 in a 4 x 4 view (scale 2) under a sky of 1 hides pi / 16 of it,
+// before and after a move (the move's rigid frame alone would make the view 2 x 2, and the
+// ball would hide most of it).
+TEST(ViewSession, AnOrthographicCameraKeepsItsScaleWhenMoved) {
+  test::TempDir d;
+  std::string xml = d.path.string() + "/ortho.xml";
+  std::ofstream(xml) << R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+  <sensor type="orthographic">
+    <transform name="to_world"><scale x="2" y="2"/><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/><rfilter type="box"/></film>
+  </sensor>
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <shape type="sphere"><float name="radius" value="1"/><bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf></shape>
+</scene>)";
+  auto scene = std::make_unique<Scene>();
+  loadScene(xml, {}, *scene);
+  ViewOptions vo;
+  vo.threads = 1;
+  vo.maxSpp = 16;
+  Sink sink;
+  auto session = std::make_unique<ViewSession>(std::move(scene), xml, vo);
+  session->start([&sink](ViewFrame f) { sink(std::move(f)); });
+  const double hidden = 1.0 - kPi / 16.0;
+  auto meanOfSaved = [&] { return meanOfImage(loadImage(json::parse(session->handle(R"({"type":"save"})"))["path"])); };
+  frameWhere(*session, sink, [](const json& f) { return f["spp"].get<int>() >= 16; });
+  EXPECT_NEAR(meanOfSaved(), hidden, 0.03);
+  session->handle(R"({"type":"camera","origin":[4,0,0],"target":[0,0,0],"up":[0,1,0],"version":3})");
+  frameWhere(*session, sink, [](const json& f) { return f["cameraVersion"] == 3 && f["spp"].get<int>() >= 16; });
+  EXPECT_NEAR(meanOfSaved(), hidden, 0.03);
+  session->stop();
 }
