@@ -314,6 +314,12 @@ def main():
     # The orthographic view on a film of aspect 2, whose near plane is [-1, 1] x [-1/2, 1/2].
     variant('orthographic, film 2:1', 'orthographic',
             lambda t: t.replace('<integer name="height" value="$res"/>', f'<integer name="height" value="{args.res // 2}"/>'))
+    # Mitsuba's analytic cylinder against envgi's tessellated one: the same view zoomed onto the
+    # textured tube, its inside seen through the open top.
+    variant('orthographic, the cylinder close up', 'orthographic',
+            lambda t: t.replace('<scale x="2.6" y="2.6"/>', '<scale x="0.85" y="0.85"/>').replace(
+                '<lookat origin="6, 5.2, 6" target="0, 0.4, 0" up="0, 1, 0"/>',
+                '<lookat origin="7.3, 5.8, 4.4" target="1.3, 1.0, -1.6" up="0, 1, 0"/>'))
     # Depth of field: the textured scene through a thin lens focused on the globe.
     variant('textured thinlens', 'textured', lambda t: t.replace('<sensor type="perspective">', THINLENS))
     # The brushed sphere alone, the map behind it hidden (the open row placement shifts the

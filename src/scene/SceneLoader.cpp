@@ -1079,8 +1079,11 @@ class Loader {
           mesh = makeCube();
         } else if (type == "disk") {
           mesh = makeDisk();
+        } else if (type == "cylinder") {
+          mesh = makeCylinder(getPoint(f, p, "p0", Vec3f(0.f)), getPoint(f, p, "p1", Vec3f(0.f, 0.f, 1.f)),
+                              getFloat(f, p, "radius", 1.f));
         } else {
-          fail(f, n, fmt::format("unknown shape type '{}' (ply, obj, sphere, rectangle, cube, disk)", type));
+          fail(f, n, fmt::format("unknown shape type '{}' (ply, obj, sphere, rectangle, cube, disk, cylinder)", type));
         }
       } catch (const std::runtime_error& e) {
         rethrowAt(f, n, e);

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/Frame.h"
+
 namespace envgi {
 
 void TriangleMesh::transform(const Transform& t) {
@@ -117,6 +119,34 @@ TriangleMesh makeDisk(int segments) {
     m.indices.push_back(uint32_t(i + 1));
   }
   m.normals.assign(m.positions.size(), Vec3f(0, 0, 1));
+  return m;
+}
+
+TriangleMesh makeCylinder(Vec3f p0, Vec3f p1, float radius, int segments) {
+  Vec3f d = p1 - p0;
+  float len = length(d);
+  if (!(radius > 0.f && radius < 1e30f)) throw std::runtime_error("cylinder radius must be positive");
+  if (!(len > 0.f && len < 1e30f)) throw std::runtime_error("cylinder p0 and p1 must be two different points");
+  // Mitsuba's frame about the axis (the same construction as Frame::fromNormal), so that the
+  // azimuth, and with it u, starts where Mitsuba's does.
+  Frame axis = Frame::fromNormal(d / len);
+  TriangleMesh m;
+  m.name = "cylinder";
+  // A column of two vertices per azimuth, the last a copy of the first at u = 1 (watertight at
+  // the seam, as the disk's rim); normals radial, so shading is as smooth as the analytic shape.
+  for (int i = 0; i <= segments; ++i) {
+    float u = float(i) / float(segments), phi = 2.f * kPi * u;
+    Vec3f radial = i < segments ? axis.s * std::cos(phi) + axis.t * std::sin(phi) : m.normals[0];
+    for (float v : {0.f, 1.f}) {
+      m.positions.push_back(i < segments ? p0 + radial * radius + d * v : m.positions[size_t(v)]);
+      m.normals.push_back(radial);
+      m.uvs.push_back({u, v});
+    }
+  }
+  for (int i = 0; i < segments; ++i) {
+    uint32_t b0 = uint32_t(2 * i), t0 = b0 + 1, b1 = b0 + 2, t1 = b0 + 3;
+    for (uint32_t k : {b0, b1, t1, b0, t1, t0}) m.indices.push_back(k);  // counter-clockwise from outside
+  }
   return m;
 }
 

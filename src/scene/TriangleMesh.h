@@ -34,9 +34,12 @@ TriangleMesh loadPly(const std::string& path);
 TriangleMesh loadObj(const std::string& path);
 
 // Mitsuba's analytic shapes as meshes: rectangle [-1,1]^2 at z=0 facing +z, cube [-1,1]^3,
-// disk of radius 1 at z=0 facing +z (tessellated into `segments` triangles).
+// disk of radius 1 at z=0 facing +z (tessellated into `segments` triangles), and the open
+// cylinder about p0 -> p1 (no caps, normals outward; `segments` quads around), with Mitsuba's
+// (u, v) = (azimuth / 2 pi, distance along the axis / its length).
 TriangleMesh makeRectangle();
 TriangleMesh makeCube();
 TriangleMesh makeDisk(int segments = 128);
+TriangleMesh makeCylinder(Vec3f p0, Vec3f p1, float radius, int segments = 256);
 
 }  // namespace envgi

@@ -48,3 +48,15 @@ TEST(Orthographic, ASphereHidesItsDiskFromNearAndFar) {
   EXPECT_LT(nearMean, 0.6);  // 1 - 0.49: the disk fills half the view
   EXPECT_GT(farMean, 0.99);
 }
+
+// Mitsuba's cylinder seen from its side: a black tube of radius 0.5 and length 1 across the
+// view hides its 1 x 1 outline, a quarter of the 2 x 2 view, at any distance.
+TEST(Orthographic, ACylinderHidesItsOutline) {
+  for (float distance : {1.2f, 20.f}) {
+    Scene s = blackSphere(distance, true);
+    s.spheres.clear();
+    s.meshes.push_back(makeCylinder(Vec3f(0.f, -0.5f, 0.f), Vec3f(0.f, 0.5f, 0.f), 0.5f));
+    s.shapes = {{false, 0, 0, false, Color(0.f)}};
+    EXPECT_NEAR(test::renderedMean(s, IntegratorType::Path, 16), 0.75, 0.004) << "distance " << distance;
+  }
+}

@@ -1,10 +1,13 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 
 #include "cli/CliRunner.h"
+#include "core/Frame.h"
 #include "scene/TriangleMesh.h"
 
 using namespace envgi;
@@ -201,4 +204,53 @@ TEST(MeshIO, PrimitivesHaveMitsubasSurfaceCoordinates) {
       EXPECT_NEAR(uv.y, phi / (2.f * float(M_PI)), 1e-3f) << t;
     }
   }
+}
+
+// Mitsuba's cylinder as a mesh, along an oblique axis: its vertices lie on the surface of radius
+// r about p0 -> p1, between the two ends; its faces face outward along their vertices' normals;
+// its area is 2 pi r L less the tessellation's chords; (u, v) inside a triangle is Mitsuba's
+// (azimuth / 2 pi in the axis's frame, distance along the axis / L); the seam closes to the bit.
+TEST(MeshIO, CylinderIsMitsubasAboutItsAxis) {
+  const Vec3f p0(1.f, -0.5f, 2.f), p1(0.2f, 1.5f, 2.6f);
+  const float r = 0.4f, len = length(p1 - p0);
+  const Vec3f axis = (p1 - p0) / len;
+  TriangleMesh c = makeCylinder(p0, p1, r, 64);
+  ASSERT_EQ(c.triangleCount(), 128u);
+  ASSERT_EQ(c.uvs.size(), c.positions.size());
+  ASSERT_EQ(c.normals.size(), c.positions.size());
+  Frame f = Frame::fromNormal(axis);
+  double area = 0.0;
+  for (size_t t = 0; t < c.triangleCount(); ++t) {
+    uint32_t i0 = c.indices[3 * t], i1 = c.indices[3 * t + 1], i2 = c.indices[3 * t + 2];
+    Vec3f a = c.positions[i0], b = c.positions[i1], d = c.positions[i2];
+    Vec3f n = cross(b - a, d - a);
+    area += 0.5 * length(n);
+    EXPECT_GT(dot(n, c.normals[i0] + c.normals[i1] + c.normals[i2]), 0.f) << t;
+    for (Vec3f w : {Vec3f(0.2f, 0.4f, 0.4f), Vec3f(0.7f, 0.1f, 0.2f), Vec3f(0.05f, 0.9f, 0.05f)}) {
+      Vec3f p = a * w.x + b * w.y + d * w.z;
+      Vec2f uv = c.uvs[i0] * w.x + c.uvs[i1] * w.y + c.uvs[i2] * w.z;
+      Vec3f q = f.toLocal(p - p0);
+      float phi = std::atan2(q.y, q.x);
+      if (phi < 0.f) phi += 2.f * float(M_PI);
+      // Just after the seam atan2 gives 0 where the last quad's u is near 1.
+      float du = std::fabs(uv.x - phi / (2.f * float(M_PI)));
+      EXPECT_LT(std::min(du, 1.f - du), 2e-3f) << t;
+      EXPECT_NEAR(uv.y, q.z / len, 1e-5f) << t;
+    }
+  }
+  for (size_t i = 0; i < c.positions.size(); ++i) {
+    Vec3f q = f.toLocal(c.positions[i] - p0);
+    EXPECT_NEAR(std::hypot(q.x, q.y), r, 1e-5f);
+    EXPECT_TRUE(std::fabs(q.z) < 1e-5f || std::fabs(q.z - len) < 1e-5f);
+    EXPECT_NEAR(length(c.normals[i]), 1.f, 1e-5f);
+    EXPECT_NEAR(dot(c.normals[i], axis), 0.f, 1e-5f);
+  }
+  const double chord = 64.0 * std::sin(M_PI / 64.0) / M_PI;  // the polygon's perimeter over the circle's
+  EXPECT_NEAR(area, 2.0 * M_PI * r * len * chord, 1e-4);
+  const size_t last = c.positions.size() - 2;
+  EXPECT_EQ(c.positions[last].x, c.positions[0].x);
+  EXPECT_EQ(c.positions[last + 1].z, c.positions[1].z);
+  EXPECT_EQ(c.uvs[last].x, 1.f);
+  EXPECT_THROW(makeCylinder(p0, p0, r), std::runtime_error);
+  EXPECT_THROW(makeCylinder(p0, p1, 0.f), std::runtime_error);
 }

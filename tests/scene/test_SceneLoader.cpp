@@ -819,6 +819,35 @@ TEST(SceneLoader, BumpMap) {
   expectErrors(f, bad);
 }
 
+// Mitsuba's cylinder: p0 (the origin), p1 (+z) and radius (1) unless given, then to_world; an
+// open tube tessellated about its axis; a radius that is not positive, or p0 = p1, is an error
+// with the line, and a property of another shape is Mitsuba's error.
+TEST(SceneLoader, Cylinder) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <shape type="cylinder"><point name="p0" x="0" y="-1" z="0"/><point name="p1" x="0" y="2" z="0"/>
+      <float name="radius" value="0.5"/><transform name="to_world"><translate x="3"/></transform></shape>
+    <shape type="cylinder"/>)"),
+            {}, s);
+  ASSERT_EQ(s.meshes.size(), 2u);
+  for (const Vec3f& p : s.meshes[0].positions) {
+    EXPECT_NEAR(std::hypot(p.x - 3.f, p.z), 0.5f, 1e-5f);
+    EXPECT_TRUE(std::fabs(p.y + 1.f) < 1e-5f || std::fabs(p.y - 2.f) < 1e-5f);
+  }
+  for (const Vec3f& p : s.meshes[1].positions) {
+    EXPECT_NEAR(std::hypot(p.x, p.y), 1.f, 1e-5f);
+    EXPECT_TRUE(p.z == 0.f || std::fabs(p.z - 1.f) < 1e-6f);
+  }
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<shape type="cylinder"><float name="radius" value="0"/></shape>)", "cylinder radius must be positive"},
+      {R"(<shape type="cylinder"><point name="p1" x="0" y="0" z="0"/></shape>)", "p0 and p1 must be two different points"},
+      {R"(<shape type="cylinder"><point name="center" x="0" y="0" z="0"/></shape>)",
+       "shape 'cylinder' has no property 'center'"},
+  };
+  expectErrors(f, bad);
+}
+
 // Mitsuba's mask: opacity as a number (0.5 unless given) or a texture named opacity, around
 // any BSDF (twosided included, either way round); errors for a wrong name, a value out of
 // [0, 1], two opacities, a missing BSDF, a mask on an area light.
