@@ -77,6 +77,14 @@ struct Bsdf {
   // scatters at full strength.
   float opacity = 1.f;
   int opacityTexture = -1;
+  // Mitsuba's blendbsdf: an entry that is no material of its own but a choice between the
+  // entries blend0 and blend1, made afresh where each ray meets the surface
+  // (SceneView::interaction): blend1 with the chance of blendWeight (a number, or a texture's
+  // luminance, clamped to [0, 1] as Mitsuba does), as pbrt-v4's MixMaterial. On average that
+  // is Mitsuba's (1 - w) f0 + w f1, and every integrator sees a plain BSDF. -1: no blend.
+  int blend0 = -1, blend1 = -1;
+  float blendWeight = 0.5f;
+  int blendWeightTexture = -1;
 };
 
 ENVGI_INLINE const float* bsdfCoatTable(const Bsdf& b) {
@@ -122,6 +130,9 @@ ENVGI_INLINE bool bsdfNeedsTangentFrame(const Bsdf& b) {
 }
 
 ENVGI_INLINE bool bsdfIsMasked(const Bsdf& b) { return b.opacityTexture >= 0 || b.opacity < 1.f; }
+ENVGI_INLINE bool bsdfIsBlend(const Bsdf& b) { return b.blend0 >= 0; }
+// How deep blends may nest (the loader's limit, which bounds the choice's loop on the device).
+constexpr int kMaxBlendDepth = 8;
 
 ENVGI_INLINE bool bsdfHasTexture(const Bsdf& b) {
   return b.reflectanceTexture >= 0 || b.specularReflectanceTexture >= 0 || b.specularTransmittanceTexture >= 0 ||

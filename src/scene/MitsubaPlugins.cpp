@@ -73,6 +73,7 @@ const PluginProperties kMitsuba[] = {
       "sheen_tint", "flatness", "clearcoat", "clearcoat_gloss", "main_specular_sampling_rate", "clearcoat_sampling_rate",
       "diffuse_reflectance_sampling_rate"}},
     {"bsdf", {"mask"}, {"opacity"}},
+    {"bsdf", {"blendbsdf"}, {"weight"}},
     {"bsdf", {"normalmap", "bumpmap"}, {"flip_invalid_normals", "use_shadowing_function"}},
     {"bsdf", {"bumpmap"}, {"scale"}},
     // Textures

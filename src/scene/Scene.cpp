@@ -7,6 +7,15 @@
 
 namespace envgi {
 
+namespace {
+// Whether material `index`, or any a blend of it may choose, needs the frame along dp/du.
+bool needsTangentFrame(const std::vector<Bsdf>& bsdfs, int index, int depth = 0) {
+  const Bsdf& b = bsdfs[size_t(index)];
+  if (!bsdfIsBlend(b) || depth > kMaxBlendDepth) return bsdfNeedsTangentFrame(b);
+  return needsTangentFrame(bsdfs, b.blend0, depth + 1) || needsTangentFrame(bsdfs, b.blend1, depth + 1);
+}
+}  // namespace
+
 void Scene::finalize() {
   if (bsdfs.empty()) bsdfs.push_back(Bsdf{});
   // A rough plastic whose alpha or ior changed since loading reads the tables of its new ones.
@@ -48,7 +57,7 @@ void Scene::finalize() {
       v.indices = m.indices.data();
       v.triangleCount = int(m.triangleCount());
       v.bsdf = s.bsdf;
-      v.anisotropic = s.bsdf >= 0 && size_t(s.bsdf) < bsdfs.size() && bsdfNeedsTangentFrame(bsdfs[size_t(s.bsdf)]);
+      v.anisotropic = s.bsdf >= 0 && size_t(s.bsdf) < bsdfs.size() && needsTangentFrame(bsdfs, s.bsdf);
       for (const Vec3f& p : m.positions) {
         lo = vmin(lo, p);
         hi = vmax(hi, p);

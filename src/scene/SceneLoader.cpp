@@ -686,18 +686,18 @@ class Loader {
           checkAttrs(f, c, {"id", "name"});
           auto it = bsdfIds_.find(attr(f, c, "id"));
           if (it == bsdfIds_.end()) fail(f, c, fmt::format("unknown BSDF id '{}'", attr(f, c, "id")));
-          Bsdf copy = scene_.bsdfs[size_t(it->second.index)];
-          copy.twoSided = true;
-          scene_.bsdfs.push_back(copy);
-          return int(scene_.bsdfs.size() - 1);
+          int copy = copyBsdf(it->second.index);
+          forEachChoice(copy, [](Bsdf& b) { b.twoSided = true; });
+          return copy;
         }
       if (!inner) fail(f, n, "twosided needs a nested <bsdf>");
       int id = bsdf(f, inner);
-      scene_.bsdfs[size_t(id)].twoSided = true;
+      forEachChoice(id, [](Bsdf& b) { b.twoSided = true; });
       return id;
     }
     if (type == "normalmap" || type == "bumpmap") return normalMap(f, n, p, type == "bumpmap");
     if (type == "mask") return mask(f, n, p);
+    if (type == "blendbsdf") return blend(f, n, p);
     // Textured properties, by name: nested <texture name=...> or <ref id=... name=...>.
     std::map<std::string, std::pair<int, pugi::xml_node>> textures;
     for (pugi::xml_node c : n.children()) {
@@ -755,7 +755,7 @@ class Loader {
       principled(f, n, p, b);
     } else {
       fail(f, n, fmt::format("unknown BSDF type '{}' (diffuse, conductor, roughconductor, dielectric, thindielectric, "
-                             "roughdielectric, plastic, roughplastic, principled, twosided, normalmap, bumpmap, mask)",
+                             "roughdielectric, plastic, roughplastic, principled, twosided, normalmap, bumpmap, mask, blendbsdf)",
                              type));
     }
     for (const auto& [name, tex] : textures) {
@@ -831,15 +831,44 @@ class Loader {
     }
   }
 
-  // An adapter's children (normalmap, bumpmap, mask): one nested BSDF (<bsdf> or a <ref> to one,
-  // copied) and textures (nested, or a <ref> named as one or to an id only a texture has), each
-  // handed to onTexture(node, index). Returns the nested BSDF's index.
+  // A copy of material `index` as a new entry, a blend's choices copied too (so that an adapter
+  // may change the copy's materials without changing the original's).
+  int copyBsdf(int index) {
+    Bsdf b = scene_.bsdfs[size_t(index)];
+    if (bsdfIsBlend(b)) {
+      b.blend0 = copyBsdf(b.blend0);
+      b.blend1 = copyBsdf(b.blend1);
+    }
+    scene_.bsdfs.push_back(b);
+    return int(scene_.bsdfs.size() - 1);
+  }
+  // Calls fn on each material that material `index` may turn out to be at a hit: itself, or for a
+  // blend the materials its choices may be (what twosided and the normal maps change).
+  template <class Fn>
+  void forEachChoice(int index, Fn&& fn) {
+    Bsdf& b = scene_.bsdfs[size_t(index)];
+    if (!bsdfIsBlend(b)) return fn(b);
+    int b0 = b.blend0, b1 = b.blend1;  // fn may grow the vector
+    forEachChoice(b0, fn);
+    forEachChoice(b1, fn);
+  }
+  int blendDepth(int index) const {
+    const Bsdf& b = scene_.bsdfs[size_t(index)];
+    return bsdfIsBlend(b) ? 1 + std::max(blendDepth(b.blend0), blendDepth(b.blend1)) : 0;
+  }
+
+  // An adapter's children (normalmap, bumpmap, mask; blendbsdf takes two): `count` nested BSDFs
+  // (<bsdf> or a <ref> to one, copied) and textures (nested, or a <ref> named as one or to an id
+  // only a texture has), each handed to onTexture(node, index). Returns the nested BSDFs' indices.
   template <class OnTexture>
-  int adapterChildren(const SourceFile* f, pugi::xml_node n, const char* adapter, OnTexture&& onTexture) {
-    int inner = -1;
+  std::vector<int> adapterChildren(const SourceFile* f, pugi::xml_node n, const char* adapter, size_t count,
+                                   OnTexture&& onTexture) {
+    std::vector<int> inner;
     auto setInner = [&](pugi::xml_node c, int id) {
-      if (inner >= 0) fail(f, c, fmt::format("{} takes one nested BSDF", adapter));
-      inner = id;
+      if (inner.size() == count)
+        fail(f, c, count == 1 ? fmt::format("{} takes one nested BSDF", adapter)
+                              : fmt::format("{} takes {} nested BSDFs", adapter, count));
+      inner.push_back(id);
     };
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element) continue;
@@ -856,8 +885,7 @@ class Loader {
         if (t != textureIds_.end() && (b == bsdfIds_.end() || c.attribute("name"))) {
           onTexture(c, t->second.index);
         } else if (b != bsdfIds_.end()) {
-          scene_.bsdfs.push_back(scene_.bsdfs[size_t(b->second.index)]);
-          setInner(c, int(scene_.bsdfs.size() - 1));
+          setInner(c, copyBsdf(b->second.index));
         } else {
           fail(f, c, fmt::format("unknown BSDF or texture id '{}'", id));
         }
@@ -865,20 +893,55 @@ class Loader {
         fail(f, c, fmt::format("unexpected <{}> in <bsdf>", tag));
       }
     }
-    if (inner < 0) fail(f, n, fmt::format("{} needs a nested <bsdf>", adapter));
+    if (inner.size() < count)
+      fail(f, n, count == 1 ? fmt::format("{} needs a nested <bsdf>", adapter)
+                            : fmt::format("{} needs {} nested BSDFs", adapter, count));
     return inner;
+  }
+
+  // Mitsuba's blendbsdf: two nested BSDFs, in the order given, and `weight` (0.5 unless given),
+  // a number in [0, 1] or a texture read as its luminance: the second BSDF's share.
+  int blend(const SourceFile* f, pugi::xml_node n, Props& p) {
+    int map = -1;
+    std::vector<int> inner = adapterChildren(f, n, "blendbsdf", 2, [&](pugi::xml_node c, int id) {
+      std::string name = c.attribute("name").as_string();
+      if (name != "weight") fail(f, c, fmt::format("blendbsdf has no texture property '{}' (its texture is named 'weight')", name));
+      if (map >= 0 || p.count("weight")) fail(f, c, "property 'weight' given twice");
+      map = id;
+    });
+    Bsdf b;
+    b.blend0 = inner[0];
+    b.blend1 = inner[1];
+    if (map >= 0) {
+      b.blendWeightTexture = map;
+    } else {
+      b.blendWeight = getFloat(f, p, "weight", 0.5f);
+      if (!(b.blendWeight >= 0.f && b.blendWeight <= 1.f))
+        fail(f, n, fmt::format("blendbsdf's weight must be within [0, 1], not {}", b.blendWeight));
+    }
+    // The tracers ask the material a ray hits, before any choice, whether the ray stops there.
+    for (int i : inner) {
+      bool masked = bsdfIsMasked(scene_.bsdfs[size_t(i)]);
+      forEachChoice(i, [&](Bsdf& c) { masked = masked || bsdfIsMasked(c); });
+      if (masked) fail(f, n, "a mask inside a blendbsdf is not supported (put the mask around the blendbsdf)");
+    }
+    reportUnused(f, p, "bsdf", "blendbsdf");
+    scene_.bsdfs.push_back(b);
+    int id = int(scene_.bsdfs.size() - 1);
+    if (blendDepth(id) > kMaxBlendDepth) fail(f, n, fmt::format("blendbsdfs nest at most {} deep", kMaxBlendDepth));
+    return id;
   }
 
   // Mitsuba's mask: a nested BSDF and its `opacity` (0.5 unless given), a number or a texture
   // read as its luminance, clamped to [0, 1].
   int mask(const SourceFile* f, pugi::xml_node n, Props& p) {
     int map = -1;
-    int inner = adapterChildren(f, n, "mask", [&](pugi::xml_node c, int id) {
+    int inner = adapterChildren(f, n, "mask", 1, [&](pugi::xml_node c, int id) {
       std::string name = c.attribute("name").as_string();
       if (name != "opacity") fail(f, c, fmt::format("mask has no texture property '{}' (its texture is named 'opacity')", name));
       if (map >= 0 || p.count("opacity")) fail(f, c, "property 'opacity' given twice");
       map = id;
-    });
+    })[0];
     Bsdf& b = scene_.bsdfs[size_t(inner)];
     if (bsdfIsMasked(b)) fail(f, n, "a mask around a mask is not supported");
     if (map >= 0) {
@@ -899,7 +962,7 @@ class Loader {
   int normalMap(const SourceFile* f, pugi::xml_node n, Props& p, bool bump) {
     const char* adapter = bump ? "bumpmap" : "normalmap";
     int map = -1;
-    int inner = adapterChildren(f, n, adapter, [&](pugi::xml_node c, int id) {
+    int inner = adapterChildren(f, n, adapter, 1, [&](pugi::xml_node c, int id) {
       std::string name = c.attribute("name").as_string();
       if (bump) {
         if (map >= 0) fail(f, c, "bumpmap takes one texture");
@@ -909,20 +972,24 @@ class Loader {
         if (map >= 0) fail(f, c, "property 'normalmap' given twice");
       }
       map = id;
-    });
+    })[0];
     if (map < 0) fail(f, n, bump ? "bumpmap needs a nested texture (its height)" : "normalmap needs a texture named 'normalmap'");
-    Bsdf& b = scene_.bsdfs[size_t(inner)];
-    if (bsdfIsNormalMapped(b)) fail(f, n, fmt::format("a {} around a normalmap or bumpmap is not supported", adapter));
-    if (bump) {
-      b.bumpTexture = map;
-      b.bumpScale = getFloat(f, p, "scale", 1.f);
-      if (!std::isfinite(b.bumpScale)) fail(f, n, "bumpmap's scale must be finite");
-    } else {
-      b.normalMapTexture = map;
-    }
+    const float bumpScale = bump ? getFloat(f, p, "scale", 1.f) : 1.f;
+    if (!std::isfinite(bumpScale)) fail(f, n, "bumpmap's scale must be finite");
     // Mitsuba 3.9 gives both adapters the same two flags (its perturbed_bsdf).
-    b.flipInvalidNormals = getBool(f, p, "flip_invalid_normals", true);
-    b.bumpShadowing = getBool(f, p, "use_shadowing_function", true);
+    const bool flip = getBool(f, p, "flip_invalid_normals", true), shadowing = getBool(f, p, "use_shadowing_function", true);
+    // Around a blend, each material it may choose is evaluated in the same tilted frame.
+    forEachChoice(inner, [&](Bsdf& b) {
+      if (bsdfIsNormalMapped(b)) fail(f, n, fmt::format("a {} around a normalmap or bumpmap is not supported", adapter));
+      if (bump) {
+        b.bumpTexture = map;
+        b.bumpScale = bumpScale;
+      } else {
+        b.normalMapTexture = map;
+      }
+      b.flipInvalidNormals = flip;
+      b.bumpShadowing = shadowing;
+    });
     reportUnused(f, p, "bsdf", adapter);
     return inner;
   }

@@ -149,6 +149,7 @@ struct SceneView {
       }
       si.ng = ng;
       si.uv = meshUv(m, i0, i1, i2, b1, b2);
+      const int bsdf = blendChoice(m.bsdf, si.uv, ray, h.geomId, uint32_t(h.primId));
       si.shading = Frame::fromNormal(ns);
       if (m.anisotropic) {
         // dp/du from the triangle's (u, v), the barycentric ones where the mesh has none.
@@ -159,31 +160,34 @@ struct SceneView {
         if (det != 0.f) {
           Vec3f dpdu = ((p1 - p0) * d2.y - (p2 - p0) * d1.y) / det;
           si.shading = Frame::fromNormalAndTangent(ns, dpdu);
-          if (bsdfs[m.bsdf].bumpTexture >= 0) {
+          if (bsdfs[bsdf].bumpTexture >= 0) {
             Vec3f dpdv = ((p2 - p0) * d1.x - (p1 - p0) * d2.x) / det;
             si.dpdu = tangentPart(si.shading, dpdu);
             si.dpdv = tangentPart(si.shading, dpdv);
           }
         }
       }
-      si.bsdf = m.bsdf;
+      si.bsdf = bsdf;
       si.light = m.lightOffset >= 0 ? m.lightOffset + h.primId : -1;
     } else {
       const SphereView& s = spheres[h.geomId - meshCount];
       Vec3f p = ray.o + ray.d * h.t;
       Vec3f n = normalize(p - s.center);
       si.p = s.center + n * s.radius;  // re-projected: removes the hit point's float error
-      si.uv = bsdfHasTexture(bsdfs[s.bsdf]) ? sphereUv(s, n) : Vec2f(0.f, 0.f);
+      int bsdf = s.bsdf;
+      if (bsdfIsBlend(bsdfs[bsdf]))
+        bsdf = blendChoice(bsdf, sphereUv(s, n), ray, h.geomId, dot(n, ray.d) > 0.f ? 1u : 0u);
+      si.uv = bsdfHasTexture(bsdfs[bsdf]) ? sphereUv(s, n) : Vec2f(0.f, 0.f);
       Vec3f radial = n;
       if (s.flipNormals) n = -n;
       si.ng = n;
       si.shading = Frame::fromNormal(n);
-      if (bsdfNeedsTangentFrame(bsdfs[s.bsdf])) {
+      if (bsdfNeedsTangentFrame(bsdfs[bsdf])) {
         // dp/du runs along the azimuth about the sphere's own z, as Mitsuba's.
         Vec3f l = s.axes.toLocal(radial);
         Vec3f dpdu = s.axes.toWorld(Vec3f(-l.y, l.x, 0.f)) * (2.f * kPi * s.radius);
         si.shading = Frame::fromNormalAndTangent(n, dpdu);
-        if (bsdfs[s.bsdf].bumpTexture >= 0) {
+        if (bsdfs[bsdf].bumpTexture >= 0) {
           // Mitsuba's sphere: v = theta / pi, so dp/dv = pi r (cos phi cos theta, sin phi cos theta, -sin theta).
           float sinTheta = std::sqrt(fmaxf(0.f, l.x * l.x + l.y * l.y));
           Vec3f dpdv = sinTheta > 0.f ? s.axes.toWorld(Vec3f(l.x * l.z / sinTheta, l.y * l.z / sinTheta, -sinTheta)) * (kPi * s.radius)
@@ -192,13 +196,27 @@ struct SceneView {
           si.dpdv = tangentPart(si.shading, dpdv);
         }
       }
-      si.bsdf = s.bsdf;
+      si.bsdf = bsdf;
       si.light = s.light;
     }
     return si;
   }
 
-  // The material at a hit, without the rest of interaction().
+  // The material a ray finds where it crosses a surface of material `index` (a crossing as
+  // rayCrossingHash's): `index` itself, or for a blend one of its two, chosen with the chance of
+  // its weight at uv by a hash of the crossing (apart from the mask's, which decides whether the
+  // ray stopped there, and apart for each level of blends nested in blends).
+  ENVGI_HD int blendChoice(int index, Vec2f uv, const Ray& ray, int geomId, uint32_t crossing) const {
+    for (int level = 0; level < kMaxBlendDepth && bsdfIsBlend(bsdfs[index]); ++level) {
+      const Bsdf& b = bsdfs[index];
+      float w = b.blendWeightTexture >= 0 ? luminance(textureEval(textures[b.blendWeightTexture], uv)) : b.blendWeight;
+      // A weight of 1 or more always picks blend1, of 0 or less (or NaN) blend0, as Mitsuba clamps it.
+      index = rayCrossingHash(ray, geomId ^ ((level + 1) << 24), crossing) < w ? b.blend1 : b.blend0;
+    }
+    return index;
+  }
+
+  // The material at a hit, without the rest of interaction() (a blend's own entry).
   ENVGI_HD int bsdfIndexAt(const Hit& h) const {
     return h.geomId < meshCount ? meshes[h.geomId].bsdf : spheres[h.geomId - meshCount].bsdf;
   }

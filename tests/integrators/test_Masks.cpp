@@ -13,6 +13,7 @@
 #include "support/TestScenes.h"
 
 using namespace envgi;
+using test::expectShare;
 
 namespace {
 
@@ -71,9 +72,6 @@ Counts shoot(const Scene& s, Vec2f offset, float split, int n = 20000, float fro
 }
 
 // A binomial share within 4.5 standard deviations.
-void expectShare(int k, int n, double p, const char* what) {
-  EXPECT_NEAR(double(k) / n, p, 4.5 * std::sqrt(p * (1.0 - p) / n) + 1e-9) << what;
-}
 
 }  // namespace
 
@@ -129,11 +127,7 @@ TEST(Mask, ASphereIsCrossedTwice) {
 // is opaque where u and v are in the same half, and lets every ray through elsewhere.
 TEST(Mask, OpacityTextureIsReadAtTheHit) {
   Scene s;
-  Texture t;
-  t.params.type = TextureType::Checkerboard;
-  t.params.color0 = Color(1.f);
-  t.params.color1 = Color(0.f);
-  s.textures.push_back(t);
+  s.textures.push_back(test::checkerboard(1.f, 0.f));
   Bsdf b = masked(0.5f, 0.f);
   b.opacityTexture = 0;
   s.bsdfs = {b};

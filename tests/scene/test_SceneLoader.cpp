@@ -848,6 +848,76 @@ TEST(SceneLoader, Cylinder) {
   expectErrors(f, bad);
 }
 
+// Mitsuba's blendbsdf: two nested BSDFs in the order given (a <ref> copied), `weight` (0.5
+// unless given) a number or a texture named weight; twosided and a normal map around a blend
+// reach every material it may choose, a ref'd blend's copy leaving the original as it was; a
+// mask goes around it. Errors: one BSDF or three, a weight out of [0, 1] or given twice, a
+// texture of another name, a mask inside.
+TEST(SceneLoader, BlendBsdf) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <bsdf type="blendbsdf" id="mix"><float name="weight" value="0.25"/>
+      <bsdf type="diffuse"><rgb name="reflectance" value="0.2"/></bsdf>
+      <bsdf type="roughconductor"/></bsdf>
+    <shape type="sphere"><ref id="mix"/></shape>
+    <shape type="sphere"><bsdf type="twosided"><ref id="mix"/></bsdf></shape>
+    <shape type="sphere"><bsdf type="blendbsdf"><texture type="checkerboard" name="weight"/>
+      <ref id="mix"/><bsdf type="twosided"><bsdf type="plastic"/></bsdf></bsdf></shape>
+    <shape type="sphere"><bsdf type="mask"><float name="opacity" value="0.4"/><bsdf type="blendbsdf">
+      <bsdf type="diffuse"/><bsdf type="conductor"/></bsdf></bsdf></shape>)"),
+            {}, s);
+  auto at = [&](size_t shape) -> const Bsdf& { return s.bsdfs[size_t(s.shapes[shape].bsdf)]; };
+  const Bsdf& mix = at(0);
+  ASSERT_TRUE(bsdfIsBlend(mix));
+  EXPECT_FLOAT_EQ(mix.blendWeight, 0.25f);
+  EXPECT_EQ(s.bsdfs[size_t(mix.blend0)].type, BsdfType::Diffuse);
+  EXPECT_FLOAT_EQ(s.bsdfs[size_t(mix.blend0)].reflectance.x, 0.2f);
+  EXPECT_EQ(s.bsdfs[size_t(mix.blend1)].type, BsdfType::RoughConductor);
+  EXPECT_FALSE(s.bsdfs[size_t(mix.blend0)].twoSided) << "the twosided copy left the original one-sided";
+  const Bsdf& two = at(1);
+  ASSERT_TRUE(bsdfIsBlend(two));
+  EXPECT_NE(two.blend0, mix.blend0);
+  EXPECT_TRUE(s.bsdfs[size_t(two.blend0)].twoSided);
+  EXPECT_TRUE(s.bsdfs[size_t(two.blend1)].twoSided);
+  const Bsdf& textured = at(2);
+  EXPECT_GE(textured.blendWeightTexture, 0);
+  EXPECT_TRUE(bsdfIsBlend(s.bsdfs[size_t(textured.blend0)])) << "a blend in a blend";
+  EXPECT_EQ(s.bsdfs[size_t(textured.blend1)].type, BsdfType::Plastic);
+  const Bsdf& masked = at(3);
+  EXPECT_TRUE(bsdfIsBlend(masked));
+  EXPECT_FLOAT_EQ(masked.opacity, 0.4f);
+  // A normal map around a blend maps both of its materials.
+  Scene n;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <texture type="bitmap" id="normals"><string name="filename" value="sky.exr"/><boolean name="raw" value="true"/></texture>
+    <shape type="sphere"><bsdf type="normalmap"><ref id="normals" name="normalmap"/>
+      <bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="roughplastic"/></bsdf></bsdf></shape>)"),
+            {}, n);
+  const Bsdf& nb = n.bsdfs[size_t(n.shapes[0].bsdf)];
+  ASSERT_TRUE(bsdfIsBlend(nb));
+  EXPECT_GE(n.bsdfs[size_t(nb.blend0)].normalMapTexture, 0);
+  EXPECT_GE(n.bsdfs[size_t(nb.blend1)].normalMapTexture, 0);
+
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<shape type="sphere"><bsdf type="blendbsdf"><bsdf type="diffuse"/></bsdf></shape>)",
+       "blendbsdf needs 2 nested BSDFs"},
+      {R"(<shape type="sphere"><bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "blendbsdf takes 2 nested BSDFs"},
+      {R"(<shape type="sphere"><bsdf type="blendbsdf"><float name="weight" value="1.5"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "blendbsdf's weight must be within [0, 1]"},
+      {R"(<shape type="sphere"><bsdf type="blendbsdf"><texture type="checkerboard" name="opacity"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "blendbsdf has no texture property 'opacity'"},
+      {R"(<shape type="sphere"><bsdf type="blendbsdf"><float name="weight" value="0.5"/><texture type="checkerboard" name="weight"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "property 'weight' given twice"},
+      {R"(<shape type="sphere"><bsdf type="blendbsdf"><bsdf type="mask"><bsdf type="diffuse"/></bsdf><bsdf type="diffuse"/></bsdf></shape>)",
+       "a mask inside a blendbsdf is not supported"},
+      {R"(<shape type="sphere"><bsdf type="blendbsdf"><float name="wieght" value="0.5"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></shape>)",
+       "bsdf 'blendbsdf' has no property 'wieght' (did you mean 'weight'?)"},
+  };
+  expectErrors(f, bad);
+}
+
 // Mitsuba's mask: opacity as a number (0.5 unless given) or a texture named opacity, around
 // any BSDF (twosided included, either way round); errors for a wrong name, a value out of
 // [0, 1], two opacities, a missing BSDF, a mask on an area light.

@@ -3,11 +3,27 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "accel/EmbreeAccel.h"
 #include "render/Renderer.h"
 #include "scene/Scene.h"
 
 namespace envgi::test {
+
+// Mitsuba's checkerboard texture of two grey levels: color0 where u and v are in the same half.
+inline Texture checkerboard(float color0, float color1) {
+  Texture t;
+  t.params.type = TextureType::Checkerboard;
+  t.params.color0 = Color(color0);
+  t.params.color1 = Color(color1);
+  return t;
+}
+
+// A binomial share k / n within 4.5 standard deviations of p.
+inline void expectShare(int k, int n, double p, const char* what) {
+  EXPECT_NEAR(double(k) / n, p, 4.5 * std::sqrt(p * (1.0 - p) / n) + 1e-9) << what;
+}
 
 // A sphere of radius 1 at the origin seen by a camera on +z, under a constant environment;
 // `texture`, where given, is the scene's texture 0 (for b's texture indices).
