@@ -342,6 +342,13 @@ def main():
             lambda t: t.replace('<scale x="2.6" y="2.6"/>', '<scale x="0.85" y="0.85"/>').replace(
                 '<lookat origin="6, 5.2, 6" target="0, 0.4, 0" up="0, 1, 0"/>',
                 '<lookat origin="7.3, 5.8, 4.4" target="1.3, 1.0, -1.6" up="0, 1, 0"/>'))
+    # A crop window (Mitsuba's crop_offset and crop size): the middle of the textured scene's film.
+    r = args.res
+    variant('textured, crop window', 'textured',
+            lambda t: t.replace('<integer name="width" value="$res"/>',
+                                f'<integer name="width" value="$res"/><integer name="crop_offset_x" value="{r // 4}"/>'
+                                f'<integer name="crop_offset_y" value="{r // 6}"/><integer name="crop_width" value="{r // 2}"/>'
+                                f'<integer name="crop_height" value="{r // 2}"/>'))
     # Depth of field: the textured scene through a thin lens focused on the globe.
     variant('textured thinlens', 'textured', lambda t: t.replace('<sensor type="perspective">', THINLENS))
     # The brushed sphere alone, the map behind it hidden (the open row placement shifts the

@@ -21,14 +21,21 @@ struct Camera {
   float apertureRadius = 0.f, focusDistance = 1e4f;
   // Mitsuba's `orthographic`: parallel rays along the frame's +z from points of the near plane.
   bool orthographic = false;
+  // Mitsuba's crop window: the image is width x height pixels of a film of filmWidth x
+  // filmHeight, from its pixel (cropX, cropY); a film of 0 x 0 is the image itself.
+  int filmWidth = 0, filmHeight = 0, cropX = 0, cropY = 0;
+
+  ENVGI_HD float fullWidth() const { return float(filmWidth > 0 ? filmWidth : width); }
+  ENVGI_HD float fullHeight() const { return float(filmHeight > 0 ? filmHeight : height); }
 
   // Whether a camera sample needs a point on the lens (a 2D draw after the filter's).
   ENVGI_HD bool hasLens() const { return apertureRadius > 0.f; }
 
-  // A ray through film position (x, y) in pixels, (0,0) the top-left corner of the image;
+  // A ray through image position (x, y) in pixels, (0,0) the top-left corner of the image (of
+  // the crop window, where there is one);
   // `lens` picks the point on the aperture (unused for a pinhole).
   ENVGI_HD Ray generateRay(float x, float y, Vec2f lens = Vec2f(0.5f, 0.5f)) const {
-    float sx = 2.f * x / float(width) - 1.f, sy = 1.f - 2.f * y / float(height);
+    float sx = 2.f * (x + float(cropX)) / fullWidth() - 1.f, sy = 1.f - 2.f * (y + float(cropY)) / fullHeight();
     // Camera-space +x is the image's left (lookat builds x = up x dir), so image right is -x.
     // On the plane z = 1: its length is 1 / cos of the angle to the axis, which turns the
     // near and far planes into distances along the ray without normalising twice.
@@ -65,8 +72,8 @@ ENVGI_INLINE bool projectToFilm(const Camera& c, Vec3f p, float* x, float* y) {
   if (c.orthographic ? !(q.z >= c.nearClip) : q.z <= 0.f) return false;
   float w = c.orthographic ? 1.f : q.z;
   float sx = -(q.x / w) / c.tanHalfX, sy = (q.y / w) / c.tanHalfY;
-  *x = 0.5f * (sx + 1.f) * float(c.width);
-  *y = 0.5f * (1.f - sy) * float(c.height);
+  *x = 0.5f * (sx + 1.f) * c.fullWidth() - float(c.cropX);
+  *y = 0.5f * (1.f - sy) * c.fullHeight() - float(c.cropY);
   return *x >= 0.f && *y >= 0.f && *x < float(c.width) && *y < float(c.height);
 }
 

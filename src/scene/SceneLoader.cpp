@@ -4,6 +4,7 @@
 #include <pugixml.hpp>
 #include <spdlog/spdlog.h>
 
+#include <array>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -442,6 +443,8 @@ class Loader {
            t == "point" || t == "vector" || t == "transform";
   }
 
+  std::array<int, 4> crop_{};  // the film's crop window: x, y, width, height (film() reads it)
+
   void sensor(const SourceFile* f, pugi::xml_node n) {
     checkAttrs(f, n, {"type", "id", "name"});
     std::string type = attr(f, n, "type");
@@ -473,6 +476,8 @@ class Loader {
     reportUnused(f, p, "sensor", type);
     cam.width = 768;
     cam.height = 576;
+    crop_ = {0, 0, cam.width, cam.height};
+    cam.filmWidth = cam.filmHeight = cam.cropX = cam.cropY = 0;
     cam.filter = makeFilter(FilterType::Gaussian);
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element) continue;
@@ -500,6 +505,14 @@ class Loader {
     } else {
       fail(f, n, fmt::format("unknown fov_axis '{}' (x, y, diagonal, smaller, larger)", axis));
     }
+    if (crop_[0] != 0 || crop_[1] != 0 || crop_[2] != cam.width || crop_[3] != cam.height) {
+      cam.filmWidth = cam.width;
+      cam.filmHeight = cam.height;
+      cam.cropX = crop_[0];
+      cam.cropY = crop_[1];
+      cam.width = crop_[2];
+      cam.height = crop_[3];
+    }
   }
 
   void film(const SourceFile* f, pugi::xml_node n) {
@@ -512,6 +525,13 @@ class Loader {
     cam.height = getInt(f, p, "height", 576);
     if (cam.width <= 0 || cam.height <= 0 || cam.width > 32768 || cam.height > 32768)
       fail(f, n, "film width and height must be between 1 and 32768");
+    // Mitsuba's crop window, applied once the sensor has its aspect from the whole film.
+    crop_ = {getInt(f, p, "crop_offset_x", 0), getInt(f, p, "crop_offset_y", 0), getInt(f, p, "crop_width", cam.width),
+             getInt(f, p, "crop_height", cam.height)};
+    if (!(crop_[0] >= 0 && crop_[1] >= 0 && crop_[2] >= 1 && crop_[3] >= 1 && crop_[2] <= cam.width - crop_[0] &&
+          crop_[3] <= cam.height - crop_[1]))
+      fail(f, n, fmt::format("the crop window ({}, {}) + {} x {} does not lie within the {} x {} film", crop_[0], crop_[1],
+                             crop_[2], crop_[3], cam.width, cam.height));
     // envgi draws each pixel's samples from its filter, so border pixels always see the whole
     // filter: what sample_border (high_quality_edges in Mitsuba 0.6) turns on in Mitsuba.
     // The others change only how Mitsuba writes its file; each is still read with its type, so

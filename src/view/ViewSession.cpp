@@ -247,6 +247,7 @@ void ViewSession::run() {
   int parkedVersion = 0;
   int spp = 0, sentSpp = -1, frame = 0;
   const int baseW = scene_->camera.width, baseH = scene_->camera.height;
+  const Camera baseFilm = scene_->camera;  // its crop window, if any
   const Transform envBase = scene_->env ? scene_->env->options().toWorld : Transform{};
   const float envBaseScale = scene_->env ? scene_->env->options().scale : 1.f;
   auto t0 = Clock::now(), lastFrame = Clock::now();
@@ -279,6 +280,14 @@ void ViewSession::run() {
       cam.toWorld = lookAt(s.origin, s.target, s.up) * cameraShape_;
       cam.width = std::max(8, int(std::lround(baseW * s.resolutionScale)));
       cam.height = std::max(8, int(std::lround(baseH * s.resolutionScale)));
+      if (baseFilm.filmWidth > 0) {
+        // A crop window scales with the image: the film and the window's corner by as much.
+        auto scaled = [](int base, int now, int was, int size) { return std::max(size, int(std::lround(double(base) * now / was))); };
+        cam.filmWidth = scaled(baseFilm.filmWidth, cam.width, baseW, cam.width);
+        cam.filmHeight = scaled(baseFilm.filmHeight, cam.height, baseH, cam.height);
+        cam.cropX = std::min(int(std::lround(double(baseFilm.cropX) * cam.width / baseW)), cam.filmWidth - cam.width);
+        cam.cropY = std::min(int(std::lround(double(baseFilm.cropY) * cam.height / baseH)), cam.filmHeight - cam.height);
+      }
       try {
         if (rebuild) {
           if (scene_->env) scene_->env->setPlacement(envBaseScale * s.envScale, rotate(Vec3f(0, 1, 0), s.envRotation) * envBase);

@@ -657,6 +657,42 @@ TEST(CliRender, MaskSceneRenders) {
   for (int open = 0; open < 2; ++open) EXPECT_NEAR(mean[1][open], mean[0][open], 0.1 * mean[0][open]) << "lattice " << 1 - open;
 }
 
+// A crop window renders its part of the film: a textured sphere under a sky of 1 (each pixel
+// its texture's albedo, nearly free of noise), rendered whole at 48 x 32 and as the 20 x 12
+// window at (22, 9); the window's pixels are the whole image's there, within 0.01 on average.
+TEST(CliRender, ACropWindowRendersItsPartOfTheFilm) {
+  TempDir d;
+  auto scene = [&](const std::string& name, const std::string& crop) {
+    std::string xml = d.file(name + ".xml");
+    std::ofstream(xml) << R"(<scene version="3.0.0"><integrator type="path"><integer name="max_depth" value="2"/></integrator>
+  <sensor type="perspective"><float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0,0,4" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="48"/><integer name="height" value="32"/>)" + crop + R"(
+      <rfilter type="box"/></film></sensor>
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <shape type="sphere"><bsdf type="diffuse"><texture type="bitmap" name="reflectance">
+    <string name="filename" value=")" + std::string(ENVGI_SOURCE_DIR) + R"(/scenes/textures/uv-grid.png"/></texture></bsdf></shape>
+</scene>)";
+    std::string out = d.file(name + ".exr");
+    CliResult r = runCli("render " + xml + " -o " + out + " --spp 64 --no-progress");
+    EXPECT_EQ(r.code, 0) << r.output;
+    return envgi::loadImage(out);
+  };
+  envgi::Image whole = scene("whole", "");
+  envgi::Image window = scene("window", R"(<integer name="crop_offset_x" value="22"/><integer name="crop_offset_y" value="9"/>
+      <integer name="crop_width" value="20"/><integer name="crop_height" value="12"/>)");
+  ASSERT_EQ(window.width, 20);
+  ASSERT_EQ(window.height, 12);
+  double diff = 0.0, mean = 0.0;
+  for (int y = 0; y < 12; ++y)
+    for (int x = 0; x < 20; ++x) {
+      diff += std::fabs(window.at(x, y).y - whole.at(x + 22, y + 9).y) / 240.0;
+      mean += window.at(x, y).y / 240.0;
+    }
+  EXPECT_LT(diff, 0.01);
+  EXPECT_GT(mean, 0.1) << "the window sees the sphere";
+}
+
 // A bundled scene end to end with path and sppm (32^2, 16 spp): no warning, a finite image that
 // is not black, and the two integrators agree on its mean within 10%.
 namespace {

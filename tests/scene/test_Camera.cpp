@@ -117,3 +117,48 @@ TEST(Camera, OrthographicRaysAreParallelFromTheNearPlane) {
   EXPECT_FALSE(projectToFilm(c, frame.point(Vec3f(0.f, 0.f, 0.05f)), &px, &py));
   EXPECT_FALSE(c.hasLens());
 }
+
+// Mitsuba's crop window: the cropped camera's pixel (x, y) is the whole film's (x + cropX,
+// y + cropY), to the bit, for the pinhole, the thin lens and the orthographic camera alike, and
+// a point projects back to the window's own coordinates (outside it: not on the image).
+TEST(Camera, ACropWindowSeesItsPartOfTheFilm) {
+  for (int kind = 0; kind < 3; ++kind) {
+    Camera full;
+    full.width = 64;
+    full.height = 48;
+    full.tanHalfX = 0.5f;
+    full.tanHalfY = 0.375f;
+    full.toWorld = lookAt(Vec3f(1.f, 2.f, 6.f), Vec3f(0.f, 0.5f, 0.f), Vec3f(0.f, 1.f, 0.f));
+    if (kind == 1) {
+      full.apertureRadius = 0.1f;
+      full.focusDistance = 5.f;
+    }
+    full.orthographic = kind == 2;
+    Camera crop = full;
+    crop.filmWidth = 64;
+    crop.filmHeight = 48;
+    crop.cropX = 30;
+    crop.cropY = 12;
+    crop.width = 20;
+    crop.height = 10;
+    Pcg32 rng(3);
+    for (int i = 0; i < 500; ++i) {
+      float x = rng.nextFloat() * 20.f, y = rng.nextFloat() * 10.f;
+      Vec2f lens(rng.nextFloat(), rng.nextFloat());
+      Ray a = crop.generateRay(x, y, lens), b = full.generateRay(x + 30.f, y + 12.f, lens);
+      ASSERT_EQ(a.o.x, b.o.x);
+      ASSERT_EQ(a.o.z, b.o.z);
+      ASSERT_EQ(a.d.y, b.d.y);
+      ASSERT_EQ(a.tMax, b.tMax);
+      float px, py;
+      ASSERT_TRUE(projectToFilm(crop, b.o + b.d * 3.f, &px, &py) || kind == 1);
+      if (kind != 1) {  // a thin lens's ray crosses the film position's line only in focus
+        ASSERT_NEAR(px, x, 2e-3f);
+        ASSERT_NEAR(py, y, 2e-3f);
+      }
+    }
+    float px, py;
+    EXPECT_FALSE(projectToFilm(crop, full.generateRay(10.f, 30.f).o + full.generateRay(10.f, 30.f).d * 3.f, &px, &py))
+        << "a point left of the window";
+  }
+}

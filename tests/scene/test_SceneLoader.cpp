@@ -53,6 +53,14 @@ std::string loadError(const std::string& path, std::map<std::string, std::string
   return "";
 }
 
+// kSensor's scene with `xml` in place of its film's tent filter, or before it where keepFilter.
+std::string sensorWithFilm(Fixture& f, const std::string& xml, bool keepFilter) {
+  const std::string tent = "<rfilter type=\"tent\"/>";
+  std::string body = kSensor;
+  body.replace(body.find(tent), keepFilter ? 0 : tent.size(), xml);
+  return f.scene(body);
+}
+
 // Each scene body (after kSensor) must fail to load with its message, naming the file and line.
 template <size_t N>
 void expectErrors(Fixture& f, const std::pair<const char*, const char*> (&bad)[N]) {
@@ -158,15 +166,40 @@ TEST(SceneLoader, OrthographicSensor) {
   EXPECT_FALSE(p.camera.orthographic);
 }
 
+// Mitsuba's crop window on the film: the image is the window, the view's aspect the whole
+// film's; a window that leaves the film is an error with the line.
+TEST(SceneLoader, FilmCropWindow) {
+  Fixture f;
+  auto withCrop = [&](const std::string& crop) { return sensorWithFilm(f, crop, true); };
+  Scene s;
+  loadScene(withCrop(R"(<integer name="crop_offset_x" value="10"/><integer name="crop_offset_y" value="4"/>
+    <integer name="crop_width" value="20"/><integer name="crop_height" value="8"/>)"),
+            {}, s);
+  EXPECT_EQ(s.camera.width, 20);
+  EXPECT_EQ(s.camera.height, 8);
+  EXPECT_EQ(s.camera.filmWidth, 64);
+  EXPECT_EQ(s.camera.filmHeight, 32);
+  EXPECT_EQ(s.camera.cropX, 10);
+  EXPECT_EQ(s.camera.cropY, 4);
+  EXPECT_NEAR(s.camera.tanHalfX, 2.f * s.camera.tanHalfY, 1e-5f) << "the aspect of the 64 x 32 film";
+  // A window of the whole film is no crop at all.
+  Scene w;
+  loadScene(withCrop(R"(<integer name="crop_width" value="64"/>)"), {}, w);
+  EXPECT_EQ(w.camera.filmWidth, 0);
+  EXPECT_EQ(w.camera.width, 64);
+  for (const char* bad : {R"(<integer name="crop_offset_x" value="50"/><integer name="crop_width" value="20"/>)",
+                          R"(<integer name="crop_height" value="0"/>)", R"(<integer name="crop_offset_y" value="-1"/>)"}) {
+    std::string e = loadError(withCrop(bad));
+    EXPECT_NE(e.find("does not lie within the 64 x 32 film"), std::string::npos) << e;
+    EXPECT_NE(e.find(".xml:"), std::string::npos) << e;
+  }
+}
+
 // Each of Mitsuba's rfilters with the parameters its plugin takes, Mitsuba's defaults where none
 // is given; a value out of range, or a parameter of another filter, is an error with the line.
 TEST(SceneLoader, EveryMitsubaFilterWithItsParameters) {
   Fixture f;
-  auto withFilter = [&](const std::string& rfilter) {
-    std::string body = kSensor;
-    body.replace(body.find("<rfilter type=\"tent\"/>"), 22, rfilter);
-    return f.scene(body);
-  };
+  auto withFilter = [&](const std::string& rfilter) { return sensorWithFilm(f, rfilter, false); };
   auto filterOf = [&](const std::string& rfilter) {
     Scene s;
     loadScene(withFilter(rfilter), {}, s);

@@ -34,6 +34,21 @@ std::string errorOfMessage(ViewSession& session, const std::string& message) {
   return "";
 }
 
+// A started session on the scene file xml, one thread, up to maxSpp samples a pixel.
+std::unique_ptr<ViewSession> startOn(const std::string& xml, int maxSpp, Sink& sink) {
+  auto scene = std::make_unique<Scene>();
+  loadScene(xml, {}, *scene);
+  ViewOptions vo;
+  vo.threads = 1;
+  vo.maxSpp = maxSpp;
+  auto session = std::make_unique<ViewSession>(std::move(scene), xml, vo);
+  session->start([&sink](ViewFrame f) { sink(std::move(f)); });
+  return session;
+}
+
+// What the session's "save" wrote.
+Image savedImage(ViewSession& session) { return loadImage(json::parse(session.handle(R"({"type":"save"})"))["path"]); }
+
 }  // namespace
 
 TEST(ViewSession, FramesComeOnRequestAndFollowTheControls) {
@@ -333,20 +348,49 @@ TEST(ViewSession, AnOrthographicCameraKeepsItsScaleWhenMoved) {
   <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
   <shape type="sphere"><float name="radius" value="1"/><bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf></shape>
 </scene>)";
-  auto scene = std::make_unique<Scene>();
-  loadScene(xml, {}, *scene);
-  ViewOptions vo;
-  vo.threads = 1;
-  vo.maxSpp = 16;
   Sink sink;
-  auto session = std::make_unique<ViewSession>(std::move(scene), xml, vo);
-  session->start([&sink](ViewFrame f) { sink(std::move(f)); });
+  auto session = startOn(xml, 16, sink);
   const double hidden = 1.0 - kPi / 16.0;
-  auto meanOfSaved = [&] { return meanOfImage(loadImage(json::parse(session->handle(R"({"type":"save"})"))["path"])); };
+  auto meanOfSaved = [&] { return meanOfImage(savedImage(*session)); };
   frameWhere(*session, sink, [](const json& f) { return f["spp"].get<int>() >= 16; });
   EXPECT_NEAR(meanOfSaved(), hidden, 0.03);
   session->handle(R"({"type":"camera","origin":[4,0,0],"target":[0,0,0],"up":[0,1,0],"version":3})");
   frameWhere(*session, sink, [](const json& f) { return f["cameraVersion"] == 3 && f["spp"].get<int>() >= 16; });
   EXPECT_NEAR(meanOfSaved(), hidden, 0.03);
+  session->stop();
+}
+
+// A crop window stays the same part of the view when the page scales the resolution: the right
+// half of an orthographic 4 x 4 view, with a black ball of radius 0.45 in its right half, shows
+// 1 - 0.2025 pi / 8 = 0.92 at full and at half resolution (had the window kept its pixels and
+// not its share of the film, it would show only sky at half resolution).
+TEST(ViewSession, ACropWindowKeepsItsPartOfTheViewAtAnyResolution) {
+  test::TempDir d;
+  std::string xml = d.path.string() + "/crop.xml";
+  std::ofstream(xml) << R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+  <sensor type="orthographic">
+    <transform name="to_world"><scale x="2" y="2"/><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/>
+      <integer name="crop_offset_x" value="16"/><integer name="crop_width" value="16"/><rfilter type="box"/></film>
+  </sensor>
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <shape type="sphere"><point name="center" x="1.5" y="0" z="0"/><float name="radius" value="0.45"/>
+    <bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf></shape>
+</scene>)";
+  Sink sink;
+  auto session = startOn(xml, 16, sink);
+  auto saved = [&] { return savedImage(*session); };
+  const double expected = 1.0 - 0.2025 * kPi / 8.0;
+  frameWhere(*session, sink, [](const json& f) { return f["spp"].get<int>() >= 16; });
+  Image full = saved();
+  EXPECT_EQ(full.width, 16);
+  EXPECT_NEAR(meanOfImage(full), expected, 0.015);
+  session->handle(R"({"type":"resolution","scale":0.5})");
+  frameWhere(*session, sink, [](const json& f) { return f["width"] == 8 && f["spp"].get<int>() >= 16; });
+  Image half = saved();
+  EXPECT_EQ(half.width, 8);
+  EXPECT_EQ(half.height, 16);
+  EXPECT_NEAR(meanOfImage(half), expected, 0.02);
   session->stop();
 }
