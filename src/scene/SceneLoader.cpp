@@ -872,6 +872,11 @@ class Loader {
     forEachChoice(b0, fn);
     forEachChoice(b1, fn);
   }
+  // Whether material `index` or any material a blend of it holds, at any depth, is masked.
+  bool anyMasked(int index) const {
+    const Bsdf& b = scene_.bsdfs[size_t(index)];
+    return bsdfIsMasked(b) || (bsdfIsBlend(b) && (anyMasked(b.blend0) || anyMasked(b.blend1)));
+  }
   int blendDepth(int index) const {
     const Bsdf& b = scene_.bsdfs[size_t(index)];
     return bsdfIsBlend(b) ? 1 + std::max(blendDepth(b.blend0), blendDepth(b.blend1)) : 0;
@@ -940,11 +945,8 @@ class Loader {
         fail(f, n, fmt::format("blendbsdf's weight must be within [0, 1], not {}", b.blendWeight));
     }
     // The tracers ask the material a ray hits, before any choice, whether the ray stops there.
-    for (int i : inner) {
-      bool masked = bsdfIsMasked(scene_.bsdfs[size_t(i)]);
-      forEachChoice(i, [&](Bsdf& c) { masked = masked || bsdfIsMasked(c); });
-      if (masked) fail(f, n, "a mask inside a blendbsdf is not supported (put the mask around the blendbsdf)");
-    }
+    for (int i : inner)
+      if (anyMasked(i)) fail(f, n, "a mask inside a blendbsdf is not supported (put the mask around the blendbsdf)");
     reportUnused(f, p, "bsdf", "blendbsdf");
     scene_.bsdfs.push_back(b);
     int id = int(scene_.bsdfs.size() - 1);

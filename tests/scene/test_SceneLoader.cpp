@@ -945,6 +945,9 @@ TEST(SceneLoader, BlendBsdf) {
        "property 'weight' given twice"},
       {R"(<shape type="sphere"><bsdf type="blendbsdf"><bsdf type="mask"><bsdf type="diffuse"/></bsdf><bsdf type="diffuse"/></bsdf></shape>)",
        "a mask inside a blendbsdf is not supported"},
+      {R"(<shape type="sphere"><bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="blendbsdf"><bsdf type="diffuse"/>
+         <bsdf type="mask"><bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></bsdf></bsdf></bsdf></shape>)",
+       "a mask inside a blendbsdf is not supported"},
       {R"(<shape type="sphere"><bsdf type="blendbsdf"><float name="wieght" value="0.5"/><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf></shape>)",
        "bsdf 'blendbsdf' has no property 'wieght' (did you mean 'weight'?)"},
   };
