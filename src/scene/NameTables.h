@@ -48,6 +48,9 @@ inline constexpr Named<IntegratorType> kIntegratorNames[] = {
     {"photon", IntegratorType::Photon, false}, {"sppm", IntegratorType::Sppm, false},
     {"grid", IntegratorType::Grid, false},
     {"photonmapper", IntegratorType::Photon, true},
+    // Mitsuba's volumetric path tracers are its path tracer where there are no media (envgi has
+    // none), and, like envgi's path, let shadow rays through masks.
+    {"volpath", IntegratorType::Path, true},   {"volpathmis", IntegratorType::Path, true},
 };
 
 inline constexpr Named<SamplerType> kSamplerNames[] = {

@@ -75,6 +75,8 @@ class Loader {
 
   void finish() {
     if (!haveSensor_) throw std::runtime_error(files_.front()->path + ": the scene has no <sensor>");
+    if (instances_ > 0)
+      spdlog::info("{} instances placed {} shapes, each a copy of its shapegroup's", instances_, instancedShapes_);
     // A -D value that nothing in the scene reads (a misspelt name, or a parameter of another
     // scene) leaves the render as it would be without it: said once, with the nearest name.
     std::vector<std::string> names(paramNames_.begin(), paramNames_.end());
@@ -415,6 +417,9 @@ class Loader {
     try {
       Properties props = scalarProperties(f, n, p);
       scene_.integrator = IntegratorSettings::fromProperties(findIntegrator(type), props);
+      if (type == "volpath" || type == "volpathmis")
+        spdlog::info("integrator '{}' is read as 'path': envgi has no media, and its path lets shadow rays through "
+                     "masks as {} does", type, type);
       for (const auto& [name, where] : props.unused()) {
         std::string error = unknownPropertyError("integrator", type, name, props.asked());
         if (!error.empty()) throw std::runtime_error(where + ": " + error);
@@ -1128,68 +1133,148 @@ class Loader {
     find(p, "sample_visible");
   }
 
+  // A shape as read, before it is placed: its geometry in its own space, its to_world and its
+  // material, so that a shape group's meshes load once however many instances place them.
+  struct ShapeTemplate {
+    ShapeEntry entry;  // the material and area light; index is set where the shape is placed
+    bool isSphere = false;
+    Vec3f center;
+    float radius = 1.f;
+    TriangleMesh mesh;  // untransformed
+    Transform toWorld;
+    bool flip = false, faceNormals = false, fromFile = false;
+  };
+  struct ShapeGroup {
+    std::vector<ShapeTemplate> shapes;
+    std::string where;  // "file:line" of its definition, for a duplicate's error
+  };
+  std::map<std::string, ShapeGroup> groups_;
+  size_t instances_ = 0, instancedShapes_ = 0;  // for the log
+
+  // A top-level <shape>: a shape group is kept for its instances, an instance places its group,
+  // anything else goes into the scene as it is.
   void shape(const SourceFile* f, pugi::xml_node n) {
     checkAttrs(f, n, {"type", "id", "name"});
     std::string type = attr(f, n, "type");
-    Props p = collectProps(f, n);
-    ShapeEntry entry;
-    Transform toWorld = getTransform(f, p, "to_world");
-    bool flip = getBool(f, p, "flip_normals", false);
-    if (type == "sphere") {
-      Sphere s;
-      Vec3f c = getPoint(f, p, "center", Vec3f(0.f));
-      float r = getFloat(f, p, "radius", 1.f);
-      if (!(r > 0.f)) fail(f, n, "sphere radius must be positive");
-      s.center = toWorld.point(c);
-      s.radius = r * length(toWorld.vector(Vec3f(1.f, 0.f, 0.f)));
-      s.axes = {normalize(toWorld.vector(Vec3f(1.f, 0.f, 0.f))), normalize(toWorld.vector(Vec3f(0.f, 1.f, 0.f))),
-                normalize(toWorld.vector(Vec3f(0.f, 0.f, 1.f)))};
-      s.flipNormals = flip;
-      entry.isSphere = true;
-      entry.index = scene_.spheres.size();
-      scene_.spheres.push_back(s);
+    if (type == "shapegroup") {
+      std::string id = attr(f, n, "id", false);
+      if (id.empty()) fail(f, n, "a shapegroup needs an id, which its instances refer to");
+      std::string where = fmt::format("{}:{}", f->path, f->lineOf(n.offset_debug()));
+      if (groups_.count(id) || bsdfIds_.count(id) || textureIds_.count(id))
+        fail(f, n, fmt::format("duplicate id '{}'", id));
+      groups_[id] = shapeGroup(f, n);
+      groups_[id].where = where;
+    } else if (type == "instance") {
+      instance(f, n);
     } else {
-      TriangleMesh mesh;
-      const bool fromFile = type == "ply" || type == "obj";
-      bool faceNormals = getBool(f, p, "face_normals", false);
+      placeShape(readShape(f, n, type), Transform{});
+    }
+  }
+
+  // Mitsuba's shapegroup: shapes that appear only where an instance places them. As in Mitsuba,
+  // a group holds no emitter, no other group and no instance.
+  ShapeGroup shapeGroup(const SourceFile* f, pugi::xml_node n) {
+    Props p = collectProps(f, n);
+    reportUnused(f, p, "shape", "shapegroup");
+    ShapeGroup g;
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element) continue;
+      std::string tag = c.name();
+      if (isPropTag(tag)) continue;
+      if (tag != "shape") fail(f, c, fmt::format("unexpected <{}> in a shapegroup (only <shape>)", tag));
+      checkAttrs(f, c, {"type", "id", "name"});
+      std::string type = attr(f, c, "type");
+      if (type == "shapegroup") fail(f, c, "a shapegroup inside a shapegroup is not permitted (as in Mitsuba)");
+      if (type == "instance") fail(f, c, "an instance inside a shapegroup is not permitted (as in Mitsuba)");
+      g.shapes.push_back(readShape(f, c, type));
+      if (g.shapes.back().entry.emissive)
+        fail(f, c, "a shape in a shapegroup cannot be an area emitter (Mitsuba does not instance emitters)");
+    }
+    return g;
+  }
+
+  // Mitsuba's instance: its group's shapes placed under its to_world. Each becomes a copy in the
+  // scene, transformed as a shape whose to_world is the instance's times its own, so every
+  // tracer, integrator and the GPU see plain meshes and spheres (memory grows with the count).
+  void instance(const SourceFile* f, pugi::xml_node n) {
+    Props p = collectProps(f, n);
+    Transform toWorld = getTransform(f, p, "to_world");
+    const ShapeGroup* group = nullptr;
+    ShapeGroup inlineGroup;
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element) continue;
+      std::string tag = c.name();
+      if (isPropTag(tag)) continue;
+      if (group) fail(f, c, "an instance refers to one shapegroup");
+      if (tag == "ref") {
+        checkAttrs(f, c, {"id", "name"});
+        std::string id = attr(f, c, "id");
+        auto it = groups_.find(id);
+        if (it == groups_.end())
+          fail(f, c,
+               bsdfIds_.count(id) || textureIds_.count(id)
+                   ? fmt::format("'{}' is not a shapegroup: an instance refers to a shapegroup", id)
+                   : fmt::format("unknown shapegroup id '{}' (a shapegroup is defined before its instances)", id));
+        group = &it->second;
+      } else if (tag == "shape" && std::string(c.attribute("type").as_string()) == "shapegroup") {
+        inlineGroup = shapeGroup(f, c);
+        group = &inlineGroup;
+      } else {
+        fail(f, c, fmt::format("unexpected <{}> in an instance (a <ref> to a shapegroup)", tag));
+      }
+    }
+    if (!group) fail(f, n, "an instance needs a <ref id=\"...\"/> to a shapegroup");
+    reportUnused(f, p, "shape", "instance");
+    for (const ShapeTemplate& t : group->shapes) placeShape(t, toWorld);
+    ++instances_;
+    instancedShapes_ += group->shapes.size();
+  }
+
+  ShapeTemplate readShape(const SourceFile* f, pugi::xml_node n, const std::string& type) {
+    Props p = collectProps(f, n);
+    ShapeTemplate t;
+    t.toWorld = getTransform(f, p, "to_world");
+    t.flip = getBool(f, p, "flip_normals", false);
+    if (type == "sphere") {
+      t.center = getPoint(f, p, "center", Vec3f(0.f));
+      t.radius = getFloat(f, p, "radius", 1.f);
+      if (!(t.radius > 0.f)) fail(f, n, "sphere radius must be positive");
+      t.isSphere = true;
+    } else {
+      t.fromFile = type == "ply" || type == "obj";
+      t.faceNormals = getBool(f, p, "face_normals", false);
       // Mitsuba's mesh loaders flip v by default: files give v up the image, bitmaps store rows down.
-      bool flipUv = fromFile && getBool(f, p, "flip_tex_coords", true);
+      bool flipUv = t.fromFile && getBool(f, p, "flip_tex_coords", true);
       try {
-        if (fromFile) {
+        if (t.fromFile) {
           std::string file = getString(f, p, "filename", "");
           if (file.empty()) fail(f, n, type + " shape needs a 'filename'");
           reportUnused(f, p, "shape", type);  // a misspelt property before a large mesh's load, not after
           fs::path path = fs::path(f->path).parent_path() / file;
           if (!fs::exists(path)) fail(f, n, fmt::format("mesh file '{}' does not exist", path.string()));
-          mesh = type == "ply" ? loadPly(path.string()) : loadObj(path.string());
+          t.mesh = type == "ply" ? loadPly(path.string()) : loadObj(path.string());
         } else if (type == "rectangle") {
-          mesh = makeRectangle();
+          t.mesh = makeRectangle();
         } else if (type == "cube") {
-          mesh = makeCube();
+          t.mesh = makeCube();
         } else if (type == "disk") {
-          mesh = makeDisk();
+          t.mesh = makeDisk();
         } else if (type == "cylinder") {
-          mesh = makeCylinder(getPoint(f, p, "p0", Vec3f(0.f)), getPoint(f, p, "p1", Vec3f(0.f, 0.f, 1.f)),
-                              getFloat(f, p, "radius", 1.f));
+          t.mesh = makeCylinder(getPoint(f, p, "p0", Vec3f(0.f)), getPoint(f, p, "p1", Vec3f(0.f, 0.f, 1.f)),
+                                getFloat(f, p, "radius", 1.f));
         } else {
-          fail(f, n, fmt::format("unknown shape type '{}' (ply, obj, sphere, rectangle, cube, disk, cylinder)", type));
+          fail(f, n,
+               fmt::format("unknown shape type '{}' (ply, obj, sphere, rectangle, cube, disk, cylinder, shapegroup, "
+                           "instance)",
+                           type));
         }
       } catch (const std::runtime_error& e) {
         rethrowAt(f, n, e);
       }
       if (flipUv)
-        for (Vec2f& uv : mesh.uvs) uv.y = 1.f - uv.y;
-      mesh.transform(toWorld);
-      if (faceNormals) mesh.normals.clear();
-      else if (mesh.normals.empty() && fromFile) mesh.computeVertexNormals();
-      if (flip) {
-        // Mitsuba flips the normals; reversing the winding keeps geometric and shading normals together.
-        for (size_t i = 0; i < mesh.indices.size(); i += 3) std::swap(mesh.indices[i + 1], mesh.indices[i + 2]);
-        for (Vec3f& nn : mesh.normals) nn = -nn;
-      }
-      entry.index = scene_.meshes.size();
-      scene_.meshes.push_back(std::move(mesh));
+        for (Vec2f& uv : t.mesh.uvs) uv.y = 1.f - uv.y;
     }
+    ShapeEntry& entry = t.entry;
     entry.bsdf = -1;
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element) continue;
@@ -1222,6 +1307,37 @@ class Loader {
     if (entry.emissive && bsdfIsMasked(scene_.bsdfs[size_t(entry.bsdf)]))
       fail(f, n, "an area emitter's shape cannot have a mask BSDF");
     reportUnused(f, p, "shape", type);
+    return t;
+  }
+
+  // Puts a shape into the scene under outer (an instance's to_world; identity for a plain shape):
+  // the same as a shape whose to_world is outer times its own.
+  void placeShape(const ShapeTemplate& t, const Transform& outer) {
+    const Transform toWorld = outer * t.toWorld;
+    ShapeEntry entry = t.entry;
+    if (t.isSphere) {
+      Sphere s;
+      s.center = toWorld.point(t.center);
+      s.radius = t.radius * length(toWorld.vector(Vec3f(1.f, 0.f, 0.f)));
+      s.axes = {normalize(toWorld.vector(Vec3f(1.f, 0.f, 0.f))), normalize(toWorld.vector(Vec3f(0.f, 1.f, 0.f))),
+                normalize(toWorld.vector(Vec3f(0.f, 0.f, 1.f)))};
+      s.flipNormals = t.flip;
+      entry.isSphere = true;
+      entry.index = scene_.spheres.size();
+      scene_.spheres.push_back(s);
+    } else {
+      TriangleMesh mesh = t.mesh;
+      mesh.transform(toWorld);
+      if (t.faceNormals) mesh.normals.clear();
+      else if (mesh.normals.empty() && t.fromFile) mesh.computeVertexNormals();
+      if (t.flip) {
+        // Mitsuba flips the normals; reversing the winding keeps geometric and shading normals together.
+        for (size_t i = 0; i < mesh.indices.size(); i += 3) std::swap(mesh.indices[i + 1], mesh.indices[i + 2]);
+        for (Vec3f& nn : mesh.normals) nn = -nn;
+      }
+      entry.index = scene_.meshes.size();
+      scene_.meshes.push_back(std::move(mesh));
+    }
     scene_.shapes.push_back(entry);
   }
 };

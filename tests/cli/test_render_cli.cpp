@@ -719,6 +719,49 @@ void expectPathAndSppmAgree(const std::string& name) {
 }  // namespace
 
 TEST(CliRender, OrthographicSceneRenders) { expectPathAndSppmAgree("orthographic"); }
+TEST(CliRender, InstancesSceneRenders) { expectPathAndSppmAgree("instances"); }
+
+// A scene written with a shapegroup and instances renders the same to the bit as the same
+// shapes written out one by one with the instances' to_world (path, 32^2, 8 spp).
+TEST(CliRender, InstancesRenderAsTheShapesTheyPlace) {
+  TempDir d;
+  const std::string head = std::string(R"(<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+  <sensor type="perspective"><float name="fov" value="45"/>
+    <transform name="to_world"><lookat origin="0,1.5,5" target="0,0.4,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/></film>
+    <sampler type="sobol"><integer name="sample_count" value="8"/></sampler></sensor>
+  <emitter type="envmap"><string name="filename" value=")") + ENVGI_SOURCE_DIR + R"(/scenes/envmaps/studio.hdr"/></emitter>
+  <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform></shape>
+)";
+  const char* placements[] = {R"(<translate x="-1"/>)", R"(<rotate y="1" angle="30"/><scale value="0.5"/><translate x="1" y="0.2"/>)"};
+  const std::string sphere = R"(<float name="radius" value="0.4"/>
+    <bsdf type="roughconductor"><string name="material" value="Cu"/><float name="alpha" value="0.2"/></bsdf>)";
+  const std::string cube = R"(<bsdf type="diffuse"><rgb name="reflectance" value="0.2,0.5,0.7"/></bsdf>)";
+  std::string grouped = head + "<shape type=\"shapegroup\" id=\"g\"><shape type=\"sphere\">" + sphere +
+                        "</shape><shape type=\"cube\">" + cube + "</shape></shape>\n";
+  std::string plain = head;
+  for (const char* t : placements) {
+    const std::string xf = std::string("<transform name=\"to_world\">") + t + "</transform>";
+    grouped += "<shape type=\"instance\"><ref id=\"g\"/>" + xf + "</shape>\n";
+    plain += "<shape type=\"sphere\">" + sphere + xf + "</shape><shape type=\"cube\">" + cube + xf + "</shape>\n";
+  }
+  std::ofstream(d.file("grouped.xml")) << grouped << "</scene>\n";
+  std::ofstream(d.file("plain.xml")) << plain << "</scene>\n";
+  for (const char* name : {"grouped", "plain"}) {
+    CliResult r = runCli(std::string("render ") + d.file(std::string(name) + ".xml") + " -o " +
+                         d.file(std::string(name) + ".exr") + " --threads 1 --no-progress");
+    ASSERT_EQ(r.code, 0) << name << ": " << r.output;
+    if (std::string(name) == "grouped")
+      EXPECT_NE(r.output.find("2 instances placed 4 shapes"), std::string::npos) << r.output;
+  }
+  envgi::Image a = envgi::loadImage(d.file("grouped.exr")), b = envgi::loadImage(d.file("plain.exr"));
+  ASSERT_EQ(a.rgb.size(), b.rgb.size());
+  EXPECT_TRUE(a.rgb == b.rgb) << "the instanced scene differs from the plain one";
+  double mean = 0.0;
+  for (float v : a.rgb) mean += v / double(a.rgb.size());
+  EXPECT_GT(mean, 0.05);
+}
 TEST(CliRender, BlendSceneRenders) { expectPathAndSppmAgree("blend"); }
 
 // The bundled principled scene, end to end with path, sppm and direct: no warning (every
@@ -746,4 +789,30 @@ TEST(CliRender, PrincipledSceneRenders) {
     if (k < 2) means[k++] = mean;
   }
   EXPECT_NEAR(means[0], means[1], 0.1 * means[0]) << "path against sppm";
+}
+
+// Mitsuba's volpath (a scene without media) renders as path, to the bit, and the log says so.
+TEST(CliRender, VolpathRendersAsPath) {
+  TempDir d;
+  std::string text;
+  {
+    std::ifstream in(tinyScene(d, 16, 4));
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  const std::string from = "<integrator type=\"path\">";
+  ASSERT_NE(text.find(from), std::string::npos);
+  std::ofstream(d.file("volpath.xml")) << std::string(text).replace(text.find(from), from.size(), "<integrator type=\"volpath\">");
+  std::ofstream(d.file("path.xml")) << text;
+  for (const char* name : {"volpath", "path"}) {
+    CliResult r = runCli(std::string("render ") + d.file(std::string(name) + ".xml") + " -o " +
+                         d.file(std::string(name) + ".exr") + " --seed 5 --no-progress");
+    ASSERT_EQ(r.code, 0) << name << ": " << r.output;
+    EXPECT_EQ(r.output.find("warn"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("integrator 'volpath' is read as 'path'") != std::string::npos,
+              std::string(name) == "volpath")
+        << r.output;
+  }
+  EXPECT_TRUE(envgi::loadImage(d.file("volpath.exr")).rgb == envgi::loadImage(d.file("path.exr")).rgb);
 }

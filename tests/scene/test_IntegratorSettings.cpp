@@ -154,6 +154,8 @@ TEST(NameTables, NamesRoundTripAndUnknownNamesAreErrors) {
   EXPECT_EQ(nameList(kIntegratorNames), "path, direct, photon, sppm, grid");
   EXPECT_EQ(nameList(kSamplerNames), "independent, stratified, sobol");
   EXPECT_EQ(findIntegrator("photonmapper"), IntegratorType::Photon);
+  EXPECT_EQ(findIntegrator("volpath"), IntegratorType::Path);
+  EXPECT_EQ(findIntegrator("volpathmis"), IntegratorType::Path);
   EXPECT_EQ(findSampler("ldsampler"), SamplerType::Sobol);
   try {
     findSampler("halton");

@@ -1073,3 +1073,82 @@ TEST(SceneLoader, Principled) {
   };
   expectErrors(f, bad);
 }
+
+namespace {
+// Bit-exact: the instance must place the very floats the plain shape gets.
+::testing::AssertionResult sameVec(Vec3f a, Vec3f b) {
+  if (a.x == b.x && a.y == b.y && a.z == b.z) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "(" << a.x << ", " << a.y << ", " << a.z << ") != (" << b.x << ", " << b.y
+                                       << ", " << b.z << ")";
+}
+}  // namespace
+
+// Mitsuba's shapegroup and instance: a group's shapes appear only where an instance places them,
+// each as the shape whose to_world is the instance's times its own (the same vertices and
+// sphere as that plain shape, to the bit where the shape's own to_world is the identity); the
+// group's materials are shared, its mesh read once. Errors as Mitsuba's: no emitter, group or
+// instance in a group; an instance needs one ref to a group defined before it.
+TEST(SceneLoader, ShapeGroupAndInstance) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <shape type="shapegroup" id="g">
+      <shape type="ply"><string name="filename" value="tri.ply"/>
+        <bsdf type="diffuse"><rgb name="reflectance" value="0.3"/></bsdf></shape>
+      <shape type="sphere"><point name="center" x="1" y="0" z="0"/><float name="radius" value="0.5"/></shape>
+    </shape>
+    <shape type="instance"><ref id="g"/></shape>
+    <shape type="instance"><ref id="g"/>
+      <transform name="to_world"><rotate y="1" angle="90"/><scale value="2"/><translate x="5"/></transform></shape>
+    <shape type="instance"><shape type="shapegroup"><shape type="rectangle"/></shape></shape>)"),
+            {}, s);
+  ASSERT_EQ(s.shapes.size(), 5u) << "two instances of two shapes, and one of an inline group's rectangle";
+  ASSERT_EQ(s.meshes.size(), 3u);
+  ASSERT_EQ(s.spheres.size(), 2u);
+  EXPECT_EQ(s.shapes[0].bsdf, s.shapes[2].bsdf) << "the group's material is shared";
+  EXPECT_FLOAT_EQ(s.bsdfs[size_t(s.shapes[0].bsdf)].reflectance.x, 0.3f);
+  // The plain shapes under the second instance's transform, as one scene would write them.
+  Scene plain;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <shape type="ply"><string name="filename" value="tri.ply"/>
+      <transform name="to_world"><rotate y="1" angle="90"/><scale value="2"/><translate x="5"/></transform></shape>
+    <shape type="sphere"><point name="center" x="1" y="0" z="0"/><float name="radius" value="0.5"/>
+      <transform name="to_world"><rotate y="1" angle="90"/><scale value="2"/><translate x="5"/></transform></shape>)"),
+            {}, plain);
+  EXPECT_TRUE(sameVec(s.meshes[0].positions[1], Vec3f(1.f, 0.f, 0.f))) << "the identity instance";
+  ASSERT_EQ(s.meshes[1].positions.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_TRUE(sameVec(s.meshes[1].positions[i], plain.meshes[0].positions[i])) << i;
+    EXPECT_TRUE(sameVec(s.meshes[1].normals[i], plain.meshes[0].normals[i])) << i;
+  }
+  EXPECT_NEAR(s.meshes[1].positions[1].x, 5.f, 1e-6f);  // (1, 0, 0) turned to -z, doubled, moved by 5
+  EXPECT_NEAR(s.meshes[1].positions[1].z, -2.f, 1e-6f);
+  EXPECT_TRUE(sameVec(s.spheres[1].center, plain.spheres[0].center));
+  EXPECT_FLOAT_EQ(s.spheres[1].radius, 1.f);
+  EXPECT_TRUE(sameVec(s.spheres[0].center, Vec3f(1.f, 0.f, 0.f)));
+  EXPECT_EQ(s.meshes[2].positions.size(), 4u) << "the inline group's rectangle";
+
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<shape type="shapegroup"><shape type="sphere"/></shape>)", "a shapegroup needs an id"},
+      {R"(<shape type="shapegroup" id="g"><shape type="shapegroup" id="h"/></shape>)",
+       "a shapegroup inside a shapegroup is not permitted"},
+      {R"(<shape type="shapegroup" id="g"/><shape type="shapegroup" id="h"><shape type="instance"><ref id="g"/></shape></shape>)",
+       "an instance inside a shapegroup is not permitted"},
+      {R"(<shape type="shapegroup" id="g"><shape type="rectangle"><emitter type="area"/></shape></shape>)",
+       "cannot be an area emitter"},
+      {R"(<shape type="shapegroup" id="g"><bsdf type="diffuse"/></shape>)", "unexpected <bsdf> in a shapegroup"},
+      {R"(<shape type="shapegroup" id="g"/><shape type="shapegroup" id="g"/>)", "duplicate id 'g'"},
+      {R"(<shape type="instance"/>)", "an instance needs a <ref"},
+      {R"(<shape type="instance"><ref id="nowhere"/></shape>)", "unknown shapegroup id 'nowhere'"},
+      {R"(<bsdf type="diffuse" id="d"/><shape type="instance"><ref id="d"/></shape>)", "'d' is not a shapegroup"},
+      {R"(<shape type="shapegroup" id="g"/><shape type="instance"><ref id="g"/><ref id="g"/></shape>)",
+       "an instance refers to one shapegroup"},
+      {R"(<shape type="shapegroup" id="g"/><shape type="instance"><ref id="g"/><bsdf type="diffuse"/></shape>)",
+       "an instance refers to one shapegroup"},
+      {R"(<shape type="instance"><bsdf type="diffuse"/></shape>)", "unexpected <bsdf> in an instance"},
+      {R"(<shape type="shapegroup" id="g"/><shape type="instance"><ref id="g"/><float name="scale" value="2"/></shape>)",
+       "shape 'instance' has no property 'scale'"},
+      {R"(<shape type="shapegroup" id="g"><shape type="ply"/></shape>)", "ply shape needs a 'filename'"},
+  };
+  expectErrors(f, bad);
+}
