@@ -13,6 +13,7 @@
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
 #include "gpu/CudaExecutor.h"
+#include "render/AovRenderer.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
 #include "scene/NameTables.h"
@@ -38,6 +39,8 @@ struct RenderArgs {
   float noiseThreshold = 0.f;
   int minSpp = 16;
   std::string sampleMap;
+  std::string aov;
+  bool aovGiven = false;
   std::string device = "auto", sampler, pointMethod, filter;
   int points = 0;
   int gpu = 0;
@@ -77,6 +80,10 @@ void runRender(const RenderArgs& a) {
     FilterType t = findName(kFilterNames, a.filter, "filter");
     if (t != scene.camera.filter.type) scene.camera.filter = makeFilter(t);
   }
+  if (a.aovGiven) scene.aovs = parseAovs(a.aov);
+  if (!scene.aovs.empty() && ext != ".exr")
+    throw std::runtime_error("AOVs are written as channels of an OpenEXR file: the output '" + a.output +
+                             "' must end in .exr");
   scene.finalize();
   bool cuda = chooseCuda(a.device);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -89,9 +96,27 @@ void runRender(const RenderArgs& a) {
   so.exposure = a.exposure;
   so.toneMap = a.aces ? ToneMap::Aces : ToneMap::Clamp;
   std::string pngPath = fs::path(a.output).replace_extension(".png").string();
+  std::vector<ImageChannel> aovs;
   auto write = [&](const Image& img) {
-    saveImage(img, a.output, so);
+    if (aovs.empty()) {
+      saveImage(img, a.output, so);
+    } else {
+      Image withAovs = img;
+      withAovs.channels = aovs;
+      saveImage(withAovs, a.output, so);
+    }
     if (a.png && ext != ".png") saveImage(img, pngPath, so);
+  };
+  // The AOVs take only camera rays, traced here on the CPU before the image (so that every
+  // checkpoint holds them), whichever device renders it.
+  auto traceAovs = [&](const EmbreeAccel& accel, int spp) {
+    if (scene.aovs.empty()) return;
+    auto t = std::chrono::steady_clock::now();
+    aovs = renderAovs(scene, accel, spp, a.threads);
+    std::string names;
+    for (const ImageChannel& c : aovs) names += (names.empty() ? "" : ", ") + c.name;
+    spdlog::info("AOVs {} from {} camera samples a pixel in {:.2f} s", names, std::min(spp, kAovMaxSamples),
+                 secondsSince(t));
   };
 
   RenderOptions ro;
@@ -130,7 +155,10 @@ void runRender(const RenderArgs& a) {
     spdlog::info("BVH: {} triangles, {} nodes, depth {}, {:.1f} bytes a triangle, built in {:.2f} s", bs.triangles,
                  bs.nodes, bs.maxDepth, bs.triangles ? double(bs.bytes()) / double(bs.triangles) : 0.0, bs.seconds);
     std::unique_ptr<EmbreeAccel> accel;
-    if (scene.integrator.type == IntegratorType::Photon) accel = std::make_unique<EmbreeAccel>(scene);
+    if (scene.integrator.type == IntegratorType::Photon || !scene.aovs.empty())
+      accel = std::make_unique<EmbreeAccel>(scene);
+    if (accel) traceAovs(*accel, requestedSpp);
+    if (scene.integrator.type != IntegratorType::Photon) accel.reset();
     auto t2 = std::chrono::steady_clock::now();
     size_t bytes = 0;
     PreparedRender pr = gpu::prepareCudaRender(scene, bvh, accel.get(), ro, a.gpu, &bytes);
@@ -142,6 +170,7 @@ void runRender(const RenderArgs& a) {
     auto t1 = std::chrono::steady_clock::now();
     EmbreeAccel accel(scene);
     spdlog::info("device: CPU; Embree BVH built in {:.2f} s", secondsSince(t1));
+    traceAovs(accel, requestedSpp);
     img = render(scene, accel, ro, &st);
   }
   std::signal(SIGINT, SIG_DFL);
@@ -225,6 +254,11 @@ void addRenderCommand(CLI::App& app) {
       ->check(atLeast(2));
   c->add_option("--sample-map", a->sampleMap,
                 "Also write each pixel's share of the requested samples as an image (.exr, .pfm, .hdr or .png)");
+  c->add_option("--aov", a->aov,
+                "AOVs written as channels of the .exr beside the image, Mitsuba's name:type list (types albedo, "
+                "depth, position, uv, geo_normal, sh_normal, prim_index, shape_index), e.g. albedo:albedo,nn:sh_normal; "
+                "replaces the scene's aov integrator's list ('' for none)")
+      ->each([a](const std::string&) { a->aovGiven = true; });
   c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
   c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(atLeast(0));
   c->add_option("--filter", a->filter, "Pixel filter: " + nameList(kFilterNames) + " (overrides the scene)");

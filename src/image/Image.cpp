@@ -63,6 +63,18 @@ Image loadExr(const std::string& path) {
     const char* names[3] = {"R", "G", "B"};
     for (int k = 0; k < 3; ++k)
       fb.insert(grey ? "Y" : names[k], Imf::Slice(Imf::FLOAT, base + k * sizeof(float), xs, ys));
+    // Every other channel (an AOV's), by name, as float.
+    for (Imf::ChannelList::ConstIterator it = ch.begin(); it != ch.end(); ++it) {
+      std::string name = it.name();
+      if (name == "R" || name == "G" || name == "B" || (grey && name == "Y")) continue;
+      if (it.channel().xSampling != 1 || it.channel().ySampling != 1) continue;
+      img.channels.push_back({name, std::vector<float>(size_t(w) * size_t(h), 0.f)});
+    }
+    for (ImageChannel& c : img.channels) {
+      char* cb = reinterpret_cast<char*>(c.values.data()) -
+                 (ptrdiff_t(dw.min.x) + ptrdiff_t(dw.min.y) * w) * ptrdiff_t(sizeof(float));
+      fb.insert(c.name, Imf::Slice(Imf::FLOAT, cb, sizeof(float), sizeof(float) * size_t(w)));
+    }
     in.setFrameBuffer(fb);
     in.readPixels(dw.min.y, dw.max.y);
     return img;
@@ -218,6 +230,13 @@ bool writeExr(const Image& img, const fs::path& path) {
   for (int k = 0; k < 3; ++k) {
     header.channels().insert(names[k], Imf::Channel(Imf::FLOAT));
     fb.insert(names[k], Imf::Slice(Imf::FLOAT, (char*)(img.rgb.data() + k), xs, ys));
+  }
+  for (const ImageChannel& c : img.channels) {
+    if (c.values.size() != size_t(img.width) * size_t(img.height))
+      throw std::runtime_error("channel '" + c.name + "' does not match the image's size");
+    if (header.channels().findChannel(c.name)) throw std::runtime_error("channel '" + c.name + "' given twice");
+    header.channels().insert(c.name, Imf::Channel(Imf::FLOAT));
+    fb.insert(c.name, Imf::Slice(Imf::FLOAT, (char*)c.values.data(), sizeof(float), sizeof(float) * size_t(img.width)));
   }
   Imf::OutputFile out(path.c_str(), header);
   out.setFrameBuffer(fb);

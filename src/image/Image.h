@@ -8,9 +8,18 @@
 
 namespace envgi {
 
+// One named channel beside an image's R, G, B (an AOV's "dd.T"): width x height floats, row-major.
+struct ImageChannel {
+  std::string name;
+  std::vector<float> values;
+};
+
 struct Image {
   int width = 0, height = 0;
   std::vector<float> rgb;  // row-major, row 0 at the top, 3 floats a pixel
+  // Further channels, which only OpenEXR holds: .exr files keep them both ways, the other
+  // formats write the RGB alone.
+  std::vector<ImageChannel> channels;
 
   Image() = default;
   Image(int w, int h) : width(w), height(h), rgb(size_t(w) * h * 3, 0.f) {}

@@ -58,6 +58,7 @@ const PluginProperties kMitsuba[] = {
     // Integrator
     {"integrator", {}, {"max_depth", "rr_depth", "hide_emitters", "timeout", "samples_per_pass", "block_size"}},
     {"integrator", {"direct"}, {"shading_samples", "emitter_samples", "bsdf_samples"}},
+    {"integrator", {"aov"}, {"aovs"}},
     // BSDFs
     {"bsdf", {"diffuse"}, {"reflectance"}},
     {"bsdf",

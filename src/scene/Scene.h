@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "envmap/EnvironmentMap.h"
+#include "scene/Aov.h"
 #include "sampling/Sampler.h"
 #include "scene/IntegratorSettings.h"
 #include "scene/SceneView.h"
@@ -54,6 +55,7 @@ class Scene {
   Camera camera;
   IntegratorSettings integrator;
   SamplerSettings sampler;
+  std::vector<Aov> aovs;  // Mitsuba's aov integrator's list: channels written beside the image
   std::string sourcePath;
 
   // Builds the views, the light list, the bounds and (points strategy) the collapsed map;

@@ -413,6 +413,7 @@ class Loader {
   void integrator(const SourceFile* f, pugi::xml_node n) {
     checkAttrs(f, n, {"type", "id", "name"});
     std::string type = attr(f, n, "type");
+    if (type == "aov") return aovIntegrator(f, n);
     Props p = collectProps(f, n);
     try {
       Properties props = scalarProperties(f, n, p);
@@ -433,6 +434,29 @@ class Loader {
   }
 
   // A plugin's properties as plain values, each with its own file and line.
+  // Mitsuba's aov integrator: its `aovs` list, written as channels beside the image, and one
+  // nested integrator that renders the image (Mitsuba allows several, each its own image).
+  void aovIntegrator(const SourceFile* f, pugi::xml_node n) {
+    Props p = collectProps(f, n);
+    std::string spec = getString(f, p, "aovs", "");
+    try {
+      scene_.aovs = parseAovs(spec);
+    } catch (const std::runtime_error& e) {
+      rethrowAt(f, n, e);
+    }
+    reportUnused(f, p, "integrator", "aov");
+    pugi::xml_node inner;
+    for (pugi::xml_node c : n.children()) {
+      if (c.type() != pugi::node_element || isPropTag(c.name())) continue;
+      if (std::string(c.name()) != "integrator") fail(f, c, fmt::format("unexpected <{}> in <integrator>", c.name()));
+      if (inner) fail(f, c, "envgi renders one image: an aov integrator holds one integrator, not several");
+      if (std::string(c.attribute("type").as_string()) == "aov") fail(f, c, "an aov integrator inside an aov integrator");
+      inner = c;
+    }
+    if (!inner) fail(f, n, "an aov integrator needs a nested <integrator> for the image (e.g. <integrator type=\"path\"/>)");
+    integrator(f, inner);
+  }
+
   Properties scalarProperties(const SourceFile* f, pugi::xml_node n, Props& p) {
     Properties out(fmt::format("{}:{}", f->path, f->lineOf(n.offset_debug())));
     for (auto& [name, prop] : p) {

@@ -816,3 +816,61 @@ TEST(CliRender, VolpathRendersAsPath) {
   }
   EXPECT_TRUE(envgi::loadImage(d.file("volpath.exr")).rgb == envgi::loadImage(d.file("path.exr")).rgb);
 }
+
+// --aov writes the AOVs as channels of the .exr (the image's RGB the same to the bit as without
+// them), and the log names them; a scene's aov integrator does the same; AOVs into a .png are an
+// error before any sample.
+TEST(CliRender, AovsAreChannelsOfTheExr) {
+  TempDir d;
+  const std::string scene = tinyScene(d, 16, 4);
+  CliResult plain = runCli("render " + scene + " -o " + d.file("plain.exr") + " --threads 1 --no-progress");
+  ASSERT_EQ(plain.code, 0) << plain.output;
+  CliResult r = runCli("render " + scene + " -o " + d.file("aov.exr") +
+                       " --threads 1 --no-progress --aov 'alb:albedo,dd:depth,nn:sh_normal'");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("AOVs alb.R, alb.G, alb.B, dd.T, nn.X, nn.Y, nn.Z from 4 camera samples"), std::string::npos)
+      << r.output;
+  envgi::Image img = envgi::loadImage(d.file("aov.exr"));
+  EXPECT_TRUE(img.rgb == envgi::loadImage(d.file("plain.exr")).rgb);
+  ASSERT_EQ(img.channels.size(), 7u);
+  const envgi::ImageChannel* depth = nullptr;
+  for (const envgi::ImageChannel& c : img.channels)
+    if (c.name == "dd.T") depth = &c;
+  ASSERT_NE(depth, nullptr);
+  // The bottom row sees the floor, the top row the sky (depth 0).
+  EXPECT_GT(depth->values[15 * 16 + 8], 1.f);
+  EXPECT_EQ(depth->values[8], 0.f);
+
+  // The same from the scene file's aov integrator around its path integrator.
+  std::string text;
+  {
+    std::ifstream in(scene);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  const std::string from = "<integrator type=\"path\"><integer name=\"max_depth\" value=\"4\"/></integrator>";
+  ASSERT_NE(text.find(from), std::string::npos);
+  text.replace(text.find(from), from.size(),
+               "<integrator type=\"aov\"><string name=\"aovs\" value=\"alb:albedo,dd:depth,nn:sh_normal\"/>" + from +
+                   "</integrator>");
+  std::ofstream(d.file("aov.xml")) << text;
+  CliResult s = runCli("render " + d.file("aov.xml") + " -o " + d.file("scene.exr") + " --threads 1 --no-progress");
+  ASSERT_EQ(s.code, 0) << s.output;
+  envgi::Image fromScene = envgi::loadImage(d.file("scene.exr"));
+  EXPECT_TRUE(fromScene.rgb == img.rgb);
+  ASSERT_EQ(fromScene.channels.size(), 7u);
+  for (size_t i = 0; i < 7; ++i) EXPECT_EQ(fromScene.channels[i].values, img.channels[i].values);
+  // --aov '' drops the scene's AOVs.
+  CliResult none = runCli("render " + d.file("aov.xml") + " -o " + d.file("none.exr") + " --aov '' --no-progress");
+  ASSERT_EQ(none.code, 0) << none.output;
+  EXPECT_TRUE(envgi::loadImage(d.file("none.exr")).channels.empty());
+
+  CliResult png = runCli("render " + scene + " -o " + d.file("aov.png") + " --aov dd:depth --no-progress");
+  EXPECT_NE(png.code, 0);
+  EXPECT_NE(png.output.find("must end in .exr"), std::string::npos) << png.output;
+  EXPECT_FALSE(std::filesystem::exists(d.file("aov.png")));
+  CliResult badSpec = runCli("render " + scene + " -o " + d.file("x.exr") + " --aov dd:dept --no-progress");
+  EXPECT_NE(badSpec.code, 0);
+  EXPECT_NE(badSpec.output.find("unknown AOV type 'dept' (did you mean 'depth'?)"), std::string::npos) << badSpec.output;
+}

@@ -198,3 +198,29 @@ TEST(Image, FailedWriteLeavesNoFile) {
   EXPECT_EQ(n, 0u) << "no temporary files left behind";
   fs::remove_all(d);
 }
+
+// Channels beside R, G, B (AOVs) go into an .exr and come back by name; the other formats write
+// the RGB alone; a channel of the wrong size or named twice is an error and leaves no file.
+TEST(Image, ExrKeepsFurtherChannels) {
+  fs::path d = tmpDir();
+  Image img = pattern();
+  std::vector<float> depth(15), nx(15);
+  for (int i = 0; i < 15; ++i) depth[size_t(i)] = 0.25f * float(i), nx[size_t(i)] = -float(i);
+  img.channels = {{"dd.T", depth}, {"nn.X", nx}};
+  std::string p = (d / "aov.exr").string();
+  saveImage(img, p);
+  Image back = loadImage(p);
+  EXPECT_EQ(back.rgb, img.rgb);
+  ASSERT_EQ(back.channels.size(), 2u);
+  for (const ImageChannel& c : back.channels) EXPECT_EQ(c.values, c.name == "dd.T" ? depth : nx) << c.name;
+  saveImage(img, (d / "aov.pfm").string());
+  EXPECT_TRUE(loadImage((d / "aov.pfm").string()).channels.empty());
+  EXPECT_TRUE(loadImage((d / "aov.pfm").string()).rgb == img.rgb);
+  Image bad = pattern();
+  bad.channels = {{"short", std::vector<float>(3, 0.f)}};
+  EXPECT_THROW(saveImage(bad, (d / "bad.exr").string()), std::runtime_error);
+  bad.channels = {{"R", depth}};
+  EXPECT_THROW(saveImage(bad, (d / "bad.exr").string()), std::runtime_error);
+  EXPECT_FALSE(fs::exists(d / "bad.exr"));
+  fs::remove_all(d);
+}

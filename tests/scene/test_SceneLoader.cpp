@@ -1152,3 +1152,34 @@ TEST(SceneLoader, ShapeGroupAndInstance) {
   };
   expectErrors(f, bad);
 }
+
+// Mitsuba's aov integrator: its list becomes the scene's AOVs and its one nested integrator the
+// image's; a bad list, none or two nested integrators are errors at their lines.
+TEST(SceneLoader, AovIntegrator) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <integrator type="aov"><string name="aovs" value="dd.y:depth,nn:sh_normal"/>
+      <integrator type="path" name="my_image"><integer name="max_depth" value="3"/></integrator></integrator>)"),
+            {}, s);
+  ASSERT_EQ(s.aovs.size(), 2u);
+  EXPECT_EQ(s.aovs[0].name, "dd.y");
+  EXPECT_EQ(s.aovs[1].type, AovType::ShNormal);
+  EXPECT_EQ(s.integrator.type, IntegratorType::Path);
+  EXPECT_EQ(s.integrator.path.maxDepth, 3);
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<integrator type="aov"><string name="aovs" value="dd:depth"/></integrator>)",
+       "an aov integrator needs a nested <integrator>"},
+      {R"(<integrator type="aov"><string name="aovs" value="dd:depth"/><integrator type="path"/><integrator type="direct"/></integrator>)",
+       "an aov integrator holds one integrator"},
+      {R"(<integrator type="aov"><integrator type="aov"><integrator type="path"/></integrator></integrator>)",
+       "an aov integrator inside an aov integrator"},
+      {R"(<integrator type="aov"><string name="aovs" value="dd:dpth"/><integrator type="path"/></integrator>)",
+       "unknown AOV type 'dpth'"},
+      {R"(<integrator type="aov"><string name="aov" value="dd:depth"/><integrator type="path"/></integrator>)",
+       "integrator 'aov' has no property 'aov' (did you mean 'aovs'?)"},
+      {R"(<integrator type="aov"><string name="aovs" value="dd:depth"/><bsdf type="diffuse"/></integrator>)",
+       "unexpected <bsdf> in <integrator>"},
+  };
+  expectErrors(f, bad);
+}

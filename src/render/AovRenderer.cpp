@@ -1,0 +1,109 @@
+#include "render/AovRenderer.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+
+#include "materials/Bsdf.h"
+#include "sampling/Sampler.h"
+
+namespace envgi {
+
+namespace {
+
+// Salts the AOVs' sample sequence apart from the image's, which would otherwise share its pixels'
+// first camera samples (harmless, but the two need not be tied).
+constexpr uint32_t kAovStream = 0x27d4eb2fu;
+
+size_t channelCount(const std::vector<Aov>& aovs) {
+  size_t n = 0;
+  for (const Aov& a : aovs) n += aovChannelNames(a).size();
+  return n;
+}
+
+}  // namespace
+
+std::vector<ImageChannel> renderAovs(const Scene& scene, const EmbreeAccel& accel, int samples, int threads) {
+  const SceneView& sc = scene.view();
+  const Camera& cam = sc.camera;
+  const int n = std::clamp(samples, 1, kAovMaxSamples);
+  const size_t pixels = size_t(cam.width) * size_t(cam.height), nc = channelCount(scene.aovs);
+  std::vector<ImageChannel> out;
+  for (const Aov& a : scene.aovs)
+    for (const std::string& name : aovChannelNames(a)) out.push_back({name, std::vector<float>(pixels, 0.f)});
+  if (nc == 0) return out;
+  // Mitsuba's shape_index counts shapes in the file's order; Hit::geomId counts meshes, then spheres.
+  std::vector<float> shapeOfGeom(scene.meshes.size() + scene.spheres.size(), -1.f);
+  for (size_t i = 0; i < scene.shapes.size(); ++i) {
+    const ShapeEntry& e = scene.shapes[i];
+    shapeOfGeom[e.isSphere ? scene.meshes.size() + e.index : e.index] = float(i);
+  }
+  const EmbreeTracer tracer{&accel};
+
+  auto body = [&](const tbb::blocked_range<int>& rows) {
+    std::vector<float> acc(nc);
+    for (int y = rows.begin(); y < rows.end(); ++y)
+      for (int x = 0; x < cam.width; ++x) {
+        std::fill(acc.begin(), acc.end(), 0.f);
+        float wsum = 0.f;
+        Sampler smp;
+        smp.type = scene.sampler.type;
+        smp.spp = uint32_t(n);
+        smp.seed = scene.sampler.seed ^ kAovStream;
+        for (int s = 0; s < n; ++s) {
+          smp.start(uint64_t(y) * uint64_t(cam.width) + uint64_t(x), uint32_t(s));
+          float w;
+          Ray ray = sampleCameraRay(cam, smp, x, y, &w);
+          Hit h;
+          const bool found = tracer.intersect(ray, &h);
+          wsum += w;
+          size_t c = 0;
+          auto put = [&](float v) { acc[c++] += w * v; };
+          auto put3 = [&](Vec3f v) { put(v.x), put(v.y), put(v.z); };
+          SurfaceInteraction si;
+          if (found) si = sc.interaction(ray, h);
+          for (const Aov& a : scene.aovs) {
+            switch (a.type) {
+              case AovType::Albedo: {
+                Color albedo(0.f);
+                if (found) {
+                  // The directional albedo towards the camera, E[f cos / pdf] over BSDF samples:
+                  // a diffuse surface's reflectance exactly, a mirror's or glass's Fresnel
+                  // colours (what denoisers take), where Mitsuba's AOV reads only diffuse terms.
+                  BsdfScratch scratch;
+                  const Bsdf& b = sc.bsdfAt(si, &scratch);
+                  const Vec3f wo = si.shading.toLocal(-ray.d);
+                  for (int k = 0; k < kAovAlbedoSamples; ++k) {
+                    BsdfSample bs;
+                    float uc = smp.get1D();
+                    Vec2f ub = smp.get2D();
+                    if (bsdfSample(b, wo, uc, ub, &bs) && isFiniteVec(bs.weight)) albedo += bs.weight;
+                  }
+                  albedo *= 1.f / float(kAovAlbedoSamples);
+                }
+                put3(Vec3f(albedo.x, albedo.y, albedo.z));
+                break;
+              }
+              // Mitsuba's si.t: camera rays start on the near plane, so depth counts from there.
+              case AovType::Depth: put(found ? h.t : 0.f); break;
+              case AovType::Position: put3(found ? si.p : Vec3f(0.f)); break;
+              case AovType::Uv: put(found ? si.uv.x : 0.f), put(found ? si.uv.y : 0.f); break;
+              case AovType::GeoNormal: put3(found ? si.ng : Vec3f(0.f)); break;
+              case AovType::ShNormal: put3(found ? si.shading.n : Vec3f(0.f)); break;
+              case AovType::PrimIndex: put(found ? float(h.primId) : -1.f); break;
+              case AovType::ShapeIndex: put(found ? shapeOfGeom[size_t(h.geomId)] : -1.f); break;
+            }
+          }
+        }
+        const size_t pixel = size_t(y) * size_t(cam.width) + size_t(x);
+        for (size_t c = 0; c < nc; ++c) out[c].values[pixel] = wsum != 0.f ? acc[c] / wsum : 0.f;
+      }
+  };
+  tbb::task_arena arena(threads > 0 ? threads : tbb::this_task_arena::max_concurrency());
+  arena.execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, cam.height, 4), body); });
+  return out;
+}
+
+}  // namespace envgi
