@@ -84,6 +84,11 @@ void runRender(const RenderArgs& a) {
   if (!scene.aovs.empty() && ext != ".exr")
     throw std::runtime_error("AOVs are written as channels of an OpenEXR file: the output '" + a.output +
                              "' must end in .exr");
+  // The film's alpha (pixel_format rgba) is the A channel, first after R, G, B as in Mitsuba's
+  // files; only an .exr holds it.
+  if (scene.filmAlpha && ext == ".exr") scene.aovs.insert(scene.aovs.begin(), Aov{"", AovType::Alpha});
+  if (scene.filmAlpha && ext != ".exr")
+    spdlog::warn("the film's pixel_format has alpha, which only an .exr holds: {} gets RGB", a.output);
   scene.finalize();
   bool cuda = chooseCuda(a.device);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -41,6 +41,7 @@ std::vector<ImageChannel> renderAovs(const Scene& scene, const EmbreeAccel& acce
     shapeOfGeom[e.isSphere ? scene.meshes.size() + e.index : e.index] = float(i);
   }
   const EmbreeTracer tracer{&accel};
+  const bool envSeen = scene.env && !scene.integrator.hidesEmitters();
 
   auto body = [&](const tbb::blocked_range<int>& rows) {
     std::vector<float> acc(nc);
@@ -94,6 +95,9 @@ std::vector<ImageChannel> renderAovs(const Scene& scene, const EmbreeAccel& acce
               case AovType::ShNormal: put3(found ? si.shading.n : Vec3f(0.f)); break;
               case AovType::PrimIndex: put(found ? float(h.primId) : -1.f); break;
               case AovType::ShapeIndex: put(found ? shapeOfGeom[size_t(h.geomId)] : -1.f); break;
+              // Mitsuba's: where the environment is seen, every ray counts (1); where it is
+              // hidden or absent, the share of the rays that met a surface.
+              case AovType::Alpha: put(found || envSeen ? 1.f : 0.f); break;
             }
           }
         }

@@ -19,7 +19,8 @@ inline constexpr int kAovAlbedoSamples = 4;
 
 // The channels of scene.aovs, in order (aovChannelNames), over the camera's film: `samples`
 // camera samples a pixel (at most kAovMaxSamples). A pixel whose rays miss everything reads 0,
-// or -1 for the two indices. threads 0: all cores.
+// or -1 for the two indices; alpha (the film's A) is 1 where the environment is seen, else the
+// share of the rays that met a surface. threads 0: all cores.
 std::vector<ImageChannel> renderAovs(const Scene& scene, const EmbreeAccel& accel, int samples, int threads);
 
 }  // namespace envgi

@@ -75,6 +75,7 @@ std::vector<std::string> aovChannelNames(const Aov& aov) {
     case AovType::Uv: suffixes = {"U", "V"}; break;
     case AovType::PrimIndex:
     case AovType::ShapeIndex: suffixes = {"I"}; break;
+    case AovType::Alpha: return {"A"};
   }
   std::vector<std::string> out;
   for (const std::string& s : suffixes) out.push_back(aov.name + "." + s);

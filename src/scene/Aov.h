@@ -8,7 +8,8 @@
 
 namespace envgi {
 
-enum class AovType { Albedo, Depth, Position, Uv, GeoNormal, ShNormal, PrimIndex, ShapeIndex };
+// Alpha is not in Mitsuba's list: it is the film's A channel (hdrfilm's pixel_format rgba).
+enum class AovType { Albedo, Depth, Position, Uv, GeoNormal, ShNormal, PrimIndex, ShapeIndex, Alpha };
 
 struct Aov {
   std::string name;  // the channels' prefix: name.R, name.G, ...
@@ -20,7 +21,7 @@ struct Aov {
 std::vector<Aov> parseAovs(const std::string& spec);
 
 // The EXR channels an AOV fills, in order: albedo name.R/G/B, depth name.T, position and the
-// normals name.X/Y/Z, uv name.U/V, the indices name.I (Mitsuba's suffixes).
+// normals name.X/Y/Z, uv name.U/V, the indices name.I (Mitsuba's suffixes); alpha is "A".
 std::vector<std::string> aovChannelNames(const Aov& aov);
 
 }  // namespace envgi

@@ -116,6 +116,17 @@ IntegratorSettings IntegratorSettings::fromProperties(IntegratorType type, Prope
   return s;
 }
 
+bool IntegratorSettings::hidesEmitters() const {
+  switch (type) {
+    case IntegratorType::Path: return path.hideEmitters;
+    case IntegratorType::Direct: return direct.hideEmitters;
+    case IntegratorType::Photon: return photon.hideEmitters;
+    case IntegratorType::Grid: return grid.hideEmitters;
+    case IntegratorType::Sppm: return false;
+  }
+  return false;
+}
+
 void IntegratorSettings::setStrategy(const std::string& name) {
   findStrategy(name);
   env.strategy = name;

@@ -99,6 +99,8 @@ struct IntegratorSettings {
   // Sets the strategy by name (checked) with its own sample counts (bsdf: BSDF samples only,
   // mis: one of each), not those the scene file set.
   void setStrategy(const std::string& name);
+  // The hide_emitters of the integrator `type` runs (SPPM has none: false).
+  bool hidesEmitters() const;
 };
 
 }  // namespace envgi

@@ -56,6 +56,7 @@ class Scene {
   IntegratorSettings integrator;
   SamplerSettings sampler;
   std::vector<Aov> aovs;  // Mitsuba's aov integrator's list: channels written beside the image
+  bool filmAlpha = false;  // hdrfilm's pixel_format rgba (or xyza, luminance_alpha): an A channel
   std::string sourcePath;
 
   // Builds the views, the light list, the bounds and (points strategy) the collapsed map;

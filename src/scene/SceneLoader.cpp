@@ -566,7 +566,17 @@ class Loader {
     // The others change only how Mitsuba writes its file; each is still read with its type, so
     // that a misspelt value is the error it is in Mitsuba.
     for (const char* harmless : {"banner", "high_quality_edges", "sample_border"}) getBool(f, p, harmless, false);
-    for (const char* harmless : {"pixel_format", "file_format", "component_format"}) getString(f, p, harmless, "");
+    for (const char* harmless : {"file_format", "component_format"}) getString(f, p, harmless, "");
+    // Mitsuba's pixel formats: envgi writes RGB, with an A channel (in an .exr) where the format
+    // has alpha. Mitsuba's default is rgba; envgi's stays rgb unless the scene asks.
+    std::string format = getString(f, p, "pixel_format", "rgb");
+    if (format != "rgb" && format != "rgba" && format != "luminance" && format != "luminance_alpha" &&
+        format != "xyz" && format != "xyza")
+      fail(f, n, fmt::format("unknown pixel_format '{}' (rgb, rgba, luminance, luminance_alpha, xyz, xyza)", format));
+    scene_.filmAlpha = format == "rgba" || format == "xyza" || format == "luminance_alpha";
+    if (format != "rgb" && format != "rgba")
+      warnOnce(fmt::format("{}:{}: pixel_format '{}' is written as {}", f->path, f->lineOf(n.offset_debug()), format,
+                           scene_.filmAlpha ? "rgba" : "rgb"));
     reportUnused(f, p, "film", type);
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element) continue;

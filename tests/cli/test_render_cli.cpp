@@ -874,3 +874,32 @@ TEST(CliRender, AovsAreChannelsOfTheExr) {
   EXPECT_NE(badSpec.code, 0);
   EXPECT_NE(badSpec.output.find("unknown AOV type 'dept' (did you mean 'depth'?)"), std::string::npos) << badSpec.output;
 }
+
+// pixel_format rgba with the environment hidden: the .exr has an A channel, 1 on the sphere and
+// 0 in the sky; a .png gets RGB and a warning, not an error.
+TEST(CliRender, RgbaFilmWritesCoverageAsAlpha) {
+  TempDir d;
+  std::string text;
+  {
+    std::ifstream in(tinyScene(d, 16, 4));
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  const std::string film = "<film type=\"hdrfilm\">";
+  const std::string path = "<integrator type=\"path\">";
+  ASSERT_NE(text.find(film), std::string::npos);
+  text.replace(text.find(film), film.size(), film + "<string name=\"pixel_format\" value=\"rgba\"/>");
+  text.replace(text.find(path), path.size(), path + "<boolean name=\"hide_emitters\" value=\"true\"/>");
+  std::ofstream(d.file("rgba.xml")) << text;
+  CliResult r = runCli("render " + d.file("rgba.xml") + " -o " + d.file("rgba.exr") + " --no-progress");
+  ASSERT_EQ(r.code, 0) << r.output;
+  envgi::Image img = envgi::loadImage(d.file("rgba.exr"));
+  ASSERT_EQ(img.channels.size(), 1u);
+  EXPECT_EQ(img.channels[0].name, "A");
+  EXPECT_EQ(img.channels[0].values[0], 0.f) << "the top-left corner sees the hidden sky";
+  EXPECT_EQ(img.channels[0].values[15 * 16 + 8], 1.f) << "the bottom row sees the floor";
+  CliResult png = runCli("render " + d.file("rgba.xml") + " -o " + d.file("rgba.png") + " --no-progress");
+  ASSERT_EQ(png.code, 0) << png.output;
+  EXPECT_NE(png.output.find("only an .exr holds"), std::string::npos) << png.output;
+}

@@ -114,3 +114,27 @@ TEST(AovRenderer, TheSameWhateverTheThreads) {
   ASSERT_EQ(a.size(), b.size());
   for (size_t i = 0; i < a.size(); ++i) EXPECT_EQ(a[i].values, b[i].values) << a[i].name;
 }
+
+// The film's alpha, as Mitsuba's: 1 everywhere while the environment is seen; with it hidden,
+// the share of a pixel's rays that meet a surface (1 inside the plane, 0 beyond it, between on
+// its edge).
+TEST(AovRenderer, AlphaIsCoverageWhereTheEnvironmentIsHidden) {
+  Scene s = planeScene(diffuse(0.5f), diffuse(0.5f), true);
+  // Half a pixel to the right: the plane's right edge, x = 0.53125, halves pixel column 24.
+  s.meshes[0].transform(translate(Vec3f(1.f / 32.f, 0.f, 0.f)));
+  s.aovs = {Aov{"", AovType::Alpha}};
+  s.finalize();
+  EmbreeAccel accel(s);
+  std::vector<ImageChannel> seen = renderAovs(s, accel, 16, 1);
+  ASSERT_EQ(seen.size(), 1u);
+  EXPECT_EQ(seen[0].name, "A");
+  for (float v : seen[0].values) ASSERT_EQ(v, 1.f);
+  s.integrator.path.hideEmitters = true;
+  std::vector<ImageChannel> hidden = renderAovs(s, accel, 16, 1);
+  auto at = [&](int x, int y) { return hidden[0].values[size_t(y) * 32 + size_t(x)]; };
+  EXPECT_EQ(at(16, 16), 1.f);
+  EXPECT_EQ(at(0, 31), 0.f);
+  EXPECT_EQ(at(23, 16), 1.f);
+  EXPECT_NEAR(at(24, 16), 0.5f, 0.2f) << "half the pixel's rays meet the plane";
+  EXPECT_EQ(at(25, 16), 0.f);
+}

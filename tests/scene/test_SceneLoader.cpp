@@ -1183,3 +1183,21 @@ TEST(SceneLoader, AovIntegrator) {
   };
   expectErrors(f, bad);
 }
+
+// hdrfilm's pixel_format: rgba (and the other formats with alpha) asks for the film's A channel;
+// the colour is written as RGB whatever the format, said once; an unknown format is an error.
+TEST(SceneLoader, FilmPixelFormat) {
+  Fixture f;
+  for (const auto& [format, alpha] : std::vector<std::pair<std::string, bool>>{
+           {"rgb", false}, {"rgba", true}, {"xyza", true}, {"luminance", false}, {"luminance_alpha", true}}) {
+    Scene s;
+    loadScene(sensorWithFilm(f, "<string name=\"pixel_format\" value=\"" + format + "\"/>", true), {}, s);
+    EXPECT_EQ(s.filmAlpha, alpha) << format;
+  }
+  Scene s;
+  loadScene(f.scene(std::string(kSensor)), {}, s);
+  EXPECT_FALSE(s.filmAlpha) << "rgb unless the scene asks (Mitsuba's default is rgba)";
+  EXPECT_NE(loadError(sensorWithFilm(f, "<string name=\"pixel_format\" value=\"rgbx\"/>", true))
+                .find("unknown pixel_format 'rgbx'"),
+            std::string::npos);
+}
