@@ -577,13 +577,7 @@ TEST(CliCompare, ErrorsAgainstAReference) {
 TEST(CliRender, FilmSampleBorderIsAccepted) {
   TempDir d;
   std::string scene = tinyScene(d, 8, 1);
-  std::string text;
-  {
-    std::ifstream in(scene);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    text = ss.str();
-  }
+  std::string text = slurp(scene);
   text.replace(text.find("<film type=\"hdrfilm\">"), std::string("<film type=\"hdrfilm\">").size(),
                "<film type=\"hdrfilm\"><boolean name=\"sample_border\" value=\"true\"/>");
   std::ofstream(scene) << text;
@@ -794,13 +788,7 @@ TEST(CliRender, PrincipledSceneRenders) {
 // Mitsuba's volpath (a scene without media) renders as path, to the bit, and the log says so.
 TEST(CliRender, VolpathRendersAsPath) {
   TempDir d;
-  std::string text;
-  {
-    std::ifstream in(tinyScene(d, 16, 4));
-    std::stringstream ss;
-    ss << in.rdbuf();
-    text = ss.str();
-  }
+  std::string text = slurp(tinyScene(d, 16, 4));
   const std::string from = "<integrator type=\"path\">";
   ASSERT_NE(text.find(from), std::string::npos);
   std::ofstream(d.file("volpath.xml")) << std::string(text).replace(text.find(from), from.size(), "<integrator type=\"volpath\">");
@@ -842,13 +830,7 @@ TEST(CliRender, AovsAreChannelsOfTheExr) {
   EXPECT_EQ(depth->values[8], 0.f);
 
   // The same from the scene file's aov integrator around its path integrator.
-  std::string text;
-  {
-    std::ifstream in(scene);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    text = ss.str();
-  }
+  std::string text = slurp(scene);
   const std::string from = "<integrator type=\"path\"><integer name=\"max_depth\" value=\"4\"/></integrator>";
   ASSERT_NE(text.find(from), std::string::npos);
   text.replace(text.find(from), from.size(),
@@ -879,13 +861,7 @@ TEST(CliRender, AovsAreChannelsOfTheExr) {
 // 0 in the sky; a .png gets RGB and a warning, not an error.
 TEST(CliRender, RgbaFilmWritesCoverageAsAlpha) {
   TempDir d;
-  std::string text;
-  {
-    std::ifstream in(tinyScene(d, 16, 4));
-    std::stringstream ss;
-    ss << in.rdbuf();
-    text = ss.str();
-  }
+  std::string text = slurp(tinyScene(d, 16, 4));
   const std::string film = "<film type=\"hdrfilm\">";
   const std::string path = "<integrator type=\"path\">";
   ASSERT_NE(text.find(film), std::string::npos);
