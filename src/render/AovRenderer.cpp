@@ -90,7 +90,16 @@ std::vector<ImageChannel> renderAovs(const Scene& scene, const EmbreeAccel& acce
               // Mitsuba's si.t: camera rays start on the near plane, so depth counts from there.
               case AovType::Depth: put(found ? h.t : 0.f); break;
               case AovType::Position: put3(found ? si.p : Vec3f(0.f)); break;
-              case AovType::Uv: put(found ? si.uv.x : 0.f), put(found ? si.uv.y : 0.f); break;
+              case AovType::Uv: {
+                Vec2f uv = found ? si.uv : Vec2f(0.f, 0.f);
+                // interaction() leaves a sphere's (u, v) out unless its material reads them.
+                if (found && h.geomId >= sc.meshCount) {
+                  const SphereView& sp = sc.spheres[h.geomId - sc.meshCount];
+                  uv = sphereUv(sp, normalize(si.p - sp.center));
+                }
+                put(uv.x), put(uv.y);
+                break;
+              }
               case AovType::GeoNormal: put3(found ? si.ng : Vec3f(0.f)); break;
               case AovType::ShNormal: put3(found ? si.shading.n : Vec3f(0.f)); break;
               case AovType::PrimIndex: put(found ? float(h.primId) : -1.f); break;

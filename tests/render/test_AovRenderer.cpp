@@ -83,6 +83,10 @@ TEST(AovRenderer, APlaneHeadOnGivesItsDepthNormalAndAlbedo) {
   EXPECT_EQ(at("s.I", sx, sy), 0.f);
   EXPECT_NEAR(at("alb.R", sx, sy), 0.8f, 1e-5f);
   EXPECT_NEAR(at("alb.B", sx, sy), 0.4f, 1e-5f);
+  // Its (u, v) though its material reads none (interaction() leaves them out): seen from above,
+  // the pixel holds polar angles up to asin(0.044 / 0.1), v = theta / pi about 0.06 on average.
+  EXPECT_GT(at("t.V", sx, sy), 0.03f);
+  EXPECT_LT(at("t.V", sx, sy), 0.1f);
   // Its cap over the pixel's square [-a, a]^2 (a = 1/32) lies sqrt(r^2 - x^2 - y^2) above its
   // centre, r - 2 a^2 / (3 * 2 r) on average to second order.
   const float a = 1.f / 32.f, cap = 0.1f - 2.f * a * a / 3.f / 0.2f;
