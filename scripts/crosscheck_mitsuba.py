@@ -297,7 +297,7 @@ def main():
     ap.add_argument('--res', type=int, default=48)
     ap.add_argument('--only', default='', help='substring of the configurations to run')
     ap.add_argument('--all-regions', action='store_true', help='print every region of each configuration, not the worst')
-    ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,textured,microfacets,brushed,bunny-sunrise,normal-map,principled,mask,orthographic,blend,instances',
+    ap.add_argument('--scene-names', default='buddha,cornell-box,teapot-glass,textured,microfacets,brushed,bunny-sunrise,normal-map,principled,mask,orthographic,blend,instances,textured-light',
                     help='comma-separated scenes (XML files in --scenes, without .xml)')
     args = ap.parse_args()
     rows = []

@@ -74,7 +74,8 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
   if (sc.lightCount == 0) return false;
   float pmf;
   Vec3f p, n;
-  const LightPrim& lp = sampleAreaLight(sc, u2, u, &pmf, &p, &n);
+  Color Le;
+  const LightPrim& lp = sampleAreaLight(sc, u2, u, &pmf, &p, &n, &Le);
   Vec3f d = p - si.p;
   float dist2 = lengthSq(d);
   if (dist2 <= 0.f) return false;
@@ -84,7 +85,7 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
   if (cosL <= 0.f) return false;  // one-sided emitters face along their normal
   ls->dir = d;
   ls->dist = dist;
-  ls->radiance = lp.radiance;
+  ls->radiance = Le;
   ls->pdf = pa * pmf / lp.area * dist2 / cosL;
   ls->environment = false;
   ls->delta = false;

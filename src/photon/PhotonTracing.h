@@ -76,14 +76,15 @@ struct PhotonEmitter {
     if (sc.lightCount == 0) return false;
     float pmf;
     Vec3f p, n;
-    const LightPrim& lp = sampleAreaLight(sc, u2, u1, &pmf, &p, &n);
+    Color Le;
+    const LightPrim& lp = sampleAreaLight(sc, u2, u1, &pmf, &p, &n, &Le);
     Vec2f u3 = smp.get2D();
     Vec3f dir = Frame::fromNormal(n).toWorld(sampleCosineHemisphere(u3));
     ray->o = offsetRayOrigin(p, n, dir, 0.f);
     ray->d = normalize(dir);
     ray->tMax = INFINITY;
     // Le cos / (pdf_area pdf_dir) with pdf_dir = cos / pi.
-    *power = lp.radiance * (kPi * lp.area / (pmf * areaProb));
+    *power = Le * (kPi * lp.area / (pmf * areaProb));
     return true;
   }
 };

@@ -46,7 +46,8 @@ void Scene::finalize() {
       hi = vmax(hi, sp.center + Vec3f(sp.radius));
       if (s.emissive) {
         v.light = int(lights_.size());
-        lights_.push_back({int(meshes.size() + s.index), 0, s.radiance, 4.f * kPi * sp.radius * sp.radius});
+        lights_.push_back(
+            {int(meshes.size() + s.index), 0, s.radiance, 4.f * kPi * sp.radius * sp.radius, s.radianceTexture});
       }
     } else {
       const TriangleMesh& m = meshes[s.index];
@@ -67,7 +68,8 @@ void Scene::finalize() {
         for (size_t t = 0; t < m.triangleCount(); ++t) {
           Vec3f p0 = m.positions[m.indices[3 * t]], p1 = m.positions[m.indices[3 * t + 1]],
                 p2 = m.positions[m.indices[3 * t + 2]];
-          lights_.push_back({int(s.index), int(t), s.radiance, 0.5f * length(cross(p1 - p0, p2 - p0))});
+          lights_.push_back(
+              {int(s.index), int(t), s.radiance, 0.5f * length(cross(p1 - p0, p2 - p0)), s.radianceTexture});
         }
       }
     }

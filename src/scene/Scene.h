@@ -34,7 +34,8 @@ struct ShapeEntry {
   size_t index = 0;  // into meshes or spheres
   int bsdf = 0;
   bool emissive = false;
-  Color radiance;
+  Color radiance;            // an area light's; with a texture, the texture's mean (its power)
+  int radianceTexture = -1;  // an area light's radiance texture, read at the (u, v) it leaves from
 };
 
 struct SamplerSettings {

@@ -677,16 +677,37 @@ class Loader {
     checkAttrs(f, n, {"type", "id", "name"});
     std::string type = attr(f, n, "type");
     Props p = collectProps(f, n);
+    int radianceTexture = -1;
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element || isPropTag(c.name())) continue;
-      if (std::string(c.name()) != "texture") fail(f, c, fmt::format("unexpected <{}> in <emitter>", c.name()));
+      const std::string tag = c.name(), name = c.attribute("name").as_string();
+      // An area light's radiance may be a texture (nested or a <ref>), read where light leaves.
+      if (type == "area" && name == "radiance" && (tag == "texture" || tag == "ref")) {
+        if (radianceTexture >= 0 || p.count("radiance")) fail(f, c, "the area emitter's radiance is given twice");
+        if (tag == "texture") {
+          radianceTexture = texture(f, c);
+        } else {
+          checkAttrs(f, c, {"id", "name"});
+          auto it = textureIds_.find(attr(f, c, "id"));
+          if (it == textureIds_.end()) fail(f, c, fmt::format("unknown texture id '{}'", attr(f, c, "id")));
+          radianceTexture = it->second.index;
+        }
+        continue;
+      }
+      if (tag != "texture") fail(f, c, fmt::format("unexpected <{}> in <emitter>", tag));
       warnOnce(fmt::format("{}:{}: a texture for '{}' of emitter '{}' is not supported; the property keeps its default",
-                           f->path, f->lineOf(c.offset_debug()), c.attribute("name").as_string(), type));
+                           f->path, f->lineOf(c.offset_debug()), name, type));
     }
     if (type == "area") {
       if (!shape) fail(f, n, "an 'area' emitter must be inside a <shape>");
       shape->emissive = true;
       shape->radiance = getColor(f, p, "radiance", Color(1.f));
+      if (radianceTexture >= 0) {
+        // The texture's mean stands for the light's power when next-event estimation and the
+        // photon pass choose among lights.
+        shape->radianceTexture = radianceTexture;
+        shape->radiance = textureMean(scene_.textures[size_t(radianceTexture)]);
+      }
     } else if (shape) {
       fail(f, n, fmt::format("only 'area' emitters can be inside a <shape>, not '{}'", type));
     } else if (type == "envmap" || type == "constant") {

@@ -40,8 +40,9 @@ struct SphereView {
 struct LightPrim {
   int geomId;    // scene geometry numbering (meshes, then spheres)
   int primId;
-  Color radiance;
+  Color radiance;  // with a texture, its mean: the primitive's power for the choice among lights
   float area;
+  int radianceTexture;  // -1: radiance everywhere; else read at the (u, v) the light leaves from
 };
 
 struct SurfaceInteraction {
@@ -177,7 +178,8 @@ struct SceneView {
       int bsdf = s.bsdf;
       if (bsdfIsBlend(bsdfs[bsdf]))
         bsdf = blendChoice(bsdf, sphereUv(s, n), ray, h.geomId, dot(n, ray.d) > 0.f ? 1u : 0u);
-      si.uv = bsdfHasTexture(bsdfs[bsdf]) ? sphereUv(s, n) : Vec2f(0.f, 0.f);
+      const bool texturedLight = s.light >= 0 && lights[s.light].radianceTexture >= 0;
+      si.uv = bsdfHasTexture(bsdfs[bsdf]) || texturedLight ? sphereUv(s, n) : Vec2f(0.f, 0.f);
       Vec3f radial = n;
       if (s.flipNormals) n = -n;
       si.ng = n;
@@ -311,21 +313,28 @@ struct SceneView {
     }
   }
 
+  // The radiance a light primitive emits at (u, v): its texture there, if it has one.
+  ENVGI_HD Color lightRadiance(const LightPrim& lp, Vec2f uv) const {
+    return lp.radianceTexture >= 0 ? textureEval(textures[lp.radianceTexture], uv) : lp.radiance;
+  }
   // Emitted radiance leaving a light primitive towards w (one-sided, like Mitsuba's area).
   ENVGI_HD Color emitted(const SurfaceInteraction& si, Vec3f w) const {
     if (si.light < 0 || dot(si.ng, w) <= 0.f) return Color(0.f);
-    return lights[si.light].radiance;
+    return lightRadiance(lights[si.light], si.uv);
   }
 };
 
-// Uniform point on a light primitive: its position and normal (the area pdf is 1 / area).
-ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2f u, Vec3f* p, Vec3f* n) {
+// Uniform point on a light primitive: its position, normal and the radiance it emits there
+// (the area pdf is 1 / area).
+ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2f u, Vec3f* p, Vec3f* n, Color* Le) {
+  *Le = lp.radiance;
   if (lp.geomId < sc.meshCount) {
     const MeshView& m = sc.meshes[lp.geomId];
     uint32_t i0 = m.indices[3 * lp.primId], i1 = m.indices[3 * lp.primId + 1], i2 = m.indices[3 * lp.primId + 2];
     Vec3f p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
     Vec2f b = sampleUniformTriangle(u);
     *p = p0 * (1.f - b.x - b.y) + p1 * b.x + p2 * b.y;
+    if (lp.radianceTexture >= 0) *Le = sc.lightRadiance(lp, meshUv(m, i0, i1, i2, b.x, b.y));
     Vec3f ng = normalize(cross(p1 - p0, p2 - p0));
     if (m.normals) {
       Vec3f ns = m.normals[i0] + m.normals[i1] + m.normals[i2];
@@ -337,14 +346,17 @@ ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2
     Vec3f d = sampleUniformSphere(u);
     *p = s.center + d * s.radius;
     *n = s.flipNormals ? -d : d;
+    if (lp.radianceTexture >= 0) *Le = sc.lightRadiance(lp, sphereUv(s, d));
   }
 }
 
-// Picks an area-light primitive by power (u2) and a uniform point on it (u).
-ENVGI_INLINE const LightPrim& sampleAreaLight(const SceneView& sc, Vec2f u2, Vec2f u, float* pmf, Vec3f* p, Vec3f* n) {
+// Picks an area-light primitive by power (u2) and a uniform point on it (u), with the radiance
+// it emits there.
+ENVGI_INLINE const LightPrim& sampleAreaLight(const SceneView& sc, Vec2f u2, Vec2f u, float* pmf, Vec3f* p, Vec3f* n,
+                                              Color* Le) {
   int li = sc.lightSelect.sample(u2, pmf, nullptr);
   const LightPrim& lp = sc.lights[li];
-  sampleLightPrim(sc, lp, u, p, n);
+  sampleLightPrim(sc, lp, u, p, n, Le);
   return lp;
 }
 

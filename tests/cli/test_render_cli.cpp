@@ -714,6 +714,7 @@ void expectPathAndSppmAgree(const std::string& name) {
 
 TEST(CliRender, OrthographicSceneRenders) { expectPathAndSppmAgree("orthographic"); }
 TEST(CliRender, InstancesSceneRenders) { expectPathAndSppmAgree("instances"); }
+TEST(CliRender, TexturedLightSceneRenders) { expectPathAndSppmAgree("textured-light"); }
 
 // A scene written with a shapegroup and instances renders the same to the bit as the same
 // shapes written out one by one with the instances' to_world (path, 32^2, 8 spp).

@@ -96,7 +96,7 @@ void pointLightsToSpots(Scene* s) {
 
 TEST(GpuRender, ZTestAgainstCpuOnBundledScenes) {
   std::vector<Case> cases;
-  for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured", "microfacets", "brushed", "sun-and-sky", "normal-map", "principled", "mask", "orthographic", "blend", "instances"})
+  for (std::string sc : {"buddha", "cornell-box", "teapot-glass", "textured", "microfacets", "brushed", "sun-and-sky", "normal-map", "principled", "mask", "orthographic", "blend", "instances", "textured-light"})
     cases.push_back({sc, "path", "mis"});
   cases.push_back({"textured", "path", "mis", 0.2f});
   cases.push_back({"sun-and-sky", "path", "mis", 0.f, true});

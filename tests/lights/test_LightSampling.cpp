@@ -11,7 +11,10 @@
 #include "integrators/NextEvent.h"
 #include "lights/LightSampling.h"
 #include "sampling/Pcg32.h"
+#include "render/Renderer.h"
+#include "scene/NameTables.h"
 #include "scene/SceneLoader.h"
+#include "support/TestScenes.h"
 
 using namespace envgi;
 
@@ -38,8 +41,10 @@ struct LitScene {
   Vec3f normal;
 };
 
-// A 0.8 x 0.8 square light of radiance 3 at height 1, turned by tiltDeg about x from facing down.
-std::unique_ptr<LitScene> squareLight(float tiltDeg) {
+// A 0.8 x 0.8 square light of radiance 3 (or `emitter`'s) at height 1, turned by tiltDeg about x
+// from facing down.
+std::unique_ptr<LitScene> squareLight(float tiltDeg,
+                                      const std::string& emitter = R"(<rgb name="radiance" value="3"/>)") {
   auto s = std::make_unique<LitScene>();
   test::TempDir dir;
   std::string path = dir.file("light.xml");
@@ -48,7 +53,7 @@ std::unique_ptr<LitScene> squareLight(float tiltDeg) {
     <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
   <shape type="rectangle"><transform name="to_world"><scale value="0.4"/><rotate x="1" angle=")"
                       << 90.f + tiltDeg << R"("/><translate y="1"/></transform>
-    <emitter type="area"><rgb name="radiance" value="3"/></emitter></shape>
+    <emitter type="area">)" << emitter << R"(</emitter></shape>
   <shape type="rectangle"><transform name="to_world"><scale value="3"/><rotate x="1" angle="-90"/></transform></shape>
 </scene>)";
   loadScene(path, {}, s->scene);
@@ -118,6 +123,75 @@ TEST(LightSampling, AreaLightIrradianceMatchesLambertsFormula) {
       double est = estimatedIrradiance(sc, p, 200000);
       EXPECT_NEAR(est, exact, 0.01 * exact + 1e-4) << "tilt " << tilt << " at " << p.x << "," << p.y << "," << p.z;
     }
+  }
+}
+
+// A light whose radiance is a checkerboard texture (9 on the squares where u and v lie in the
+// same half, 1 on the others): its irradiance is the sum of each square's, Lambert's formula
+// for each, at next-event estimation's samples and through prepareLd's shadow rays.
+TEST(LightSampling, TexturedAreaLightIsTheSumOfItsSquares) {
+  const std::string checks = R"(<texture type="checkerboard" name="radiance"><rgb name="color0" value="9"/>
+    <rgb name="color1" value="1"/></texture>)";
+  for (float tilt : {0.f, 30.f}) {
+    auto s = squareLight(tilt, checks);
+    const SceneView& sc = s->scene.view();
+    ASSERT_GT(sc.lightCount, 0);
+    EXPECT_EQ(sc.lights[0].radianceTexture, 0);
+    EXPECT_FLOAT_EQ(sc.lights[0].radiance.y, 5.f) << "the texture's mean stands for its power";
+    // The rectangle's (u, v) = ((x + 1) / 2, (y + 1) / 2) in its own frame: its quadrants, each
+    // counter-clockwise about the emitting normal, with their radiance.
+    const float t = (90.f + tilt) * kPi / 180.f;
+    auto place = [&](float x, float y) {
+      Vec3f v(x * 0.4f, y * 0.4f, 0.f);
+      return Vec3f(v.x, v.y * std::cos(t) - v.z * std::sin(t), v.y * std::sin(t) + v.z * std::cos(t)) + Vec3f(0, 1, 0);
+    };
+    auto quad = [&](float x0, float y0) {
+      return std::vector<Vec3f>{place(x0, y0), place(x0 + 1, y0), place(x0 + 1, y0 + 1), place(x0, y0 + 1)};
+    };
+    EmbreeAccel accel(s->scene);
+    EmbreeTracer tracer{&accel};
+    for (Vec3f p : {Vec3f(0, 0, 0), Vec3f(0.3f, 0, 0.5f), Vec3f(0.8f, 0, -1.f)}) {
+      double exact = polygonIrradiance(quad(-1, -1), s->normal, p, Vec3f(0, 1, 0), 9.0) +
+                     polygonIrradiance(quad(0, 0), s->normal, p, Vec3f(0, 1, 0), 9.0) +
+                     polygonIrradiance(quad(0, -1), s->normal, p, Vec3f(0, 1, 0), 1.0) +
+                     polygonIrradiance(quad(-1, 0), s->normal, p, Vec3f(0, 1, 0), 1.0);
+      double uniform = polygonIrradiance(s->corners, s->normal, p, Vec3f(0, 1, 0), 5.0);
+      EXPECT_NEAR(estimatedIrradiance(sc, p, 200000), exact, 0.01 * exact + 1e-4) << "tilt " << tilt << " at " << p.x << "," << p.z;
+      EXPECT_NEAR(shadowedIrradiance(sc, tracer, p, 200000), exact, 0.015 * exact + 1e-4) << "tilt " << tilt;
+      // Off the light's axis the squares nearer p weigh more: a uniform light of the mean is off.
+      if (p.x != 0.f) EXPECT_GT(std::fabs(exact - uniform), 0.03 * exact) << "tilt " << tilt << " at " << p.x;
+    }
+  }
+}
+
+// A camera sees a textured light's texture, in every integrator that shows emitters: a
+// checkerboard (9 and 1) rectangle filling an orthographic view reads 9 and 1 in its quadrants.
+TEST(LightSampling, ATexturedLightSeenDirectlyShowsItsTexture) {
+  for (IntegratorType type : {IntegratorType::Path, IntegratorType::Direct, IntegratorType::Photon,
+                              IntegratorType::Sppm, IntegratorType::Grid}) {
+    Scene s;
+    s.meshes.push_back(makeRectangle());
+    s.textures.push_back(test::checkerboard(9.f, 1.f));
+    Bsdf black;
+    black.reflectance = Color(0.f);
+    s.bsdfs.push_back(black);
+    ShapeEntry e{false, 0, 0, true, Color(5.f)};
+    e.radianceTexture = 0;
+    s.shapes.push_back(e);
+    s.camera.toWorld = lookAt(Vec3f(0, 0, 5), Vec3f(0, 0, 0), Vec3f(0, 1, 0));
+    s.camera.width = s.camera.height = 8;
+    s.camera.orthographic = true;
+    s.camera.tanHalfX = s.camera.tanHalfY = 1.f;
+    s.camera.filter = makeFilter(FilterType::Box);
+    s.sampler.sampleCount = 4;
+    s.integrator.type = type;
+    Image img = test::renderedImage(s);
+    // Looking down -z, image right is world +x: the top-left pixel sees x < 0, y > 0 (colour 1),
+    // the top-right x > 0, y > 0 (colour 0).
+    EXPECT_NEAR(img.at(1, 1).y, 1.f, 1e-4f) << integratorName(type);
+    EXPECT_NEAR(img.at(6, 1).y, 9.f, 1e-4f) << integratorName(type);
+    EXPECT_NEAR(img.at(6, 6).y, 1.f, 1e-4f) << integratorName(type);
+    EXPECT_NEAR(img.at(1, 6).y, 9.f, 1e-4f) << integratorName(type);
   }
 }
 

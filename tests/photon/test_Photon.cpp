@@ -364,6 +364,37 @@ TEST(PhotonEmission, ConstantSkyDeliversPiLAToAPlane) {
   EXPECT_NEAR(arrived, expected, 0.02 * expected);
 }
 
+// An area light whose radiance is a checkerboard texture (9 and 1) sends each square's photons
+// with that square's flux, pi L A: 9 : 1 between the squares, where the texture's mean on every
+// photon would give 1 : 1 and the same total.
+TEST(PhotonEmission, TexturedAreaLightEmitsEachSquaresFlux) {
+  auto s = std::make_unique<Scene>();
+  TriangleMesh m = makeRectangle();  // [-1, 1]^2 at z = 0 facing +z; (u, v) = ((x + 1) / 2, (y + 1) / 2)
+  s->meshes.push_back(m);
+  s->textures.push_back(test::checkerboard(9.f, 1.f));
+  s->bsdfs.push_back(Bsdf{});
+  ShapeEntry e{false, 0, 0, true, Color(5.f)};
+  e.radianceTexture = 0;
+  s->shapes.push_back(e);
+  s->camera.width = s->camera.height = 4;
+  s->finalize();
+  PhotonEmitter em = makePhotonEmitter(*s);
+  const SceneView& sc = s->view();
+  const int n = 400000;
+  double flux[2] = {0.0, 0.0};  // squares of colour 0 (u and v in the same half), of colour 1
+  Sampler smp;
+  for (int i = 0; i < n; ++i) {
+    smp.start(uint64_t(i), 0);
+    Ray r;
+    Color pw;
+    if (!em.emit(sc, smp, &r, &pw)) continue;
+    flux[(r.o.x < 0.f) == (r.o.y < 0.f) ? 0 : 1] += pw.y / n;
+  }
+  // Two squares of area 1 each a colour: pi * 9 * 2 and pi * 1 * 2.
+  EXPECT_NEAR(flux[0], kPi * 18.0, 0.02 * kPi * 18.0);
+  EXPECT_NEAR(flux[1], kPi * 2.0, 0.02 * kPi * 2.0);
+}
+
 // Which materials a photon estimate stands in for: a rough conductor only where it is rough
 // both ways (an anisotropic one sharp along either axis is followed like a mirror).
 TEST(SpecularChain, AnisotropicConductorIsDiffuseLikeOnlyWhenRoughBothWays) {

@@ -465,10 +465,9 @@ TEST(SceneLoader, HarmlessUnsupportedElementsOnlyWarn) {
     <emitter type="projector"/>
     <phase type="hg"/>
     <shape type="sphere"><float name="silhouette_sampling_weight" value="1"/></shape>
-    <shape type="sphere"><emitter type="area"><texture type="checkerboard" name="radiance"/></emitter></shape>)"),
+    <emitter type="spot"><texture type="checkerboard" name="texture"/></emitter>)"),
                             {}, s));
-  ASSERT_EQ(s.shapes.size(), 2u);  // shapes[1] is read below
-  EXPECT_EQ(s.shapes[1].radiance.x, 1.f) << "an emitter's texture keeps the default radiance";
+  ASSERT_EQ(s.deltaLights.size(), 1u) << "a spot's projected texture is left out; the spot stays";
 }
 
 // A property that no Mitsuba plugin of that type takes is an error, as Mitsuba's "Unreferenced
@@ -1200,4 +1199,38 @@ TEST(SceneLoader, FilmPixelFormat) {
   EXPECT_NE(loadError(sensorWithFilm(f, "<string name=\"pixel_format\" value=\"rgbx\"/>", true))
                 .find("unknown pixel_format 'rgbx'"),
             std::string::npos);
+}
+
+// An area emitter's radiance as a texture (nested or a <ref>): the shape keeps the texture and
+// its mean (for the choice among lights); given with a radiance value too, or a <ref> to an
+// unknown id, it is an error; a texture on another emitter's property is still only warned about.
+TEST(SceneLoader, TexturedAreaEmitter) {
+  Fixture f;
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <texture type="checkerboard" id="checks"><rgb name="color0" value="4"/><rgb name="color1" value="2"/></texture>
+    <shape type="rectangle"><emitter type="area"><texture type="bitmap" name="radiance">
+      <string name="filename" value="sky.exr"/></texture></emitter></shape>
+    <shape type="sphere"><emitter type="area"><ref id="checks" name="radiance"/></emitter></shape>)"),
+            {}, s);
+  ASSERT_EQ(s.shapes.size(), 2u);
+  EXPECT_TRUE(s.shapes[0].emissive);
+  ASSERT_GE(s.shapes[0].radianceTexture, 0);
+  EXPECT_FLOAT_EQ(s.shapes[0].radiance.x, 0.5f) << "the bitmap's mean";
+  EXPECT_EQ(s.shapes[1].radianceTexture, 0) << "the named checkerboard";
+  EXPECT_FLOAT_EQ(s.shapes[1].radiance.y, 3.f);
+  EXPECT_EQ(s.view().lights[0].radianceTexture, s.shapes[0].radianceTexture);
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<shape type="sphere"><emitter type="area"><rgb name="radiance" value="2"/>
+        <texture type="checkerboard" name="radiance"/></emitter></shape>)",
+       "the area emitter's radiance is given twice"},
+      {R"(<shape type="sphere"><emitter type="area"><texture type="checkerboard" name="radiance"/>
+        <texture type="checkerboard" name="radiance"/></emitter></shape>)",
+       "the area emitter's radiance is given twice"},
+      {R"(<shape type="sphere"><emitter type="area"><ref id="nowhere" name="radiance"/></emitter></shape>)",
+       "unknown texture id 'nowhere'"},
+      {R"(<shape type="sphere"><emitter type="area"><bsdf type="diffuse"/></emitter></shape>)",
+       "unexpected <bsdf> in <emitter>"},
+  };
+  expectErrors(f, bad);
 }

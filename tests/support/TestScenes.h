@@ -68,9 +68,8 @@ inline std::unique_ptr<Scene> sphereOnFloor(const Bsdf& floor, const Bsdf& ball,
   return s;
 }
 
-// The scene finalized and rendered on the CPU (no non-finite samples): the mean of its pixels'
-// luminance.
-inline double renderedMean(Scene& s) {
+// The scene finalized and rendered on the CPU, with no non-finite samples.
+inline Image renderedImage(Scene& s) {
   s.finalize();
   EmbreeAccel accel(s);
   RenderOptions o;
@@ -78,6 +77,12 @@ inline double renderedMean(Scene& s) {
   RenderStats st;
   Image img = render(s, accel, o, &st);
   EXPECT_EQ(st.nonFiniteSamples, 0u);
+  return img;
+}
+
+// The mean of renderedImage's pixels' luminance.
+inline double renderedMean(Scene& s) {
+  Image img = renderedImage(s);
   double sum = 0.0;
   for (int y = 0; y < img.height; ++y)
     for (int x = 0; x < img.width; ++x) sum += img.at(x, y).y;
