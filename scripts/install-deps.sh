@@ -5,7 +5,7 @@ set -euo pipefail
 
 PKGS=(
   build-essential cmake ninja-build pkg-config git ca-certificates
-  libembree-dev libtbb-dev libopenexr-dev libstb-dev libjpeg62-turbo-dev
+  libembree-dev libtbb-dev libopenexr-dev libstb-dev libjpeg62-turbo-dev zlib1g-dev
   libtinyobjloader-dev libpugixml-dev libcli11-dev nlohmann-json3-dev
   libfmt-dev libspdlog-dev libnanoflann-dev
   libgtest-dev libbenchmark-dev

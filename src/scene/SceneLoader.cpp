@@ -1296,10 +1296,12 @@ class Loader {
       if (!(t.radius > 0.f)) fail(f, n, "sphere radius must be positive");
       t.isSphere = true;
     } else {
-      t.fromFile = type == "ply" || type == "obj";
+      t.fromFile = type == "ply" || type == "obj" || type == "serialized";
       t.faceNormals = getBool(f, p, "face_normals", false);
-      // Mitsuba's mesh loaders flip v by default: files give v up the image, bitmaps store rows down.
-      bool flipUv = t.fromFile && getBool(f, p, "flip_tex_coords", true);
+      // Mitsuba's ply and obj loaders flip v by default: files give v up the image, bitmaps store
+      // rows down. Its serialized loader keeps v as stored.
+      bool flipUv = (type == "ply" || type == "obj") && getBool(f, p, "flip_tex_coords", true);
+      const int shapeIndex = type == "serialized" ? getInt(f, p, "shape_index", 0) : 0;
       try {
         if (t.fromFile) {
           std::string file = getString(f, p, "filename", "");
@@ -1307,7 +1309,13 @@ class Loader {
           reportUnused(f, p, "shape", type);  // a misspelt property before a large mesh's load, not after
           fs::path path = fs::path(f->path).parent_path() / file;
           if (!fs::exists(path)) fail(f, n, fmt::format("mesh file '{}' does not exist", path.string()));
-          t.mesh = type == "ply" ? loadPly(path.string()) : loadObj(path.string());
+          if (type == "serialized") {
+            bool fileFaceNormals = false;
+            t.mesh = loadSerialized(path.string(), shapeIndex, &fileFaceNormals);
+            t.faceNormals = t.faceNormals || fileFaceNormals;  // the file's flag means face_normals
+          } else {
+            t.mesh = type == "ply" ? loadPly(path.string()) : loadObj(path.string());
+          }
         } else if (type == "rectangle") {
           t.mesh = makeRectangle();
         } else if (type == "cube") {
@@ -1319,8 +1327,8 @@ class Loader {
                                 getFloat(f, p, "radius", 1.f));
         } else {
           fail(f, n,
-               fmt::format("unknown shape type '{}' (ply, obj, sphere, rectangle, cube, disk, cylinder, shapegroup, "
-                           "instance)",
+               fmt::format("unknown shape type '{}' (ply, obj, serialized, sphere, rectangle, cube, disk, cylinder, "
+                           "shapegroup, instance)",
                            type));
         }
       } catch (const std::runtime_error& e) {

@@ -32,6 +32,10 @@ struct TriangleMesh {
 TriangleMesh loadPly(const std::string& path);
 // Wavefront OBJ through tinyobjloader; all groups become one mesh.
 TriangleMesh loadObj(const std::string& path);
+// Mitsuba's .serialized (versions 3 and 4; zlib): mesh shapeIndex of the file, its positions,
+// normals and (u, v) where it has them (vertex colours are skipped, as Mitsuba does);
+// *faceNormals, where given, gets the file's face-normals flag.
+TriangleMesh loadSerialized(const std::string& path, int shapeIndex = 0, bool* faceNormals = nullptr);
 
 // Mitsuba's analytic shapes as meshes: rectangle [-1,1]^2 at z=0 facing +z, cube [-1,1]^3,
 // disk of radius 1 at z=0 facing +z (tessellated into `segments` triangles), and the open

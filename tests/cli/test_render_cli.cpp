@@ -12,6 +12,7 @@
 
 #include "cli/CliRunner.h"
 #include "image/Image.h"
+#include "support/SerializedFile.h"
 
 using namespace envgi::test;
 namespace fs = std::filesystem;
@@ -879,4 +880,36 @@ TEST(CliRender, RgbaFilmWritesCoverageAsAlpha) {
   CliResult png = runCli("render " + d.file("rgba.xml") + " -o " + d.file("rgba.png") + " --no-progress");
   ASSERT_EQ(png.code, 0) << png.output;
   EXPECT_NE(png.output.find("only an .exr holds"), std::string::npos) << png.output;
+}
+
+// Mitsuba's serialized shape: the bunny written as the second mesh of a .serialized file renders
+// the same to the bit as the scene's PLY (shape_index 1; the file's other mesh is a triangle).
+TEST(CliRender, SerializedMeshRendersAsItsPly) {
+  TempDir d;
+  const std::string src = std::string(ENVGI_SOURCE_DIR) + "/scenes/";
+  envgi::TriangleMesh bunny = envgi::loadPly(src + "meshes/bun_zipper_res2.ply");
+  MeshData tri;
+  tri.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  tri.indices = {0, 1, 2};
+  const std::string file = writeSerialized(d, "meshes.serialized", {tri, meshData(bunny)});
+  std::string text = slurp(src + "bunny-sunrise.xml");
+  const std::string ply = "<shape type=\"ply\">\n        <string name=\"filename\" value=\"meshes/bun_zipper_res2.ply\"/>";
+  ASSERT_NE(text.find(ply), std::string::npos);
+  for (const char* dir : {"envmaps/", "meshes/"})
+    for (size_t at = text.find(std::string("value=\"") + dir); at != std::string::npos;
+         at = text.find(std::string("value=\"") + dir, at + 8))
+      text.insert(at + 7, src);
+  std::ofstream(d.file("ply.xml")) << text;
+  const std::string plyAbs = "<shape type=\"ply\">\n        <string name=\"filename\" value=\"" + src + "meshes/bun_zipper_res2.ply\"/>";
+  ASSERT_NE(text.find(plyAbs), std::string::npos);
+  text.replace(text.find(plyAbs), plyAbs.size(),
+               "<shape type=\"serialized\"><string name=\"filename\" value=\"" + file +
+                   "\"/><integer name=\"shape_index\" value=\"1\"/>");
+  std::ofstream(d.file("serialized.xml")) << text;
+  for (const char* name : {"ply", "serialized"}) {
+    CliResult r = runCli(std::string("render ") + d.file(std::string(name) + ".xml") + " -o " +
+                         d.file(std::string(name) + ".exr") + " -D res=32 -D spp=4 --threads 1 --no-progress");
+    ASSERT_EQ(r.code, 0) << name << ": " << r.output;
+  }
+  EXPECT_EQ(slurp(d.file("ply.exr")), slurp(d.file("serialized.exr")));
 }

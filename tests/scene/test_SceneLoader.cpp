@@ -9,6 +9,7 @@
 #include "envmap/LightProbe.h"
 #include "materials/BsdfFactory.h"
 #include "scene/SceneLoader.h"
+#include "support/SerializedFile.h"
 
 using namespace envgi;
 
@@ -1231,6 +1232,38 @@ TEST(SceneLoader, TexturedAreaEmitter) {
        "unknown texture id 'nowhere'"},
       {R"(<shape type="sphere"><emitter type="area"><bsdf type="diffuse"/></emitter></shape>)",
        "unexpected <bsdf> in <emitter>"},
+  };
+  expectErrors(f, bad);
+}
+
+// Mitsuba's serialized shape: shape_index picks the mesh, the file's face-normal flag means
+// face_normals, to_world applies as to the other meshes; errors name the line.
+TEST(SceneLoader, SerializedShape) {
+  Fixture f;
+  test::MeshData a, b;
+  a.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  a.indices = {0, 1, 2};
+  b = a;
+  b.normals = {0, 0, 1, 0, 0, 1, 0, 0, 1};
+  b.faceNormals = true;
+  test::writeSerialized(f.dir, "m.serialized", {a, b});
+  Scene s;
+  loadScene(f.scene(std::string(kSensor) + R"(
+    <shape type="serialized"><string name="filename" value="m.serialized"/></shape>
+    <shape type="serialized"><string name="filename" value="m.serialized"/><integer name="shape_index" value="1"/>
+      <transform name="to_world"><translate x="2"/></transform></shape>)"),
+            {}, s);
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_EQ(s.meshes[0].normals.size(), 3u) << "computed, as for a PLY without normals";
+  EXPECT_TRUE(s.meshes[1].normals.empty()) << "the file's face-normal flag";
+  EXPECT_FLOAT_EQ(s.meshes[1].positions[1].x, 3.f);
+  const std::pair<const char*, const char*> bad[] = {
+      {R"(<shape type="serialized"><string name="filename" value="m.serialized"/><integer name="shape_index" value="2"/></shape>)",
+       "shape_index 2 is out of range (the file holds 2 meshes)"},
+      {R"(<shape type="serialized"><string name="filename" value="tri.ply"/></shape>)", "not a Mitsuba .serialized mesh"},
+      {R"(<shape type="serialized"><string name="filename" value="none.serialized"/></shape>)", "does not exist"},
+      {R"(<shape type="serialized"><string name="filename" value="m.serialized"/><integer name="shape_indx" value="1"/></shape>)",
+       "shape 'serialized' has no property 'shape_indx' (did you mean 'shape_index'?)"},
   };
   expectErrors(f, bad);
 }
