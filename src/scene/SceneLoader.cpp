@@ -1272,6 +1272,7 @@ class Loader {
                    : fmt::format("unknown shapegroup id '{}' (a shapegroup is defined before its instances)", id));
         group = &it->second;
       } else if (tag == "shape" && std::string(c.attribute("type").as_string()) == "shapegroup") {
+        checkAttrs(f, c, {"type", "id", "name"});
         inlineGroup = shapeGroup(f, c);
         group = &inlineGroup;
       } else {
