@@ -61,7 +61,9 @@ TEST(ReconstructionFilter, WeightedSamplesFollowTheProfile) {
       for (int i = 0; i < kN; ++i) {
         FilterSample s = sampleFilter(f, Vec2f((i + 0.5f) / kN, (j + 0.5f) / kN));
         ASSERT_TRUE(std::isfinite(s.weight));
-        if (c.type != FilterType::Gaussian) ASSERT_LE(std::fabs(s.offset.x), f.radius + 1e-5f);
+        if (c.type != FilterType::Gaussian) {
+          ASSERT_LE(std::fabs(s.offset.x), f.radius + 1e-5f);
+        }
         meanW += s.weight;
         int b = int((s.offset.x + reach) / (2.0 * reach) * kBins);
         if (b >= 0 && b < kBins) hist[b] += s.weight;
