@@ -85,10 +85,11 @@ void runRender(const RenderArgs& a) {
     throw std::runtime_error("AOVs are written as channels of an OpenEXR file: the output '" + a.output +
                              "' must end in .exr");
   // The film's alpha (pixel_format rgba) is the A channel, first after R, G, B as in Mitsuba's
-  // files; only an .exr holds it.
-  if (scene.filmAlpha && ext == ".exr") scene.aovs.insert(scene.aovs.begin(), Aov{"", AovType::Alpha});
-  if (scene.filmAlpha && ext != ".exr")
-    spdlog::warn("the film's pixel_format has alpha, which only an .exr holds: {} gets RGB", a.output);
+  // files; an .exr and a .png hold it (the PNG beside an .exr too), .hdr and .pfm do not.
+  if (scene.filmAlpha && (ext == ".exr" || ext == ".png" || a.png))
+    scene.aovs.insert(scene.aovs.begin(), Aov{"", AovType::Alpha});
+  if (scene.filmAlpha && ext != ".exr" && ext != ".png")
+    spdlog::warn("the film's pixel_format has alpha, which {} cannot hold: it gets RGB", a.output);
   scene.finalize();
   bool cuda = chooseCuda(a.device);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -105,12 +106,13 @@ void runRender(const RenderArgs& a) {
   auto write = [&](const Image& img) {
     if (aovs.empty()) {
       saveImage(img, a.output, so);
-    } else {
-      Image withAovs = img;
-      withAovs.channels = aovs;
-      saveImage(withAovs, a.output, so);
+      if (a.png && ext != ".png") saveImage(img, pngPath, so);
+      return;
     }
-    if (a.png && ext != ".png") saveImage(img, pngPath, so);
+    Image withAovs = img;
+    withAovs.channels = aovs;
+    saveImage(withAovs, a.output, so);
+    if (a.png && ext != ".png") saveImage(withAovs, pngPath, so);
   };
   // The AOVs take only camera rays, traced here on the CPU before the image (so that every
   // checkpoint holds them), whichever device renders it.

@@ -421,7 +421,21 @@ void saveImage(const Image& img, const std::string& path, const SaveOptions& opt
     } else {
       std::vector<unsigned char> ldr = toneMapImage(img, opts);
       if (ext == ".png") {
-        ok = stbi_write_png(tmp.c_str(), img.width, img.height, 3, ldr.data(), img.width * 3) != 0;
+        // A channel named A (the film's alpha) makes an RGBA PNG: coverage, not tone mapped.
+        const ImageChannel* alpha = nullptr;
+        for (const ImageChannel& c : img.channels)
+          if (c.name == "A" && c.values.size() == size_t(img.width) * size_t(img.height)) alpha = &c;
+        if (alpha) {
+          std::vector<unsigned char> rgba(size_t(img.width) * size_t(img.height) * 4);
+          for (size_t i = 0; i < alpha->values.size(); ++i) {
+            for (int k = 0; k < 3; ++k) rgba[4 * i + size_t(k)] = ldr[3 * i + size_t(k)];
+            float a = std::clamp(alpha->values[i], 0.f, 1.f);
+            rgba[4 * i + 3] = (unsigned char)std::lround(a * 255.f);
+          }
+          ok = stbi_write_png(tmp.c_str(), img.width, img.height, 4, rgba.data(), img.width * 4) != 0;
+        } else {
+          ok = stbi_write_png(tmp.c_str(), img.width, img.height, 3, ldr.data(), img.width * 3) != 0;
+        }
       } else {
         std::string jpg = encodeJpeg(img.width, img.height, ldr, 95);
         std::ofstream f(tmp, std::ios::binary);

@@ -17,8 +17,8 @@ struct ImageChannel {
 struct Image {
   int width = 0, height = 0;
   std::vector<float> rgb;  // row-major, row 0 at the top, 3 floats a pixel
-  // Further channels, which only OpenEXR holds: .exr files keep them both ways, the other
-  // formats write the RGB alone.
+  // Further channels, which only OpenEXR holds: .exr files keep them both ways; a .png takes a
+  // channel named A as its alpha; the other formats write the RGB alone.
   std::vector<ImageChannel> channels;
 
   Image() = default;

@@ -748,8 +748,9 @@ TEST(CliRender, InstancesRenderAsTheShapesTheyPlace) {
     CliResult r = runCli(std::string("render ") + d.file(std::string(name) + ".xml") + " -o " +
                          d.file(std::string(name) + ".exr") + " --threads 1 --no-progress");
     ASSERT_EQ(r.code, 0) << name << ": " << r.output;
-    if (std::string(name) == "grouped")
+    if (std::string(name) == "grouped") {
       EXPECT_NE(r.output.find("2 instances placed 4 shapes"), std::string::npos) << r.output;
+    }
   }
   envgi::Image a = envgi::loadImage(d.file("grouped.exr")), b = envgi::loadImage(d.file("plain.exr"));
   ASSERT_EQ(a.rgb.size(), b.rgb.size());
@@ -860,7 +861,8 @@ TEST(CliRender, AovsAreChannelsOfTheExr) {
 }
 
 // pixel_format rgba with the environment hidden: the .exr has an A channel, 1 on the sphere and
-// 0 in the sky; a .png gets RGB and a warning, not an error.
+// 0 in the sky; a .png (alone or beside the .exr) is RGBA with that alpha; an .hdr gets RGB and a
+// warning, not an error.
 TEST(CliRender, RgbaFilmWritesCoverageAsAlpha) {
   TempDir d;
   std::string text = slurp(tinyScene(d, 16, 4));
@@ -877,9 +879,17 @@ TEST(CliRender, RgbaFilmWritesCoverageAsAlpha) {
   EXPECT_EQ(img.channels[0].name, "A");
   EXPECT_EQ(img.channels[0].values[0], 0.f) << "the top-left corner sees the hidden sky";
   EXPECT_EQ(img.channels[0].values[15 * 16 + 8], 1.f) << "the bottom row sees the floor";
-  CliResult png = runCli("render " + d.file("rgba.xml") + " -o " + d.file("rgba.png") + " --no-progress");
+  // A PNG's colour type (byte 25, in IHDR) is 6 for RGBA, 2 for RGB.
+  auto pngColourType = [](const std::string& bytes) { return bytes.size() > 25 ? int(bytes[25]) : -1; };
+  CliResult png = runCli("render " + d.file("rgba.xml") + " -o " + d.file("alone.png") + " --no-progress");
   ASSERT_EQ(png.code, 0) << png.output;
-  EXPECT_NE(png.output.find("only an .exr holds"), std::string::npos) << png.output;
+  EXPECT_EQ(pngColourType(slurp(d.file("alone.png"))), 6);
+  CliResult beside = runCli("render " + d.file("rgba.xml") + " -o " + d.file("rgba.exr") + " --png --no-progress");
+  ASSERT_EQ(beside.code, 0) << beside.output;
+  EXPECT_EQ(pngColourType(slurp(d.file("rgba.png"))), 6);
+  CliResult hdr = runCli("render " + d.file("rgba.xml") + " -o " + d.file("rgba.hdr") + " --no-progress");
+  ASSERT_EQ(hdr.code, 0) << hdr.output;
+  EXPECT_NE(hdr.output.find("cannot hold: it gets RGB"), std::string::npos) << hdr.output;
 }
 
 // Mitsuba's serialized shape: the bunny written as the second mesh of a .serialized file renders

@@ -224,3 +224,30 @@ TEST(Image, ExrKeepsFurtherChannels) {
   EXPECT_FALSE(fs::exists(d / "bad.exr"));
   fs::remove_all(d);
 }
+
+// A channel named A makes a .png RGBA: its alpha is the channel, clamped to [0, 1], not tone
+// mapped; without it the PNG is RGB.
+TEST(Image, PngTakesTheAChannelAsAlpha) {
+  fs::path d = tmpDir();
+  Image img = pattern();
+  std::vector<float> a(15);
+  for (int i = 0; i < 15; ++i) a[size_t(i)] = float(i) / 10.f - 0.2f;  // -0.2 .. 1.2
+  a[5] = 0.2f;
+  img.channels = {{"A", a}};
+  saveImage(img, (d / "a.png").string());
+  int w = 0, h = 0, n = 0;
+  unsigned char* px = stbi_load((d / "a.png").string().c_str(), &w, &h, &n, 0);
+  ASSERT_NE(px, nullptr);
+  EXPECT_EQ(n, 4);
+  EXPECT_EQ(px[3], 0) << "-0.2 clamps to 0";
+  EXPECT_EQ(px[4 * 5 + 3], 51) << "0.2 of 255";
+  EXPECT_EQ(px[4 * 14 + 3], 255) << "1.2 clamps to 1";
+  stbi_image_free(px);
+  img.channels.clear();
+  saveImage(img, (d / "b.png").string());
+  px = stbi_load((d / "b.png").string().c_str(), &w, &h, &n, 0);
+  ASSERT_NE(px, nullptr);
+  EXPECT_EQ(n, 3);
+  stbi_image_free(px);
+  fs::remove_all(d);
+}
