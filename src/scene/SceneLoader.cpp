@@ -433,7 +433,6 @@ class Loader {
       if (c.type() == pugi::node_element && !isPropTag(c.name())) fail(f, c, fmt::format("unexpected <{}> in <integrator>", c.name()));
   }
 
-  // A plugin's properties as plain values, each with its own file and line.
   // Mitsuba's aov integrator: its `aovs` list, written as channels beside the image, and one
   // nested integrator that renders the image (Mitsuba allows several, each its own image).
   void aovIntegrator(const SourceFile* f, pugi::xml_node n) {
@@ -457,6 +456,7 @@ class Loader {
     integrator(f, inner);
   }
 
+  // A plugin's properties as plain values, each with its own file and line.
   Properties scalarProperties(const SourceFile* f, pugi::xml_node n, Props& p) {
     Properties out(fmt::format("{}:{}", f->path, f->lineOf(n.offset_debug())));
     for (auto& [name, prop] : p) {
@@ -684,14 +684,7 @@ class Loader {
       // An area light's radiance may be a texture (nested or a <ref>), read where light leaves.
       if (type == "area" && name == "radiance" && (tag == "texture" || tag == "ref")) {
         if (radianceTexture >= 0 || p.count("radiance")) fail(f, c, "the area emitter's radiance is given twice");
-        if (tag == "texture") {
-          radianceTexture = texture(f, c);
-        } else {
-          checkAttrs(f, c, {"id", "name"});
-          auto it = textureIds_.find(attr(f, c, "id"));
-          if (it == textureIds_.end()) fail(f, c, fmt::format("unknown texture id '{}'", attr(f, c, "id")));
-          radianceTexture = it->second.index;
-        }
+        radianceTexture = textureChild(f, c);
         continue;
       }
       if (tag != "texture") fail(f, c, fmt::format("unexpected <{}> in <emitter>", tag));
@@ -783,17 +776,8 @@ class Loader {
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element) continue;
       std::string tag = c.name();
-      int index = -1;
-      if (tag == "texture") {
-        index = texture(f, c);
-      } else if (tag == "ref") {
-        checkAttrs(f, c, {"id", "name"});
-        auto it = textureIds_.find(attr(f, c, "id"));
-        if (it == textureIds_.end()) fail(f, c, fmt::format("unknown texture id '{}'", attr(f, c, "id")));
-        index = it->second.index;
-      } else {
-        continue;
-      }
+      if (tag != "texture" && tag != "ref") continue;
+      const int index = textureChild(f, c);
       std::string name = attr(f, c, "name");
       if (p.count(name) || textures.count(name)) fail(f, c, fmt::format("property '{}' given twice", name));
       textures[name] = {index, c};
@@ -1108,6 +1092,16 @@ class Loader {
     return Color(float(sum[0] / n), float(sum[1] / n), float(sum[2] / n));
   }
 
+  // A texture given to a property: a nested <texture> (read here) or a <ref> to a named one;
+  // the index into scene_.textures.
+  int textureChild(const SourceFile* f, pugi::xml_node c) {
+    if (std::string(c.name()) == "texture") return texture(f, c);
+    checkAttrs(f, c, {"id", "name"});
+    auto it = textureIds_.find(attr(f, c, "id"));
+    if (it == textureIds_.end()) fail(f, c, fmt::format("unknown texture id '{}'", attr(f, c, "id")));
+    return it->second.index;
+  }
+
   // Mitsuba's bitmap and checkerboard textures; returns the index into scene_.textures.
   int texture(const SourceFile* f, pugi::xml_node n) {
     checkAttrs(f, n, {"type", "id", "name"});
@@ -1215,14 +1209,16 @@ class Loader {
       std::string id = attr(f, n, "id", false);
       if (id.empty()) fail(f, n, "a shapegroup needs an id, which its instances refer to");
       std::string where = fmt::format("{}:{}", f->path, f->lineOf(n.offset_debug()));
-      if (groups_.count(id) || bsdfIds_.count(id) || textureIds_.count(id))
-        fail(f, n, fmt::format("duplicate id '{}'", id));
-      groups_[id] = shapeGroup(f, n);
-      groups_[id].where = where;
+      if (auto it = groups_.find(id); it != groups_.end())
+        fail(f, n, fmt::format("duplicate id '{}' (first defined at {})", id, it->second.where));
+      if (bsdfIds_.count(id) || textureIds_.count(id)) fail(f, n, fmt::format("duplicate id '{}'", id));
+      ShapeGroup g = shapeGroup(f, n);
+      g.where = where;
+      groups_[id] = std::move(g);
     } else if (type == "instance") {
       instance(f, n);
     } else {
-      placeShape(readShape(f, n, type), Transform{});
+      placeShape(readShape(f, n, type), Transform{});  // moved: a plain shape's mesh is not copied
     }
   }
 
@@ -1375,8 +1371,9 @@ class Loader {
   }
 
   // Puts a shape into the scene under outer (an instance's to_world; identity for a plain shape):
-  // the same as a shape whose to_world is outer times its own.
-  void placeShape(const ShapeTemplate& t, const Transform& outer) {
+  // the same as a shape whose to_world is outer times its own. By value: an instance passes a
+  // copy of its group's shape, a plain shape its own.
+  void placeShape(ShapeTemplate t, const Transform& outer) {
     const Transform toWorld = outer * t.toWorld;
     ShapeEntry entry = t.entry;
     if (t.isSphere) {
@@ -1390,7 +1387,7 @@ class Loader {
       entry.index = scene_.spheres.size();
       scene_.spheres.push_back(s);
     } else {
-      TriangleMesh mesh = t.mesh;
+      TriangleMesh mesh = std::move(t.mesh);
       mesh.transform(toWorld);
       if (t.faceNormals) mesh.normals.clear();
       else if (mesh.normals.empty() && t.fromFile) mesh.computeVertexNormals();
