@@ -104,15 +104,15 @@ void runRender(const RenderArgs& a) {
   std::string pngPath = fs::path(a.output).replace_extension(".png").string();
   std::vector<ImageChannel> aovs;
   auto write = [&](const Image& img) {
-    if (aovs.empty()) {
-      saveImage(img, a.output, so);
-      if (a.png && ext != ".png") saveImage(img, pngPath, so);
-      return;
+    const Image* out = &img;
+    Image withAovs;  // a copy only where there are channels to add
+    if (!aovs.empty()) {
+      withAovs = img;
+      withAovs.channels = aovs;
+      out = &withAovs;
     }
-    Image withAovs = img;
-    withAovs.channels = aovs;
-    saveImage(withAovs, a.output, so);
-    if (a.png && ext != ".png") saveImage(withAovs, pngPath, so);
+    saveImage(*out, a.output, so);
+    if (a.png && ext != ".png") saveImage(*out, pngPath, so);
   };
   // The AOVs take only camera rays, traced here on the CPU before the image (so that every
   // checkpoint holds them), whichever device renders it.

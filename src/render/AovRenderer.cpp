@@ -7,7 +7,7 @@
 #include <algorithm>
 
 #include "materials/Bsdf.h"
-#include "sampling/Sampler.h"
+#include "render/PixelKernel.h"
 
 namespace envgi {
 
@@ -17,22 +17,17 @@ namespace {
 // first camera samples (harmless, but the two need not be tied).
 constexpr uint32_t kAovStream = 0x27d4eb2fu;
 
-size_t channelCount(const std::vector<Aov>& aovs) {
-  size_t n = 0;
-  for (const Aov& a : aovs) n += aovChannelNames(a).size();
-  return n;
-}
-
 }  // namespace
 
 std::vector<ImageChannel> renderAovs(const Scene& scene, const EmbreeAccel& accel, int samples, int threads) {
   const SceneView& sc = scene.view();
   const Camera& cam = sc.camera;
   const int n = std::clamp(samples, 1, kAovMaxSamples);
-  const size_t pixels = size_t(cam.width) * size_t(cam.height), nc = channelCount(scene.aovs);
+  const size_t pixels = size_t(cam.width) * size_t(cam.height);
   std::vector<ImageChannel> out;
   for (const Aov& a : scene.aovs)
     for (const std::string& name : aovChannelNames(a)) out.push_back({name, std::vector<float>(pixels, 0.f)});
+  const size_t nc = out.size();
   if (nc == 0) return out;
   // Mitsuba's shape_index counts shapes in the file's order; Hit::geomId counts meshes, then spheres.
   std::vector<float> shapeOfGeom(scene.meshes.size() + scene.spheres.size(), -1.f);
@@ -49,14 +44,10 @@ std::vector<ImageChannel> renderAovs(const Scene& scene, const EmbreeAccel& acce
       for (int x = 0; x < cam.width; ++x) {
         std::fill(acc.begin(), acc.end(), 0.f);
         float wsum = 0.f;
-        Sampler smp;
-        smp.type = scene.sampler.type;
-        smp.spp = uint32_t(n);
-        smp.seed = scene.sampler.seed ^ kAovStream;
+        Sampler smp = sequenceSampler({scene.sampler.type, uint32_t(n), scene.sampler.seed ^ kAovStream});
         for (int s = 0; s < n; ++s) {
-          smp.start(uint64_t(y) * uint64_t(cam.width) + uint64_t(x), uint32_t(s));
           float w;
-          Ray ray = sampleCameraRay(cam, smp, x, y, &w);
+          Ray ray = startCameraSample(cam, smp, x, y, s, &w);
           Hit h;
           const bool found = tracer.intersect(ray, &h);
           wsum += w;
@@ -84,7 +75,7 @@ std::vector<ImageChannel> renderAovs(const Scene& scene, const EmbreeAccel& acce
                   }
                   albedo *= 1.f / float(kAovAlbedoSamples);
                 }
-                put3(Vec3f(albedo.x, albedo.y, albedo.z));
+                put3(albedo);
                 break;
               }
               // Mitsuba's si.t: camera rays start on the near plane, so depth counts from there.

@@ -4,20 +4,11 @@
 #include <stdexcept>
 
 #include "scene/MitsubaPlugins.h"
+#include "scene/NameTables.h"
 
 namespace envgi {
 
 namespace {
-
-struct AovTypeName {
-  const char* name;
-  AovType type;
-};
-constexpr AovTypeName kAovTypes[] = {
-    {"albedo", AovType::Albedo},       {"depth", AovType::Depth},         {"position", AovType::Position},
-    {"uv", AovType::Uv},               {"geo_normal", AovType::GeoNormal}, {"sh_normal", AovType::ShNormal},
-    {"prim_index", AovType::PrimIndex}, {"shape_index", AovType::ShapeIndex},
-};
 
 std::string trim(const std::string& s) {
   size_t a = s.find_first_not_of(" \t\n"), b = s.find_last_not_of(" \t\n");
@@ -46,15 +37,13 @@ std::vector<Aov> parseAovs(const std::string& spec) {
     std::string type = trim(item.substr(colon + 1));
     bool found = false;
     std::vector<std::string> names;
-    for (const AovTypeName& t : kAovTypes) {
+    for (const Named<AovType>& t : kAovTypeNames) {
       names.emplace_back(t.name);
-      if (type == t.name) a.type = t.type, found = true;
+      if (type == t.name) a.type = t.value, found = true;
     }
-    if (!found) {
-      std::string list;
-      for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
-      throw std::runtime_error("unknown AOV type '" + type + "'" + didYouMean(type, names) + " (" + list + ")");
-    }
+    if (!found)
+      throw std::runtime_error("unknown AOV type '" + type + "'" + didYouMean(type, names) + " (" +
+                               nameList(kAovTypeNames) + ")");
     if (a.name.empty()) throw std::runtime_error("AOV '" + item + "' has no name");
     // Two AOVs writing one channel would leave only the later one's values in the file.
     for (const std::string& c : aovChannelNames(a))

@@ -8,6 +8,7 @@
 
 #include "envmap/EnvironmentMapView.h"
 #include "sampling/Sampler.h"
+#include "scene/Aov.h"
 #include "scene/Camera.h"
 #include "scene/IntegratorSettings.h"
 
@@ -63,6 +64,13 @@ inline constexpr Named<FilterType> kFilterNames[] = {
     {"box", FilterType::Box, false},           {"tent", FilterType::Tent, false},
     {"gaussian", FilterType::Gaussian, false}, {"mitchell", FilterType::Mitchell, false},
     {"catmullrom", FilterType::CatmullRom, false}, {"lanczos", FilterType::Lanczos, false}};
+
+// Mitsuba's aov integrator's types (scene/Aov.h; the film's alpha is not one of them).
+inline constexpr Named<AovType> kAovTypeNames[] = {
+    {"albedo", AovType::Albedo, false},         {"depth", AovType::Depth, false},
+    {"position", AovType::Position, false},     {"uv", AovType::Uv, false},
+    {"geo_normal", AovType::GeoNormal, false},  {"sh_normal", AovType::ShNormal, false},
+    {"prim_index", AovType::PrimIndex, false},  {"shape_index", AovType::ShapeIndex, false}};
 
 inline IntegratorType findIntegrator(const std::string& name) { return findName(kIntegratorNames, name, "integrator"); }
 inline const char* integratorName(IntegratorType t) { return nameOf(kIntegratorNames, t); }

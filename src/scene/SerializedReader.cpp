@@ -59,24 +59,24 @@ class Inflater {
     read(&v, sizeof(T));
     return v;
   }
-  // count values of `double` or float in the file, as floats, in chunks (see above).
-  std::vector<float> floats(uint64_t count, bool dbl) {
-    std::vector<float> out;
+  // count values of T, in chunks that grow the array only as the data arrives (see above).
+  template <class T>
+  std::vector<T> array(uint64_t count) {
     constexpr uint64_t kChunk = 1u << 22;
+    std::vector<T> out;
     for (uint64_t done = 0; done < count;) {
-      uint64_t n = std::min(kChunk, count - done);
-      size_t at = out.size();
-      out.resize(at + size_t(n));
-      if (dbl) {
-        std::vector<double> tmp(static_cast<size_t>(n));
-        read(tmp.data(), size_t(n) * sizeof(double));
-        for (uint64_t i = 0; i < n; ++i) out[at + i] = float(tmp[i]);
-      } else {
-        read(out.data() + at, size_t(n) * sizeof(float));
-      }
+      const uint64_t n = std::min(kChunk, count - done);
+      out.resize(out.size() + size_t(n));
+      read(out.data() + done, size_t(n) * sizeof(T));
       done += n;
     }
     return out;
+  }
+  // count values stored as double or float, as floats.
+  std::vector<float> floats(uint64_t count, bool dbl) {
+    if (!dbl) return array<float>(count);
+    std::vector<double> d = array<double>(count);
+    return std::vector<float>(d.begin(), d.end());
   }
 
  private:
@@ -143,15 +143,8 @@ TriangleMesh loadSerialized(const std::string& path, int shapeIndex, bool* faceN
     for (size_t i = 0; i < t.size(); i += 2) m.uvs.emplace_back(t[i], t[i + 1]);
   }
   if (flags & kHasColors) z.floats(3 * vertices, dbl);  // vertex colours: read past, as Mitsuba does
-  // Indices are 32-bit (64-bit only past 2^32 vertices, which the check above refuses), read in
-  // chunks like the arrays.
-  for (uint64_t done = 0; done < 3 * triangles;) {
-    uint64_t n = std::min<uint64_t>(1u << 22, 3 * triangles - done);
-    size_t at = m.indices.size();
-    m.indices.resize(at + size_t(n));
-    z.read(m.indices.data() + at, size_t(n) * sizeof(uint32_t));
-    done += n;
-  }
+  // Indices are 32-bit (64-bit only past 2^32 vertices, which the check above refuses).
+  m.indices = z.array<uint32_t>(3 * triangles);
   m.validate();
   if (faceNormals) *faceNormals = (flags & kFaceNormals) != 0;
   return m;

@@ -159,7 +159,9 @@ TEST(LightSampling, TexturedAreaLightIsTheSumOfItsSquares) {
       EXPECT_NEAR(estimatedIrradiance(sc, p, 200000), exact, 0.01 * exact + 1e-4) << "tilt " << tilt << " at " << p.x << "," << p.z;
       EXPECT_NEAR(shadowedIrradiance(sc, tracer, p, 200000), exact, 0.015 * exact + 1e-4) << "tilt " << tilt;
       // Off the light's axis the squares nearer p weigh more: a uniform light of the mean is off.
-      if (p.x != 0.f) EXPECT_GT(std::fabs(exact - uniform), 0.03 * exact) << "tilt " << tilt << " at " << p.x;
+      if (p.x != 0.f) {
+        EXPECT_GT(std::fabs(exact - uniform), 0.03 * exact) << "tilt " << tilt << " at " << p.x;
+      }
     }
   }
 }
