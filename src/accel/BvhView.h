@@ -197,6 +197,15 @@ struct BvhTracer {
   ENVGI_HD bool intersect(const Ray& r, Hit* h) const { return bvh.intersect(r, h); }
   ENVGI_HD bool occluded(Vec3f o, Vec3f d, float tMax) const { return bvh.occluded(o, d, tMax); }
   ENVGI_HD bool intersectSurface(const Ray& r, Hit* h) const { return bvh.intersectSurface(r, h); }
+  // A round of coherent rays (renderTileByBounce's camera rays), one at a time here.
+  template <class Rays, class Out>
+  void intersectCoherent(int n, Rays rays, Out out) const {
+    for (int i = 0; i < n; ++i) {
+      Hit h;
+      const bool found = bvh.intersect(rays(i), &h);
+      out(i, found, h);
+    }
+  }
 };
 
 }  // namespace envgi

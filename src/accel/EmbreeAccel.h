@@ -54,6 +54,46 @@ class EmbreeAccel {
     return true;
   }
 
+  // intersect() for n coherent rays (rays(i) the i-th, out(i, found, hit) its answer) in
+  // Embree's 16-wide packets, which share traversal steps: a tile's camera rays, in 4 x 4
+  // blocks, in 0.83x the time of one at a time (docs/performance.md, stop 50). The hits are
+  // those of intersect() to the bit.
+  template <class Rays, class Out>
+  void intersectCoherent(int n, Rays rays, Out out) const {
+    alignas(64) RTCRayHit16 rh;
+    alignas(64) int valid[16];
+    Context ctx;
+    rtcInitIntersectContext(&ctx.rtc);
+    ctx.rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    ctx.throughMasks = true;
+    for (int b = 0; b < n; b += 16) {
+      const int m = n - b < 16 ? n - b : 16;
+      for (int j = 0; j < 16; ++j) {
+        const Ray& r = rays(b + (j < m ? j : 0));
+        valid[j] = j < m && traceable(r) ? -1 : 0;
+        rh.ray.org_x[j] = r.o.x, rh.ray.org_y[j] = r.o.y, rh.ray.org_z[j] = r.o.z;
+        rh.ray.dir_x[j] = r.d.x, rh.ray.dir_y[j] = r.d.y, rh.ray.dir_z[j] = r.d.z;
+        rh.ray.tnear[j] = 0.f, rh.ray.tfar[j] = r.tMax, rh.ray.mask[j] = 0xFFFFFFFFu;
+        rh.ray.time[j] = 0.f, rh.ray.flags[j] = 0, rh.ray.id[j] = 0;
+        rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
+        rh.hit.instID[0][j] = RTC_INVALID_GEOMETRY_ID;
+      }
+      rtcIntersect16(valid, scene_, &ctx.rtc, &rh);
+      for (int j = 0; j < m; ++j) {
+        Hit h;
+        const bool found = valid[j] && rh.hit.geomID[j] != RTC_INVALID_GEOMETRY_ID;
+        if (found) {
+          h.t = rh.ray.tfar[j];
+          h.geomId = int(rh.hit.geomID[j]);
+          h.primId = int(rh.hit.primID[j]);
+          h.u = rh.hit.u[j];
+          h.v = rh.hit.v[j];
+        }
+        out(b + j, found, h);
+      }
+    }
+  }
+
   bool occluded(Vec3f o, Vec3f d, float tMax) const {
     Ray ray{o, d, tMax};
     if (!traceable(ray)) return true;
@@ -96,6 +136,8 @@ struct EmbreeTracer {
   const EmbreeAccel* accel;
   bool intersect(const Ray& r, Hit* h) const { return accel->intersect(r, h); }
   bool occluded(Vec3f o, Vec3f d, float tMax) const { return accel->occluded(o, d, tMax); }
+  template <class Rays, class Out>
+  void intersectCoherent(int n, Rays rays, Out out) const { accel->intersectCoherent(n, rays, out); }
   // Every surface, masked ones included (photon tracing decides at those itself).
   bool intersectSurface(const Ray& r, Hit* h) const { return accel->intersect(r, h, false); }
 };

@@ -1,7 +1,7 @@
 // Runs render passes on the CPU: oneTBB over image tiles, each tile a bounce at a time
 // (renderTileByBounce) for the path tracer, each pixel through renderPixel for the others; both
 // run the integrator bodies the CUDA kernels run. Deterministic whatever the thread count (no
-// shared sums), and the same sums either way.
+// shared sums), and the same sums either way up to Embree's packets' rounding of camera hits.
 #pragma once
 
 #include <tbb/blocked_range.h>
@@ -33,7 +33,8 @@ class CpuExecutor final : public PassExecutor {
     if (cam.filter.hasNegativeLobes()) film_.weightSum.assign(film_.sum.size(), 0.f);
     if constexpr (RunsByBounce<Integrator>::value) {
       // A bounce at a time unless ENVGI_CPU_BY_BOUNCE=0 asks for renderPixel (for A/B timings:
-      // docs/performance.md); the film is the same to the bit either way.
+      // docs/performance.md); the film is the same either way but for the last bits of the
+      // camera rays' hit distances, which Embree's packets compute in their own way.
       const char* e = std::getenv("ENVGI_CPU_BY_BOUNCE");
       byBounce_ = integrate_.shadesAfterTrace() && !(e && std::strcmp(e, "0") == 0);
     }

@@ -209,12 +209,22 @@ struct ShadowRayLater {
   }
 };
 
+// The i-th pixel of a tile tw wide (a multiple of 4) taken in 4 x 4 blocks, row by row of
+// blocks: its index in the tile's row-major order.
+inline int blockOrderSlot(int i, int tw) {
+  const int block = i >> 4, lane = i & 15, blocksAcross = tw >> 2;
+  const int x = (block % blocksAcross) * 4 + (lane & 3), y = (block / blocksAcross) * 4 + (lane >> 2);
+  return y * tw + x;
+}
+
 // Samples [s0, s1) of the tile [x0, x1) x [y0, y1) a bounce at a time (CPU): sample s of every
 // pixel starts together, then each round traces all live paths' rays back to back and shades
 // them back to back, instead of alternating one ray's traversal with its shading. That keeps
 // the BVH, then the map's tables, in cache across a round (renderPixel took 4-8% longer on the
-// buddha bench: docs/performance.md). Each pixel adds its samples in renderPixel's order, so
-// the film's sums are the same to the bit.
+// buddha bench: docs/performance.md). The camera rays go to the tracer together, for packets.
+// Each pixel adds its samples in renderPixel's order, so the film's sums are the same to the
+// bit where the tracer's packets give one-ray hits to the bit (the BVH's loop does; Embree's
+// packets round t in their own way).
 template <class Integrator>
 void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Integrator& integ, int x0, int y0, int x1,
                         int y1, int s0, int s1, FilmView film, TileBatch* b, PixelCounters* counters) {
@@ -230,10 +240,24 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       b->state[k] = integ.begin(startCameraSample(cam, b->sampler[k], x, y, s, &b->weight[k]));
       b->active[live++] = k;
     }
-    while (live > 0) {
-      for (int i = 0; i < live; ++i) {
-        int k = b->active[i];
-        b->found[k] = integ.tracer.intersect(b->state[k].ray, &b->hit[k]);
+    for (bool cameraRays = true; live > 0; cameraRays = false) {
+      if (cameraRays) {
+        // Coherent: the tracer may trace them together, the tile's pixels in 4 x 4 blocks
+        // where every pixel takes the sample and the tile's sides are multiples of 4.
+        const bool blocks = live == n && tw % 4 == 0 && (y1 - y0) % 4 == 0;
+        auto slot = [&](int i) { return blocks ? blockOrderSlot(i, tw) : b->active[i]; };
+        integ.tracer.intersectCoherent(
+            live, [&](int i) -> const Ray& { return b->state[slot(i)].ray; },
+            [&](int i, bool found, const Hit& h) {
+              const int k = slot(i);
+              b->found[k] = found;
+              if (found) b->hit[k] = h;
+            });
+      } else {
+        for (int i = 0; i < live; ++i) {
+          int k = b->active[i];
+          b->found[k] = integ.tracer.intersect(b->state[k].ray, &b->hit[k]);
+        }
       }
       counters->rays += uint64_t(live);
       // Ask for the hit triangles' indices, then their vertices, for the whole round before
