@@ -358,6 +358,11 @@ def main():
     variant('anisotropic sphere (brushed, alone)', 'brushed',
             lambda t: re.sub(r'<shape type="(rectangle|cube)">.*?</shape>', '', t, flags=re.S).replace(
                 '<integrator type="path">', '<integrator type="path"><boolean name="hide_emitters" value="true"/>'))
+    # A textured area light drawn by its texture (stop 50): the screen showing bright letters on
+    # a dark panel, the map removed so that the screen lights the room alone.
+    variant('textured-light, the sign alone', 'textured-light',
+            lambda t: re.sub(r'<emitter type="envmap">.*?</emitter>', '', t, flags=re.S).replace(
+                'value="$screen"', 'value="textures/sign.png"'))
     # Delta lights: the sun, point and area lights of sun-and-sky with the map's background
     # hidden (the open row placement), and a point light and a spot added to the area-lit
     # Cornell box. The

@@ -72,6 +72,7 @@ DeviceScene::DeviceScene(const Scene& scene, const Bvh& hostBvh) {
   view.textures = arena.upload(textures.data(), textures.size(), "textures");
   view.lights = arena.upload(hv.lights, size_t(hv.lightCount), "lights");
   view.lightSelect.bins = arena.upload(hv.lightSelect.bins, size_t(hv.lightSelect.n), "light table");
+  view.lightCells = arena.upload(hv.lightCells, size_t(hv.lightCellCount), "textured lights' cells");
   view.deltaLights = arena.upload(hv.deltaLights, size_t(hv.deltaLightCount), "delta lights");
   if (hv.hasEnvironment) view.env = uploadEnvironment(arena, hv.env);
   deviceView = arena.upload(&view, 1, "scene");

@@ -42,7 +42,7 @@ ENVGI_INLINE float areaLightPdf(const SceneView& sc, int light, Vec3f p, Vec3f l
   float dist2 = lengthSq(d);
   float cosL = std::fabs(dot(ln, d)) / std::sqrt(dist2);
   if (cosL <= 0.f) return 0.f;
-  return sc.areaSelectProb() * sc.lightSelect.pmf(light) / sc.lights[light].area * dist2 / cosL;
+  return sc.areaSelectProb() * sc.lightSelect.pmf(light) * sc.lightAreaPdf(sc.lights[light], lp) * dist2 / cosL;
 }
 
 ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si, Vec3f axis, EnvStrategy strategy,
@@ -72,10 +72,10 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
     return !isBlack(ls->radiance);
   }
   if (sc.lightCount == 0) return false;
-  float pmf;
+  float pmf, areaPdf;
   Vec3f p, n;
   Color Le;
-  const LightPrim& lp = sampleAreaLight(sc, u2, u, &pmf, &p, &n, &Le);
+  sampleAreaLight(sc, u2, u, &pmf, &p, &n, &Le, &areaPdf);
   Vec3f d = p - si.p;
   float dist2 = lengthSq(d);
   if (dist2 <= 0.f) return false;
@@ -86,7 +86,7 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
   ls->dir = d;
   ls->dist = dist;
   ls->radiance = Le;
-  ls->pdf = pa * pmf / lp.area * dist2 / cosL;
+  ls->pdf = pa * pmf * areaPdf * dist2 / cosL;
   ls->environment = false;
   ls->delta = false;
   return ls->pdf > 0.f;

@@ -74,17 +74,17 @@ struct PhotonEmitter {
       return !isBlack(*power);
     }
     if (sc.lightCount == 0) return false;
-    float pmf;
+    float pmf, areaPdf;
     Vec3f p, n;
     Color Le;
-    const LightPrim& lp = sampleAreaLight(sc, u2, u1, &pmf, &p, &n, &Le);
+    sampleAreaLight(sc, u2, u1, &pmf, &p, &n, &Le, &areaPdf);
     Vec2f u3 = smp.get2D();
     Vec3f dir = Frame::fromNormal(n).toWorld(sampleCosineHemisphere(u3));
     ray->o = offsetRayOrigin(p, n, dir, 0.f);
     ray->d = normalize(dir);
     ray->tMax = INFINITY;
     // Le cos / (pdf_area pdf_dir) with pdf_dir = cos / pi.
-    *power = Le * (kPi * lp.area / (pmf * areaProb));
+    *power = Le * (kPi / (pmf * areaPdf * areaProb));
     return true;
   }
 };

@@ -1,5 +1,7 @@
 #include "scene/Scene.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 #include "envmap/CollapsedMap.h"
@@ -13,6 +15,104 @@ bool needsTangentFrame(const std::vector<Bsdf>& bsdfs, int index, int depth = 0)
   const Bsdf& b = bsdfs[size_t(index)];
   if (!bsdfIsBlend(b) || depth > kMaxBlendDepth) return bsdfNeedsTangentFrame(b);
   return needsTangentFrame(bsdfs, b.blend0, depth + 1) || needsTangentFrame(bsdfs, b.blend1, depth + 1);
+}
+
+// The texels, or a checkerboard's squares, across one unit of (u, v) after to_uv, by axis.
+Vec2f texelsPerUnit(const TextureView& t) {
+  const float sx = t.type == TextureType::Bitmap ? float(t.width) : 8.f;
+  const float sy = t.type == TextureType::Bitmap ? float(t.height) : 8.f;
+  return {sx, sy};
+}
+
+// Length in texels of the (u, v) step d once to_uv maps it.
+float texelLength(const TextureView& t, Vec2f d) {
+  const Vec2f s = texelsPerUnit(t);
+  const float x = (t.toUv[0] * d.x + t.toUv[1] * d.y) * s.x, y = (t.toUv[3] * d.x + t.toUv[4] * d.y) * s.y;
+  return std::sqrt(x * x + y * y);
+}
+
+// Cuts each textured light triangle into cells about half a texel across (at most 256 a side,
+// and 2^21 in all: past that every triangle's side count shrinks alike), weighs each cell by
+// the mean luminance the texture shows at a lattice of points over it (a quarter of a texel
+// apart or closer), and sets the triangle's radiance to the mean there (its power for the
+// choice among lights). A floor of 1e-3 of the triangle's mean weight keeps every cell
+// drawable: a bright spot between the lattice's points costs variance, never bias.
+void buildLightCells(const std::vector<MeshView>& meshes, const std::vector<TextureView>& textures,
+                     std::vector<LightPrim>& lights, std::vector<AliasBin>* cells) {
+  cells->clear();
+  constexpr int kMaxSide = 256;
+  constexpr double kMaxCells = double(1 << 21);
+  auto corners = [&](const LightPrim& lp, Vec2f uv[3]) {
+    const MeshView& m = meshes[size_t(lp.geomId)];
+    const uint32_t* ix = m.indices + 3 * lp.primId;
+    uv[0] = meshUv(m, ix[0], ix[1], ix[2], 0.f, 0.f);
+    uv[1] = meshUv(m, ix[0], ix[1], ix[2], 1.f, 0.f);
+    uv[2] = meshUv(m, ix[0], ix[1], ix[2], 0.f, 1.f);
+  };
+  std::vector<float> side(lights.size(), 0.f);
+  double total = 0.0;
+  for (size_t i = 0; i < lights.size(); ++i) {
+    const LightPrim& lp = lights[i];
+    if (lp.radianceTexture < 0 || lp.geomId >= int(meshes.size()) || !(lp.area > 0.f)) continue;
+    const TextureView& t = textures[size_t(lp.radianceTexture)];
+    Vec2f uv[3];
+    corners(lp, uv);
+    float longest = std::max({texelLength(t, uv[1] - uv[0]), texelLength(t, uv[2] - uv[1]), texelLength(t, uv[0] - uv[2])});
+    side[i] = std::min(std::max(std::ceil(2.f * longest), 1.f), float(kMaxSide));
+    total += double(side[i]) * double(side[i]);
+  }
+  const float shrink = total > kMaxCells ? float(std::sqrt(kMaxCells / total)) : 1.f;
+  std::vector<float> weight;
+  for (size_t i = 0; i < lights.size(); ++i) {
+    if (side[i] == 0.f) continue;
+    LightPrim& lp = lights[i];
+    const TextureView& t = textures[size_t(lp.radianceTexture)];
+    const MeshView& m = meshes[size_t(lp.geomId)];
+    const uint32_t* ix = m.indices + 3 * lp.primId;
+    const int n = std::max(1, int(side[i] * shrink));
+    Vec2f uv[3];
+    corners(lp, uv);
+    const float cellLongest =
+        std::max({texelLength(t, uv[1] - uv[0]), texelLength(t, uv[2] - uv[1]), texelLength(t, uv[0] - uv[2])}) / float(n);
+    // Steps a side of a cell's lattice: four a texel, within [2, 8].
+    const int k = std::min(8, std::max(2, int(std::ceil(4.f * cellLongest))));
+    weight.assign(size_t(n) * size_t(n), 0.f);
+    Color sum(0.f);
+    double points = 0.0;
+    for (int c = 0; c < n * n; ++c) {
+      const Vec2f v0 = triangleCellCorner(c, n, 0), v1 = triangleCellCorner(c, n, 1), v2 = triangleCellCorner(c, n, 2);
+      float cellSum = 0.f;
+      int cellPoints = 0;
+      auto at = [&](Vec2f b) {
+        const Color L = textureEval(t, meshUv(m, ix[0], ix[1], ix[2], b.x, b.y));
+        cellSum += luminance(L);
+        ++cellPoints;
+        sum += L;
+        points += 1.0;
+      };
+      for (int a = 0; a <= k; ++a)
+        for (int b = 0; a + b <= k; ++b) {
+          const float fa = float(a) / float(k), fb = float(b) / float(k);
+          at(v0 * (1.f - fa - fb) + v1 * fa + v2 * fb);
+        }
+      at((v0 + v1 + v2) * (1.f / 3.f));
+      weight[size_t(c)] = cellSum / float(cellPoints);
+    }
+    double mean = 0.0;
+    for (float w : weight) mean += double(w);
+    mean /= double(weight.size());
+    for (float& w : weight) w = std::max(w, float(1e-3 * mean));
+    // The triangle's power: its own mean, at least 1e-3 of the texture's (lp.radiance until here),
+    // so that no triangle the lattice saw black is never chosen.
+    const Color own = sum / float(points), least = lp.radiance * 1e-3f;
+    lp.radiance = luminance(own) >= luminance(least) ? own : least;
+    if (n == 1) continue;  // one cell: uniform, as without
+    AliasTable table(weight.data(), weight.size());
+    const AliasTableView v = table.view();
+    lp.cellOffset = int(cells->size());
+    lp.cells = n;
+    cells->insert(cells->end(), v.bins, v.bins + v.n);
+  }
 }
 }  // namespace
 
@@ -77,6 +177,12 @@ void Scene::finalize() {
   for (const MeshView& v : meshViews_)
     if (!v.positions) throw std::runtime_error("internal: mesh without a shape entry");
   if (!(lo.x <= hi.x)) lo = hi = Vec3f(0.f);
+  textureViews_.clear();
+  for (const Texture& t : textures) {
+    textureViews_.push_back(t.params);
+    textureViews_.back().texels = t.texels.empty() ? nullptr : t.texels.data();
+  }
+  buildLightCells(meshViews_, textureViews_, lights_, &lightCells_);
   std::vector<float> power(lights_.size());
   for (size_t i = 0; i < lights_.size(); ++i) power[i] = luminance(lights_[i].radiance) * lights_[i].area;
   if (!lights_.empty()) lightTable_ = AliasTable(power.data(), power.size());
@@ -87,15 +193,12 @@ void Scene::finalize() {
   view_.spheres = sphereViews_.data();
   view_.sphereCount = int(sphereViews_.size());
   view_.bsdfs = bsdfs.data();
-  textureViews_.clear();
-  for (const Texture& t : textures) {
-    textureViews_.push_back(t.params);
-    textureViews_.back().texels = t.texels.empty() ? nullptr : t.texels.data();
-  }
   view_.textures = textureViews_.data();
   view_.lights = lights_.data();
   view_.lightCount = int(lights_.size());
   if (!lights_.empty()) view_.lightSelect = lightTable_.view();
+  view_.lightCells = lightCells_.empty() ? nullptr : lightCells_.data();
+  view_.lightCellCount = int(lightCells_.size());
   view_.deltaLights = deltaLights.empty() ? nullptr : deltaLights.data();
   view_.deltaLightCount = int(deltaLights.size());
   view_.hasEnvironment = env != nullptr;

@@ -74,6 +74,7 @@ class Scene {
   std::vector<TextureView> textureViews_;
   std::vector<LightPrim> lights_;
   AliasTable lightTable_;
+  std::vector<AliasBin> lightCells_;  // textured light triangles' cell tables (SceneView::lightCells)
   SceneView view_;
 };
 

@@ -9,7 +9,9 @@
 #include "envmap/EnvironmentMapView.h"
 #include "materials/Bsdf.h"
 #include "materials/Texture.h"
+#include "sampling/AliasTable.h"
 #include "sampling/Pcg32.h"
+#include "sampling/TriangleCells.h"
 #include "scene/Camera.h"
 #include "scene/DeltaLight.h"
 #include "scene/Ray.h"
@@ -40,9 +42,14 @@ struct SphereView {
 struct LightPrim {
   int geomId;    // scene geometry numbering (meshes, then spheres)
   int primId;
-  Color radiance;  // with a texture, its mean: the primitive's power for the choice among lights
+  Color radiance;  // with a texture, its mean over the primitive: its power for the choice among lights
   float area;
   int radianceTexture;  // -1: radiance everywhere; else read at the (u, v) the light leaves from
+  // A textured triangle's points are drawn by the texture: one of its cells^2 cells
+  // (TriangleCells.h) from the alias table at SceneView::lightCells + cellOffset, then a point
+  // uniformly in it. cells 0: uniformly over the primitive (untextured lights, spheres).
+  int cellOffset = 0;
+  int cells = 0;
 };
 
 struct SurfaceInteraction {
@@ -115,6 +122,8 @@ struct SceneView {
   const LightPrim* lights = nullptr;
   int lightCount = 0;
   AliasTableView lightSelect;  // area lights by power
+  const AliasBin* lightCells = nullptr;  // the textured triangles' cell tables, one after another
+  int lightCellCount = 0;
   const DeltaLight* deltaLights = nullptr;
   int deltaLightCount = 0;
   bool hasEnvironment = false;
@@ -317,6 +326,15 @@ struct SceneView {
   ENVGI_HD Color lightRadiance(const LightPrim& lp, Vec2f uv) const {
     return lp.radianceTexture >= 0 ? textureEval(textures[lp.radianceTexture], uv) : lp.radiance;
   }
+  // The density over a light primitive's area of the point sampleLightPrim draws, at q on it.
+  ENVGI_HD float lightAreaPdf(const LightPrim& lp, Vec3f q) const {
+    if (lp.cells == 0) return 1.f / lp.area;
+    const MeshView& m = meshes[lp.geomId];
+    const uint32_t* ix = m.indices + 3 * lp.primId;
+    const Vec2f b = triangleBarycentrics(q, m.positions[ix[0]], m.positions[ix[1]], m.positions[ix[2]]);
+    const int n = lp.cells, cell = triangleCellOf(b, n);
+    return lightCells[lp.cellOffset + cell].pmf * float(n * n) / lp.area;
+  }
   // Emitted radiance leaving a light primitive towards w (one-sided, like Mitsuba's area).
   ENVGI_HD Color emitted(const SurfaceInteraction& si, Vec3f w) const {
     if (si.light < 0 || dot(si.ng, w) <= 0.f) return Color(0.f);
@@ -324,15 +342,29 @@ struct SceneView {
   }
 };
 
-// Uniform point on a light primitive: its position, normal and the radiance it emits there
-// (the area pdf is 1 / area).
-ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2f u, Vec3f* p, Vec3f* n, Color* Le) {
+// A point on a light primitive: its position, normal, the radiance it emits there and its
+// density over the primitive's area (1 / area unless the primitive is drawn by its texture).
+ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2f u, Vec3f* p, Vec3f* n, Color* Le,
+                                  float* areaPdf) {
   *Le = lp.radiance;
+  *areaPdf = 1.f / lp.area;
   if (lp.geomId < sc.meshCount) {
     const MeshView& m = sc.meshes[lp.geomId];
     uint32_t i0 = m.indices[3 * lp.primId], i1 = m.indices[3 * lp.primId + 1], i2 = m.indices[3 * lp.primId + 2];
     Vec3f p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
-    Vec2f b = sampleUniformTriangle(u);
+    Vec2f b;
+    if (lp.cells > 0) {
+      // The cell from both numbers, the point inside it from the bits the choice left over.
+      const int cellCount = lp.cells * lp.cells;
+      float pmf, rest;
+      const int cell = AliasTableView{sc.lightCells + lp.cellOffset, cellCount}.sample(u, &pmf, &rest);
+      const float a = std::floor(rest * 4096.f), fine = rest * 4096.f - a;
+      b = sampleTriangleCell(cell, lp.cells,
+                             Vec2f((a + 0.5f) * (1.f / 4096.f), (std::floor(fine * 2048.f) + 0.5f) * (1.f / 2048.f)));
+      *areaPdf = pmf * float(cellCount) / lp.area;
+    } else {
+      b = sampleUniformTriangle(u);
+    }
     *p = p0 * (1.f - b.x - b.y) + p1 * b.x + p2 * b.y;
     if (lp.radianceTexture >= 0) *Le = sc.lightRadiance(lp, meshUv(m, i0, i1, i2, b.x, b.y));
     Vec3f ng = normalize(cross(p1 - p0, p2 - p0));
@@ -350,13 +382,13 @@ ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2
   }
 }
 
-// Picks an area-light primitive by power (u2) and a uniform point on it (u), with the radiance
-// it emits there.
+// Picks an area-light primitive by power (u2) and a point on it (u), with the radiance it emits
+// there and the point's density over the primitive's area.
 ENVGI_INLINE const LightPrim& sampleAreaLight(const SceneView& sc, Vec2f u2, Vec2f u, float* pmf, Vec3f* p, Vec3f* n,
-                                              Color* Le) {
+                                              Color* Le, float* areaPdf) {
   int li = sc.lightSelect.sample(u2, pmf, nullptr);
   const LightPrim& lp = sc.lights[li];
-  sampleLightPrim(sc, lp, u, p, n, Le);
+  sampleLightPrim(sc, lp, u, p, n, Le, areaPdf);
   return lp;
 }
 

@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 
 #include "accel/EmbreeAccel.h"
 #include "cli/CliRunner.h"
+#include "image/Image.h"
 #include "integrators/NextEvent.h"
 #include "lights/LightSampling.h"
 #include "sampling/Pcg32.h"
@@ -137,7 +139,8 @@ TEST(LightSampling, TexturedAreaLightIsTheSumOfItsSquares) {
     const SceneView& sc = s->scene.view();
     ASSERT_GT(sc.lightCount, 0);
     EXPECT_EQ(sc.lights[0].radianceTexture, 0);
-    EXPECT_FLOAT_EQ(sc.lights[0].radiance.y, 5.f) << "the texture's mean stands for its power";
+    // Each triangle of the rectangle holds half of each bright square and one dim one whole.
+    EXPECT_NEAR(sc.lights[0].radiance.y, 5.f, 0.05f) << "the triangle's mean stands for its power";
     // The rectangle's (u, v) = ((x + 1) / 2, (y + 1) / 2) in its own frame: its quadrants, each
     // counter-clockwise about the emitting normal, with their radiance.
     const float t = (90.f + tilt) * kPi / 180.f;
@@ -163,6 +166,127 @@ TEST(LightSampling, TexturedAreaLightIsTheSumOfItsSquares) {
         EXPECT_GT(std::fabs(exact - uniform), 0.03 * exact) << "tilt " << tilt << " at " << p.x;
       }
     }
+  }
+}
+
+namespace {
+// An 8 x 8 bitmap light, nearest-filtered so that it is constant over each texel: one texel
+// (5, 2) at 100, the rest at 0.1. Texel (i, j) covers u in [i/8, (i+1)/8], v in [j/8, (j+1)/8]
+// (row 0 of the image at v = 0).
+constexpr int kTexels = 8, kBrightX = 5, kBrightY = 2;
+float texelRadiance(int i, int j) { return i == kBrightX && j == kBrightY ? 100.f : 0.1f; }
+
+std::unique_ptr<LitScene> bitmapLight(test::TempDir& dir) {
+  Image img(kTexels, kTexels);
+  for (int j = 0; j < kTexels; ++j)
+    for (int i = 0; i < kTexels; ++i) img.set(i, j, Color(texelRadiance(i, j)));
+  saveImage(img, dir.file("spot.pfm"));
+  return squareLight(0.f, R"(<texture type="bitmap" name="radiance"><string name="filename" value=")" +
+                              dir.file("spot.pfm") + R"("/><string name="filter_type" value="nearest"/></texture>)");
+}
+
+// The light's texel (i, j) as a quad in the world: the rectangle's (u, v) = ((x + 1) / 2,
+// (y + 1) / 2) in its frame, scaled by 0.4, facing down at height 1.
+std::vector<Vec3f> texelQuad(int i, int j) {
+  auto place = [](float u, float v) { return Vec3f(0.4f * (2.f * u - 1.f), 1.f, 0.4f * (2.f * v - 1.f)); };
+  const float s = 1.f / kTexels;
+  return {place(i * s, j * s), place((i + 1) * s, j * s), place((i + 1) * s, (j + 1) * s), place(i * s, (j + 1) * s)};
+}
+
+// Mean and variance of next-event estimation's L cos / pdf at floor point p.
+std::pair<double, double> irradianceSamples(const SceneView& sc, Vec3f p, int n) {
+  SurfaceInteraction si = floorPoint(p);
+  Pcg32 rng(9, 4);
+  double sum = 0.0, sumSq = 0.0;
+  for (int i = 0; i < n; ++i) {
+    LightSample ls;
+    float uSel = rng.nextFloat();
+    Vec2f u(rng.nextFloat(), rng.nextFloat()), u2(rng.nextFloat(), rng.nextFloat());
+    double f = 0.0;
+    if (sampleLight(sc, si, si.ng, EnvStrategy::Importance, uSel, u, u2, &ls)) {
+      float cosP = dot(ls.dir, si.ng);
+      if (cosP > 0.f) f = double(ls.radiance.y) * cosP / ls.pdf;
+    }
+    sum += f;
+    sumSq += f * f;
+  }
+  const double mean = sum / n;
+  return {mean, sumSq / n - mean * mean};
+}
+}  // namespace
+
+// A textured light's points are drawn by its texture: most land on the one bright texel (1/64
+// of the area), the density handed back with each point is the one lightAreaPdf finds there,
+// and that density integrates to 1 over each triangle.
+TEST(LightSampling, TexturedLightDrawsPointsByItsTexture) {
+  test::TempDir dir;
+  auto s = bitmapLight(dir);
+  const SceneView& sc = s->scene.view();
+  ASSERT_EQ(sc.lightCount, 2);
+  for (int l = 0; l < 2; ++l) EXPECT_GT(sc.lights[l].cells, 1) << "triangle " << l << " is cut into cells";
+  Pcg32 rng(21, 5);
+  const int n = 100000;
+  int bright = 0, mismatched = 0;
+  for (int i = 0; i < n; ++i) {
+    float pmf, areaPdf;
+    Vec3f p, nrm;
+    Color Le;
+    const LightPrim& lp = sampleAreaLight(sc, Vec2f(rng.nextFloat(), rng.nextFloat()),
+                                          Vec2f(rng.nextFloat(), rng.nextFloat()), &pmf, &p, &nrm, &Le, &areaPdf);
+    const float found = sc.lightAreaPdf(lp, p);
+    mismatched += std::fabs(found - areaPdf) > 1e-3f * areaPdf;  // a point on a cell's edge may read the neighbour
+    const MeshView& m = sc.meshes[lp.geomId];
+    const uint32_t* ix = m.indices + 3 * lp.primId;
+    const Vec2f b = triangleBarycentrics(p, m.positions[ix[0]], m.positions[ix[1]], m.positions[ix[2]]);
+    const Vec2f uv = meshUv(m, ix[0], ix[1], ix[2], b.x, b.y);
+    bright += int(uv.x * kTexels) == kBrightX && int(uv.y * kTexels) == kBrightY;
+    EXPECT_NEAR(Le.y, texelRadiance(std::min(int(uv.x * kTexels), kTexels - 1), std::min(int(uv.y * kTexels), kTexels - 1)),
+                1e-3f + 0.01f * Le.y)
+        << "the radiance handed back is the texture's at the point";
+  }
+  EXPECT_LE(mismatched, n / 1000) << "sampled densities that lightAreaPdf does not give back";
+  // The bright texel holds 100 / (100 + 63 x 0.1) = 94% of the power, uniform points put 1.6%
+  // there; half-texel cells across its edges take some of its share (71% measured).
+  EXPECT_GT(double(bright) / n, 0.6) << bright << " of " << n;
+  for (int l = 0; l < 2; ++l) {
+    const LightPrim& lp = sc.lights[l];
+    const MeshView& m = sc.meshes[lp.geomId];
+    const uint32_t* ix = m.indices + 3 * lp.primId;
+    double integral = 0.0;
+    const int k = 200000;
+    for (int i = 0; i < k; ++i) {
+      const Vec2f b = sampleUniformTriangle(Vec2f(rng.nextFloat(), rng.nextFloat()));
+      const Vec3f q = m.positions[ix[0]] * (1.f - b.x - b.y) + m.positions[ix[1]] * b.x + m.positions[ix[2]] * b.y;
+      integral += double(sc.lightAreaPdf(lp, q)) * double(lp.area) / k;
+    }
+    EXPECT_NEAR(integral, 1.0, 0.03) << "triangle " << l;
+  }
+}
+
+// Next-event estimation under that light gives the sum of Lambert's formula over its 64
+// texels, drawn by the texture or uniformly (the cells switched off), and by the texture its
+// samples vary less than a tenth as much.
+TEST(LightSampling, TexturedLightNextEventMatchesItsTexelsWithLessVariance) {
+  test::TempDir dir;
+  auto s = bitmapLight(dir);
+  const SceneView& sc = s->scene.view();
+  std::vector<LightPrim> uniformLights(sc.lights, sc.lights + sc.lightCount);
+  for (LightPrim& lp : uniformLights) lp.cells = 0;
+  SceneView uniform = sc;
+  uniform.lights = uniformLights.data();
+  const int n = 200000;
+  for (Vec3f p : {Vec3f(0, 0, 0), Vec3f(0.3f, 0, 0.5f), Vec3f(0.8f, 0, -1.f)}) {
+    double exact = 0.0;
+    for (int j = 0; j < kTexels; ++j)
+      for (int i = 0; i < kTexels; ++i)
+        exact += polygonIrradiance(texelQuad(i, j), s->normal, p, Vec3f(0, 1, 0), texelRadiance(i, j));
+    auto [meanCells, varCells] = irradianceSamples(sc, p, n);
+    auto [meanUniform, varUniform] = irradianceSamples(uniform, p, n);
+    EXPECT_NEAR(meanCells, exact, 4.0 * std::sqrt(varCells / n) + 0.002 * exact) << "at " << p.x << "," << p.z;
+    EXPECT_NEAR(meanUniform, exact, 4.0 * std::sqrt(varUniform / n) + 0.002 * exact) << "at " << p.x << "," << p.z;
+    EXPECT_LT(varCells, 0.1 * varUniform) << "at " << p.x << "," << p.z;
+    std::printf("at (%.1f, %.1f): exact %.5f, by texture %.5f (variance %.4g), uniform %.5f (variance %.4g)\n", p.x, p.z,
+                exact, meanCells, varCells, meanUniform, varUniform);
   }
 }
 
