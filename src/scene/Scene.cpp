@@ -31,17 +31,22 @@ float texelLength(const TextureView& t, Vec2f d) {
   return std::sqrt(x * x + y * y);
 }
 
-// Cuts each textured light triangle into cells about half a texel across (at most 256 a side,
-// and 2^21 in all: past that every triangle's side count shrinks alike), weighs each cell by
-// the mean luminance the texture shows at a lattice of points over it (a quarter of a texel
-// apart or closer), and sets the triangle's radiance to the mean there (its power for the
-// choice among lights). A floor of 1e-3 of the triangle's mean weight keeps every cell
-// drawable: a bright spot between the lattice's points costs variance, never bias.
+// Cuts each textured light into cells: a triangle into n^2 about half a texel across, a sphere
+// into n rows and 2n columns of its (u, v), a texel each where to_uv keeps the texture's grid
+// (at most 256 a side, and 2^21 cells in all: past that every light's side count shrinks
+// alike). Each cell is weighed by its area times the mean luminance the texture shows at a
+// lattice of points over it (a quarter of a texel apart or closer), and the light's radiance
+// becomes the mean over it (its power for the choice among lights), at least 1e-3 of the
+// texture's mean (lp.radiance until then), so that no light the lattice saw black is never
+// chosen. A floor of 1e-3 of the mean weight keeps every cell drawable: a bright spot between
+// the lattice's points costs variance, never bias.
 void buildLightCells(const std::vector<MeshView>& meshes, const std::vector<TextureView>& textures,
                      std::vector<LightPrim>& lights, std::vector<AliasBin>* cells) {
   cells->clear();
-  constexpr int kMaxSide = 256;
+  constexpr float kMaxSide = 256.f;
   constexpr double kMaxCells = double(1 << 21);
+  const int meshCount = int(meshes.size());
+  // A triangle's (u, v) at its corners, and its longest side in texels.
   auto corners = [&](const LightPrim& lp, Vec2f uv[3]) {
     const MeshView& m = meshes[size_t(lp.geomId)];
     const uint32_t* ix = m.indices + 3 * lp.primId;
@@ -49,17 +54,25 @@ void buildLightCells(const std::vector<MeshView>& meshes, const std::vector<Text
     uv[1] = meshUv(m, ix[0], ix[1], ix[2], 1.f, 0.f);
     uv[2] = meshUv(m, ix[0], ix[1], ix[2], 0.f, 1.f);
   };
+  auto longestSide = [&](const LightPrim& lp, const TextureView& t) {
+    Vec2f uv[3];
+    corners(lp, uv);
+    return std::max({texelLength(t, uv[1] - uv[0]), texelLength(t, uv[2] - uv[1]), texelLength(t, uv[0] - uv[2])});
+  };
+  // A sphere's rows: the texels down its v, or half those across its u, whichever is more.
+  auto sphereTexels = [&](const TextureView& t) {
+    return std::max(texelLength(t, Vec2f(0.f, 1.f)), 0.5f * texelLength(t, Vec2f(1.f, 0.f)));
+  };
   std::vector<float> side(lights.size(), 0.f);
   double total = 0.0;
   for (size_t i = 0; i < lights.size(); ++i) {
     const LightPrim& lp = lights[i];
-    if (lp.radianceTexture < 0 || lp.geomId >= int(meshes.size()) || !(lp.area > 0.f)) continue;
+    if (lp.radianceTexture < 0 || !(lp.area > 0.f)) continue;
     const TextureView& t = textures[size_t(lp.radianceTexture)];
-    Vec2f uv[3];
-    corners(lp, uv);
-    float longest = std::max({texelLength(t, uv[1] - uv[0]), texelLength(t, uv[2] - uv[1]), texelLength(t, uv[0] - uv[2])});
-    side[i] = std::min(std::max(std::ceil(2.f * longest), 1.f), float(kMaxSide));
-    total += double(side[i]) * double(side[i]);
+    const bool sphere = lp.geomId >= meshCount;
+    const float want = sphere ? sphereTexels(t) : 2.f * longestSide(lp, t);
+    side[i] = std::min(std::max(std::ceil(want), 1.f), kMaxSide);
+    total += (sphere ? 2.0 : 1.0) * double(side[i]) * double(side[i]);
   }
   const float shrink = total > kMaxCells ? float(std::sqrt(kMaxCells / total)) : 1.f;
   std::vector<float> weight;
@@ -67,46 +80,67 @@ void buildLightCells(const std::vector<MeshView>& meshes, const std::vector<Text
     if (side[i] == 0.f) continue;
     LightPrim& lp = lights[i];
     const TextureView& t = textures[size_t(lp.radianceTexture)];
-    const MeshView& m = meshes[size_t(lp.geomId)];
-    const uint32_t* ix = m.indices + 3 * lp.primId;
     const int n = std::max(1, int(side[i] * shrink));
-    Vec2f uv[3];
-    corners(lp, uv);
-    const float cellLongest =
-        std::max({texelLength(t, uv[1] - uv[0]), texelLength(t, uv[2] - uv[1]), texelLength(t, uv[0] - uv[2])}) / float(n);
-    // Steps a side of a cell's lattice: four a texel, within [2, 8].
-    const int k = std::min(8, std::max(2, int(std::ceil(4.f * cellLongest))));
-    weight.assign(size_t(n) * size_t(n), 0.f);
+    const bool sphere = lp.geomId >= meshCount;
+    const int cellCount = sphere ? sphereCellCount(n) : n * n;
+    // Steps a side of a cell's lattice of points: four a texel, within [2, 6]. The lattice
+    // takes in the cell's edges and corners, so that a bright texel crossing a sliver of the
+    // cell is seen, pulled inside by 1e-3 of the cell, so that a cell whose edges are texel
+    // edges does not read its neighbours' texels.
+    const float cellTexels = (sphere ? sphereTexels(t) : longestSide(lp, t)) / float(n);
+    const int k = std::min(6, std::max(2, int(std::ceil(4.f * cellTexels))));
+    constexpr float kInset = 1e-3f;
+    weight.assign(size_t(cellCount), 0.f);
     Color sum(0.f);
-    double points = 0.0;
-    for (int c = 0; c < n * n; ++c) {
-      const Vec2f v0 = triangleCellCorner(c, n, 0), v1 = triangleCellCorner(c, n, 1), v2 = triangleCellCorner(c, n, 2);
+    double totalShare = 0.0;
+    for (int c = 0; c < cellCount; ++c) {
       float cellSum = 0.f;
-      int cellPoints = 0;
-      auto at = [&](Vec2f b) {
-        const Color L = textureEval(t, meshUv(m, ix[0], ix[1], ix[2], b.x, b.y));
+      Color cellColour(0.f);
+      int points = 0;
+      auto at = [&](Vec2f uv) {
+        const Color L = textureEval(t, uv);
         cellSum += luminance(L);
-        ++cellPoints;
-        sum += L;
-        points += 1.0;
+        cellColour += L;
+        ++points;
       };
-      for (int a = 0; a <= k; ++a)
-        for (int b = 0; a + b <= k; ++b) {
-          const float fa = float(a) / float(k), fb = float(b) / float(k);
-          at(v0 * (1.f - fa - fb) + v1 * fa + v2 * fb);
-        }
-      at((v0 + v1 + v2) * (1.f / 3.f));
-      weight[size_t(c)] = cellSum / float(cellPoints);
+      float share;  // the cell's part of the light's area
+      if (sphere) {
+        const int iv = c / (2 * n), iu = c - iv * 2 * n;
+        for (int a = 0; a <= k; ++a)
+          for (int b = 0; b <= k; ++b) {
+            const float fa = kInset + (1.f - 2.f * kInset) * float(a) / float(k);
+            const float fb = kInset + (1.f - 2.f * kInset) * float(b) / float(k);
+            at(Vec2f((float(iu) + fa) / float(2 * n), (float(iv) + fb) / float(n)));
+          }
+        share = sphereCellShare(c, n);
+      } else {
+        const MeshView& m = meshes[size_t(lp.geomId)];
+        const uint32_t* ix = m.indices + 3 * lp.primId;
+        const Vec2f v0 = triangleCellCorner(c, n, 0), v1 = triangleCellCorner(c, n, 1), v2 = triangleCellCorner(c, n, 2);
+        const Vec2f centre = (v0 + v1 + v2) * (1.f / 3.f);
+        auto atBary = [&](Vec2f b) {
+          b = b + (centre - b) * kInset;
+          at(meshUv(m, ix[0], ix[1], ix[2], b.x, b.y));
+        };
+        for (int a = 0; a <= k; ++a)
+          for (int b = 0; a + b <= k; ++b) {
+            const float fa = float(a) / float(k), fb = float(b) / float(k);
+            atBary(v0 * (1.f - fa - fb) + v1 * fa + v2 * fb);
+          }
+        atBary(centre);
+        share = 1.f / float(cellCount);
+      }
+      weight[size_t(c)] = share * cellSum / float(points);
+      sum += cellColour * (share / float(points));
+      totalShare += share;
     }
     double mean = 0.0;
     for (float w : weight) mean += double(w);
     mean /= double(weight.size());
     for (float& w : weight) w = std::max(w, float(1e-3 * mean));
-    // The triangle's power: its own mean, at least 1e-3 of the texture's (lp.radiance until here),
-    // so that no triangle the lattice saw black is never chosen.
-    const Color own = sum / float(points), least = lp.radiance * 1e-3f;
+    const Color own = sum / float(totalShare), least = lp.radiance * 1e-3f;
     lp.radiance = luminance(own) >= luminance(least) ? own : least;
-    if (n == 1) continue;  // one cell: uniform, as without
+    if (cellCount == 1) continue;  // one cell: uniform, as without
     AliasTable table(weight.data(), weight.size());
     const AliasTableView v = table.view();
     lp.cellOffset = int(cells->size());

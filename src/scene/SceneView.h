@@ -11,6 +11,7 @@
 #include "materials/Texture.h"
 #include "sampling/AliasTable.h"
 #include "sampling/Pcg32.h"
+#include "sampling/SphereCells.h"
 #include "sampling/TriangleCells.h"
 #include "scene/Camera.h"
 #include "scene/DeltaLight.h"
@@ -45,9 +46,10 @@ struct LightPrim {
   Color radiance;  // with a texture, its mean over the primitive: its power for the choice among lights
   float area;
   int radianceTexture;  // -1: radiance everywhere; else read at the (u, v) the light leaves from
-  // A textured triangle's points are drawn by the texture: one of its cells^2 cells
-  // (TriangleCells.h) from the alias table at SceneView::lightCells + cellOffset, then a point
-  // uniformly in it. cells 0: uniformly over the primitive (untextured lights, spheres).
+  // A textured primitive's points are drawn by the texture: a cell from the alias table at
+  // SceneView::lightCells + cellOffset, then a point uniformly (by area) in it; a triangle has
+  // cells^2 cells (TriangleCells.h), a sphere 2 cells^2 (SphereCells.h). cells 0: uniformly
+  // over the primitive (untextured lights).
   int cellOffset = 0;
   int cells = 0;
 };
@@ -329,6 +331,11 @@ struct SceneView {
   // The density over a light primitive's area of the point sampleLightPrim draws, at q on it.
   ENVGI_HD float lightAreaPdf(const LightPrim& lp, Vec3f q) const {
     if (lp.cells == 0) return 1.f / lp.area;
+    if (lp.geomId >= meshCount) {
+      const SphereView& s = spheres[lp.geomId - meshCount];
+      const int cell = sphereCellOf(sphereUv(s, normalize(q - s.center)), lp.cells);
+      return lightCells[lp.cellOffset + cell].pmf / (sphereCellShare(cell, lp.cells) * lp.area);
+    }
     const MeshView& m = meshes[lp.geomId];
     const uint32_t* ix = m.indices + 3 * lp.primId;
     const Vec2f b = triangleBarycentrics(q, m.positions[ix[0]], m.positions[ix[1]], m.positions[ix[2]]);
@@ -375,7 +382,18 @@ ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2
     *n = ng;
   } else {
     const SphereView& s = sc.spheres[lp.geomId - sc.meshCount];
-    Vec3f d = sampleUniformSphere(u);
+    Vec3f d;
+    if (lp.cells > 0) {
+      const int cellCount = sphereCellCount(lp.cells);
+      float pmf, rest;
+      const int cell = AliasTableView{sc.lightCells + lp.cellOffset, cellCount}.sample(u, &pmf, &rest);
+      const float a = std::floor(rest * 4096.f), fine = rest * 4096.f - a;
+      d = s.axes.toWorld(sampleSphereCell(
+          cell, lp.cells, Vec2f((a + 0.5f) * (1.f / 4096.f), (std::floor(fine * 2048.f) + 0.5f) * (1.f / 2048.f))));
+      *areaPdf = pmf / (sphereCellShare(cell, lp.cells) * lp.area);
+    } else {
+      d = sampleUniformSphere(u);
+    }
     *p = s.center + d * s.radius;
     *n = s.flipNormals ? -d : d;
     if (lp.radianceTexture >= 0) *Le = sc.lightRadiance(lp, sphereUv(s, d));

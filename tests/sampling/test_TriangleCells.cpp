@@ -1,13 +1,15 @@
 // A triangle's n^2 cells (TriangleCells.h): a point drawn in a cell is found in that cell, the
 // cells tile the triangle evenly (chi-square of uniform points' cells), and a point is drawn
-// uniformly inside its cell.
+// uniformly inside its cell. A sphere's 2 n^2 cells (SphereCells.h): the same, by area.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <vector>
 
 #include "sampling/Pcg32.h"
+#include "sampling/SphereCells.h"
 #include "sampling/TriangleCells.h"
+#include "sampling/Warp.h"
 #include "support/ChiSquare.h"
 #include "support/TestScenes.h"
 
@@ -88,4 +90,60 @@ TEST(TriangleCells, PointsAreUniformInsideTheirCell) {
       EXPECT_NEAR(mean.y, centroid.y, 0.01f / float(n)) << n << " cell " << cell;
       test::expectShare(below, m, 0.5, "a median halves the cell");
     }
+}
+
+// A sphere's cells: their shares of the area sum to 1, a direction drawn in a cell is found
+// there, and uniform directions fall in each cell by its share (chi-square over 72 cells).
+TEST(SphereCells, CellsTileTheSphereByArea) {
+  const int n = 6, cells = sphereCellCount(n), samples = 288000;
+  double shares = 0.0;
+  Pcg32 rng(13, 6);
+  for (int c = 0; c < cells; ++c) {
+    shares += sphereCellShare(c, n);
+    for (int i = 0; i < 4; ++i) {
+      const Vec3f d = sampleSphereCell(c, n, Vec2f(0.05f + 0.9f * rng.nextFloat(), 0.05f + 0.9f * rng.nextFloat()));
+      EXPECT_NEAR(length(d), 1.f, 1e-5f);
+      float phi = std::atan2(d.y, d.x);
+      if (phi < 0.f) phi += 2.f * kPi;
+      const Vec2f uv(phi / (2.f * kPi), std::acos(std::fmin(std::fmax(d.z, -1.f), 1.f)) / kPi);
+      EXPECT_EQ(sphereCellOf(uv, n), c);
+    }
+  }
+  EXPECT_NEAR(shares, 1.0, 1e-5);
+  std::vector<double> count(size_t(cells), 0.0);
+  for (int i = 0; i < samples; ++i) {
+    const Vec3f d = sampleUniformSphere(Vec2f(rng.nextFloat(), rng.nextFloat()));
+    float phi = std::atan2(d.y, d.x);
+    if (phi < 0.f) phi += 2.f * kPi;
+    count[size_t(sphereCellOf(Vec2f(phi / (2.f * kPi), std::acos(std::fmin(std::fmax(d.z, -1.f), 1.f)) / kPi), n))] += 1.0;
+  }
+  double chi2 = 0.0;
+  for (int c = 0; c < cells; ++c) {
+    const double expected = samples * double(sphereCellShare(c, n));
+    chi2 += (count[size_t(c)] - expected) * (count[size_t(c)] - expected) / expected;
+  }
+  EXPECT_GT(test::gammaQ(0.5 * (cells - 1), 0.5 * chi2), 1e-3) << "chi2 " << chi2;
+}
+
+// Inside a sphere cell, directions are uniform by area: the share of them above the cell's
+// middle height (z) is one half, and their azimuths split evenly at the cell's middle one.
+TEST(SphereCells, PointsAreUniformInsideTheirCell) {
+  Pcg32 rng(17, 7);
+  const int n = 5;
+  for (int c : {0, 3, 2 * n * 2 + 1, sphereCellCount(n) - 1}) {
+    const int iv = c / (2 * n), iu = c - iv * 2 * n;
+    const float z0 = std::cos(kPi * float(iv) / float(n)), z1 = std::cos(kPi * float(iv + 1) / float(n));
+    const float midPhi = 2.f * kPi * (float(iu) + 0.5f) / float(2 * n);
+    const int m = 40000;
+    int upper = 0, before = 0;
+    for (int i = 0; i < m; ++i) {
+      const Vec3f d = sampleSphereCell(c, n, Vec2f(rng.nextFloat(), rng.nextFloat()));
+      upper += d.z > 0.5f * (z0 + z1);
+      float phi = std::atan2(d.y, d.x);
+      if (phi < 0.f) phi += 2.f * kPi;
+      before += phi < midPhi;
+    }
+    test::expectShare(upper, m, 0.5, "uniform in z (Archimedes): half above the middle height");
+    test::expectShare(before, m, 0.5, "uniform in azimuth");
+  }
 }
