@@ -170,6 +170,26 @@ TEST(LightSampling, TexturedAreaLightIsTheSumOfItsSquares) {
 }
 
 namespace {
+// Draws n points on the scene's area lights and hands each to visit(light, point, radiance);
+// returns how many came with a density that lightAreaPdf does not give back at the point (a
+// point on a cell's edge may read its neighbour's).
+template <class Visit>
+int drawLightPoints(const SceneView& sc, int n, Pcg32& rng, Visit visit) {
+  int mismatched = 0;
+  for (int i = 0; i < n; ++i) {
+    float pmf, areaPdf;
+    Vec3f p, nrm;
+    Color Le;
+    const LightPrim& lp = sampleAreaLight(sc, Vec2f(rng.nextFloat(), rng.nextFloat()),
+                                          Vec2f(rng.nextFloat(), rng.nextFloat()), &pmf, &p, &nrm, &Le, &areaPdf);
+    mismatched += std::fabs(sc.lightAreaPdf(lp, p) - areaPdf) > 1e-3f * areaPdf;
+    visit(lp, p, Le);
+  }
+  return mismatched;
+}
+}  // namespace
+
+namespace {
 // An 8 x 8 bitmap light, nearest-filtered so that it is constant over each texel: one texel
 // (5, 2) at 100, the rest at 0.1. Texel (i, j) covers u in [i/8, (i+1)/8], v in [j/8, (j+1)/8]
 // (row 0 of the image at v = 0).
@@ -226,15 +246,8 @@ TEST(LightSampling, TexturedLightDrawsPointsByItsTexture) {
   for (int l = 0; l < 2; ++l) EXPECT_GT(sc.lights[l].cells, 1) << "triangle " << l << " is cut into cells";
   Pcg32 rng(21, 5);
   const int n = 100000;
-  int bright = 0, mismatched = 0;
-  for (int i = 0; i < n; ++i) {
-    float pmf, areaPdf;
-    Vec3f p, nrm;
-    Color Le;
-    const LightPrim& lp = sampleAreaLight(sc, Vec2f(rng.nextFloat(), rng.nextFloat()),
-                                          Vec2f(rng.nextFloat(), rng.nextFloat()), &pmf, &p, &nrm, &Le, &areaPdf);
-    const float found = sc.lightAreaPdf(lp, p);
-    mismatched += std::fabs(found - areaPdf) > 1e-3f * areaPdf;  // a point on a cell's edge may read the neighbour
+  int bright = 0;
+  const int mismatched = drawLightPoints(sc, n, rng, [&](const LightPrim& lp, Vec3f p, Color Le) {
     const MeshView& m = sc.meshes[lp.geomId];
     const uint32_t* ix = m.indices + 3 * lp.primId;
     const Vec2f b = triangleBarycentrics(p, m.positions[ix[0]], m.positions[ix[1]], m.positions[ix[2]]);
@@ -243,7 +256,7 @@ TEST(LightSampling, TexturedLightDrawsPointsByItsTexture) {
     EXPECT_NEAR(Le.y, texelRadiance(std::min(int(uv.x * kTexels), kTexels - 1), std::min(int(uv.y * kTexels), kTexels - 1)),
                 1e-3f + 0.01f * Le.y)
         << "the radiance handed back is the texture's at the point";
-  }
+  });
   EXPECT_LE(mismatched, n / 1000) << "sampled densities that lightAreaPdf does not give back";
   // The bright texel holds 100 / (100 + 63 x 0.1) = 94% of the power, uniform points put 1.6%
   // there; half-texel cells across its edges take some of its share (71% measured).
@@ -346,16 +359,8 @@ TEST(LightSampling, TexturedSphereLightDrawsPointsByItsTexture) {
   EXPECT_GT(lp.cells, 1) << "the sphere is cut into cells";
   Pcg32 rng(23, 8);
   const int n = 100000;
-  int bright = 0, mismatched = 0;
-  for (int i = 0; i < n; ++i) {
-    float pmf, areaPdf;
-    Vec3f p, nrm;
-    Color Le;
-    sampleAreaLight(sc, Vec2f(rng.nextFloat(), rng.nextFloat()), Vec2f(rng.nextFloat(), rng.nextFloat()), &pmf, &p, &nrm,
-                    &Le, &areaPdf);
-    mismatched += std::fabs(sc.lightAreaPdf(lp, p) - areaPdf) > 1e-3f * areaPdf;
-    bright += Le.y > 50.f;
-  }
+  int bright = 0;
+  const int mismatched = drawLightPoints(sc, n, rng, [&](const LightPrim&, Vec3f, Color Le) { bright += Le.y > 50.f; });
   EXPECT_LE(mismatched, n / 1000) << "sampled densities that lightAreaPdf does not give back";
   // The bright texel, 4.4% of the area (an eighth of the band from 45 to 90 degrees), holds
   // 4.42 / (4.42 + 0.1 x 0.956) = 98% of the power; uniform points put 4.4% there.
