@@ -363,6 +363,13 @@ def main():
     variant('textured-light, the sign alone', 'textured-light',
             lambda t: re.sub(r'<emitter type="envmap">.*?</emitter>', '', t, flags=re.S).replace(
                 'value="$screen"', 'value="textures/sign.png"'))
+    # A sphere light with the uv grid over its (u, v), in place of the screen, the map kept.
+    variant('textured-light, a textured sphere light', 'textured-light',
+            lambda t: re.sub(r'<shape type="rectangle">.*?</shape>',
+                             '<shape type="sphere"><point name="center" x="0" y="1.3" z="-0.9"/>'
+                             '<float name="radius" value="0.4"/><emitter type="area"><texture type="bitmap" '
+                             'name="radiance"><string name="filename" value="textures/uv-grid.png"/></texture>'
+                             '</emitter></shape>', t, count=1, flags=re.S))
     # Delta lights: the sun, point and area lights of sun-and-sky with the map's background
     # hidden (the open row placement), and a point light and a spot added to the area-lit
     # Cornell box. The
