@@ -68,7 +68,8 @@ def bsdfs():
                         f'<bsdf type="roughdielectric"><float name="int_ior" value="{ior}"/><float name="alpha" value="{a}"/>'
                         '<string name="distribution" value="ggx"/></bsdf>'))
     out.append(('conductor none', '<bsdf type="conductor"><string name="material" value="none"/></bsdf>'))
-    for m in ('Au', 'Ag', 'Al', 'Cu', 'Cr'):
+    # The first five, and a few of the other materials Mitsuba's conductor names (stop 50).
+    for m in ('Au', 'Ag', 'Al', 'Cu', 'Cr', 'W', 'Ni_palik', 'TiN', 'Cu_palik', 'Hg_palik', 'a-C'):
         out.append((f'conductor {m}', f'<bsdf type="conductor"><string name="material" value="{m}"/></bsdf>'))
     for a in (0.1, 0.3, 0.6):
         for m in ('none', 'Au'):

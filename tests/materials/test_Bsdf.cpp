@@ -2,6 +2,10 @@
 // incident angles, plus weight = eval/pdf, reciprocity, non-negativity and energy bounds.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <string>
+
 #include "materials/BsdfFactory.h"
 #include "sampling/Pcg32.h"
 #include "support/ChiSquare.h"
@@ -233,7 +237,9 @@ TEST(Bsdf, OnlyTwoLobeBsdfsReadTheLobeChoice) {
       bool same = okA == okB && (!okA || (a.wi.x == b.wi.x && a.wi.y == b.wi.y && a.wi.z == b.wi.z &&
                                           a.weight.x == b.weight.x && a.pdf == b.pdf && a.delta == b.delta));
       differs = differs || !same;
-      if (!bsdfPicksALobe(c.bsdf)) ASSERT_TRUE(same) << c.name << " read uc";
+      if (!bsdfPicksALobe(c.bsdf)) {
+        ASSERT_TRUE(same) << c.name << " read uc";
+      }
     }
     EXPECT_EQ(differs, bsdfPicksALobe(c.bsdf)) << c.name;
   }
@@ -302,6 +308,46 @@ TEST(Bsdf, EnergyConservation) {
   }
 }
 
+// Every material name Mitsuba 3's conductor takes (its spectra, as RGB in scalar_rgb): each
+// gives finite, non-negative eta and k and a reflectance at normal incidence in (0, 1]; the
+// "_palik" names read the same data as the plain ones, except Cu's, which Mitsuba keeps apart;
+// tungsten (W) matches Mitsuba 3.9.1's RGB to 1e-3.
+TEST(Bsdf, EveryMitsubaConductorMaterial) {
+  const char* names[] = {"a-C",  "Ag",   "Al",  "AlAs", "AlSb", "Au",       "Be",  "Cr",  "CsI",      "Cu",
+                         "Cu2O", "CuO",  "d-C", "Hg",   "HgTe", "Ir",       "K",   "Li",  "MgO",      "Mo",
+                         "Nb",   "Rh",   "Se",  "SiC",  "SnTe", "Ta",       "Te",  "ThF4", "TiC",     "TiN",
+                         "TiO2", "VC",   "VN",  "W",    "Na_palik", "Ni_palik", "V_palik", "Cu_palik"};
+  for (const char* m : names) {
+    Color eta, k;
+    bool mirror = true;
+    ASSERT_NO_THROW(conductorPreset(m, &eta, &k, &mirror)) << m;
+    EXPECT_FALSE(mirror) << m;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_TRUE(std::isfinite(eta[c]) && eta[c] >= 0.f && std::isfinite(k[c]) && k[c] >= 0.f) << m;
+    }
+    const Color F = fresnelConductor(1.f, eta, k);
+    EXPECT_GT(F.x + F.y + F.z, 0.f) << m;
+    EXPECT_LE(std::max({F.x, F.y, F.z}), 1.f) << m;
+  }
+  for (const char* m : {"AlAs", "Be", "Hg", "Mo", "TiN", "VN"}) {
+    Color eta, k, etaP, kP;
+    bool mirror;
+    conductorPreset(m, &eta, &k, &mirror);
+    conductorPreset(std::string(m) + "_palik", &etaP, &kP, &mirror);
+    EXPECT_EQ(eta.x, etaP.x) << m;
+    EXPECT_EQ(k.z, kP.z) << m;
+  }
+  Color eta, k, etaP, kP;
+  bool mirror;
+  conductorPreset("Cu", &eta, &k, &mirror);
+  conductorPreset("Cu_palik", &etaP, &kP, &mirror);
+  EXPECT_NE(eta.x, etaP.x) << "Mitsuba's Cu and Cu_palik are two data sets";
+  EXPECT_THROW(conductorPreset("Au_palik", &eta, &k, &mirror), std::runtime_error) << "Mitsuba has no Au_palik";
+  conductorPreset("W", &eta, &k, &mirror);
+  EXPECT_NEAR(eta.x, 4.371f, 1e-3f);
+  EXPECT_NEAR(k.z, 2.273f, 1e-3f);
+}
+
 TEST(Bsdf, ConductorPresetsAndFresnel) {
   Color eta, k;
   bool mirror;
@@ -316,6 +362,11 @@ TEST(Bsdf, ConductorPresetsAndFresnel) {
   Color F = fresnelConductor(1.f, eta, k);
   EXPECT_GT(F.x, F.z) << "gold reflects red more than blue";
   EXPECT_THROW(conductorPreset("Unobtainium", &eta, &k, &mirror), std::runtime_error);
+  try {
+    conductorPreset("Wolfram", &eta, &k, &mirror);
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("Ni_palik"), std::string::npos) << "the error lists the names: " << e.what();
+  }
   EXPECT_NEAR(fresnelDielectric(1.f, 1.5f), 0.04f, 1e-4f);
   EXPECT_EQ(fresnelDielectric(-0.1f, 1.5f), 1.f);  // total internal reflection from inside
   EXPECT_NEAR(fresnelDiffuseReflectance(1.5f), 0.092f, 0.003f);
