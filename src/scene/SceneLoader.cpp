@@ -261,10 +261,15 @@ class Loader {
     if (!x) return def;
     expectTag(f, *x, {"float", "string"});
     std::string v = attr(f, x->node, "value");
+    // Mitsuba 3's names with its values, and envgi's "glass" (bk7) and "sapphire".
     static const std::map<std::string, float> named = {
-        {"vacuum", 1.f},       {"air", 1.000277f},      {"water", 1.333f},   {"bk7", 1.5046f},
-        {"glass", 1.5046f},    {"polypropylene", 1.49f}, {"acrylic glass", 1.49f}, {"diamond", 2.419f},
-        {"sapphire", 1.77f},   {"fused quartz", 1.458f}};
+        {"vacuum", 1.f},          {"helium", 1.000036f},    {"hydrogen", 1.000132f},  {"air", 1.000277f},
+        {"carbon dioxide", 1.00045f}, {"water", 1.333f},    {"acetone", 1.36f},       {"ethanol", 1.361f},
+        {"carbon tetrachloride", 1.461f}, {"glycerol", 1.4729f}, {"benzene", 1.501f}, {"silicone oil", 1.52045f},
+        {"bromine", 1.661f},      {"water ice", 1.31f},     {"fused quartz", 1.458f}, {"pyrex", 1.47f},
+        {"acrylic glass", 1.49f}, {"polypropylene", 1.49f}, {"bk7", 1.5046f},         {"sodium chloride", 1.544f},
+        {"amber", 1.55f},         {"pet", 1.575f},          {"diamond", 2.419f},      {"glass", 1.5046f},
+        {"sapphire", 1.77f}};
     if (x->tag == "string") {
       auto it = named.find(v);
       if (it == named.end()) fail(f, x->node, fmt::format("unknown index of refraction '{}'", v));
