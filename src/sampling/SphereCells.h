@@ -12,9 +12,10 @@ namespace envgi {
 
 ENVGI_INLINE int sphereCellCount(int n) { return 2 * n * n; }
 
-// The cell of (u, v), row-major by v.
+// The cell of (u, v), row-major by v (a NaN coordinate reads as 0).
 ENVGI_INLINE int sphereCellOf(Vec2f uv, int n) {
-  int iu = int(uv.x * float(2 * n)), iv = int(uv.y * float(n));
+  const float u = fminf(fmaxf(uv.x, 0.f), 1.f), v = fminf(fmaxf(uv.y, 0.f), 1.f);
+  int iu = int(u * float(2 * n)), iv = int(v * float(n));
   iu = iu < 0 ? 0 : (iu > 2 * n - 1 ? 2 * n - 1 : iu);
   iv = iv < 0 ? 0 : (iv > n - 1 ? n - 1 : iv);
   return iv * 2 * n + iu;
