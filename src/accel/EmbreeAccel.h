@@ -57,7 +57,8 @@ class EmbreeAccel {
   // intersect() for n coherent rays (rays(i) the i-th, out(i, found, hit) its answer) in
   // Embree's 16-wide packets, which share traversal steps: a tile's camera rays, in 4 x 4
   // blocks, in 0.83x the time of one at a time (docs/performance.md, stop 50). The hits are
-  // those of intersect() to the bit.
+  // intersect()'s: the same primitive, u and v to the bit, t within an ulp or two (the packet
+  // kernels compute it their own way).
   template <class Rays, class Out>
   void intersectCoherent(int n, Rays rays, Out out) const {
     alignas(64) RTCRayHit16 rh;

@@ -223,9 +223,8 @@ struct EnvironmentMapView {
     float r;
     int i = t.sample(u, pmf, &r);
     int px = i % width, py = i / width;
-    float a = std::floor(r * 4096.f), rest = r * 4096.f - a;
-    float ux = (a + 0.5f) * (1.f / 4096.f), uy = (std::floor(rest * 2048.f) + 0.5f) * (1.f / 2048.f);
-    return {(float(px) + ux) / float(width), (float(py) + uy) / float(height)};
+    const Vec2f f = splitLeftover(r);
+    return {(float(px) + f.x) / float(width), (float(py) + f.y) / float(height)};
   }
 
   // A density over (u, v) as a density in solid angle: dw = 2 pi^2 sin(theta) du dv; zero at

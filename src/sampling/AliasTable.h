@@ -1,6 +1,7 @@
 // Walker/Vose alias table: O(1) discrete sampling, the alternative to binary search.
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include "core/Vec.h"
@@ -56,6 +57,14 @@ struct AliasTableView {
     return chosen;
   }
 };
+
+// A choice's leftover number (AliasTableView::sample's *rest) as a point of the unit square,
+// for the place inside what was chosen: 12 bits across, 11 down, each centred in its step so
+// that float rounding never carries the point over the square's edge.
+ENVGI_INLINE Vec2f splitLeftover(float r) {
+  const float a = std::floor(r * 4096.f), rest = r * 4096.f - a;
+  return {(a + 0.5f) * (1.f / 4096.f), (std::floor(rest * 2048.f) + 0.5f) * (1.f / 2048.f)};
+}
 
 class AliasTable {
  public:

@@ -66,19 +66,20 @@ void buildLightCells(const std::vector<MeshView>& meshes, const std::vector<Text
   auto sphereTexels = [&](const TextureView& t) {
     return std::max(texelLength(t, Vec2f(0.f, 1.f)), 0.5f * texelLength(t, Vec2f(1.f, 0.f)));
   };
-  std::vector<float> side(lights.size(), 0.f);
+  // Each light's extent in texels (a triangle's longest side, a sphere's rows) and side count.
+  std::vector<float> texels(lights.size(), 0.f), side(lights.size(), 0.f);
   double total = 0.0;
   for (size_t i = 0; i < lights.size(); ++i) {
     const LightPrim& lp = lights[i];
     if (lp.radianceTexture < 0 || !(lp.area > 0.f)) continue;
     const TextureView& t = textures[size_t(lp.radianceTexture)];
     const bool sphere = lp.geomId >= meshCount;
-    const float want = sphere ? sphereTexels(t) : 2.f * longestSide(lp, t);
-    side[i] = std::min(std::max(std::ceil(want), 1.f), kMaxSide);
+    texels[i] = sphere ? sphereTexels(t) : longestSide(lp, t);
+    side[i] = std::min(std::max(std::ceil(sphere ? texels[i] : 2.f * texels[i]), 1.f), kMaxSide);
     total += (sphere ? 2.0 : 1.0) * double(side[i]) * double(side[i]);
   }
   const float shrink = total > kMaxCells ? float(std::sqrt(kMaxCells / total)) : 1.f;
-  std::vector<float> weight, shares;
+  std::vector<float> weight;
   std::vector<Color> colour;
   for (size_t i = 0; i < lights.size(); ++i) {
     if (side[i] == 0.f) continue;
@@ -91,12 +92,13 @@ void buildLightCells(const std::vector<MeshView>& meshes, const std::vector<Text
     // takes in the cell's edges and corners, so that a bright texel crossing a sliver of the
     // cell is seen, pulled inside by 1e-3 of the cell, so that a cell whose edges are texel
     // edges does not read its neighbours' texels.
-    const float cellTexels = (sphere ? sphereTexels(t) : longestSide(lp, t)) / float(n);
+    const float cellTexels = texels[i] / float(n);
     const int k = std::min(6, std::max(2, int(std::ceil(4.f * cellTexels))));
     constexpr float kInset = 1e-3f;
     weight.assign(size_t(cellCount), 0.f);
     colour.assign(size_t(cellCount), Color(0.f));
-    shares.assign(size_t(cellCount), 0.f);
+    // The cell's part of the light's area.
+    auto share = [&](int c) { return sphere ? sphereCellShare(c, n) : 1.f / float(cellCount); };
     // The cells apart (a 512 x 256 texture's two triangles read 3.8 M points), summed after in
     // order, so that the tables do not depend on the thread count.
     tbb::parallel_for(tbb::blocked_range<int>(0, cellCount, 256), [&](const tbb::blocked_range<int>& range) {
@@ -110,7 +112,6 @@ void buildLightCells(const std::vector<MeshView>& meshes, const std::vector<Text
           cellColour += L;
           ++points;
         };
-        float share;  // the cell's part of the light's area
         if (sphere) {
           const int iv = c / (2 * n), iu = c - iv * 2 * n;
           for (int a = 0; a <= k; ++a)
@@ -119,7 +120,6 @@ void buildLightCells(const std::vector<MeshView>& meshes, const std::vector<Text
               const float fb = kInset + (1.f - 2.f * kInset) * float(b) / float(k);
               at(Vec2f((float(iu) + fa) / float(2 * n), (float(iv) + fb) / float(n)));
             }
-          share = sphereCellShare(c, n);
         } else {
           const MeshView& m = meshes[size_t(lp.geomId)];
           const uint32_t* ix = m.indices + 3 * lp.primId;
@@ -135,16 +135,14 @@ void buildLightCells(const std::vector<MeshView>& meshes, const std::vector<Text
               atBary(v0 * (1.f - fa - fb) + v1 * fa + v2 * fb);
             }
           atBary(centre);
-          share = 1.f / float(cellCount);
         }
-        weight[size_t(c)] = share * cellSum / float(points);
-        colour[size_t(c)] = cellColour * (share / float(points));
-        shares[size_t(c)] = share;
+        weight[size_t(c)] = share(c) * cellSum / float(points);
+        colour[size_t(c)] = cellColour * (share(c) / float(points));
       }
     });
     Color sum(0.f);
     double totalShare = 0.0;
-    for (int c = 0; c < cellCount; ++c) sum += colour[size_t(c)], totalShare += double(shares[size_t(c)]);
+    for (int c = 0; c < cellCount; ++c) sum += colour[size_t(c)], totalShare += double(share(c));
     double mean = 0.0;
     for (float w : weight) mean += double(w);
     mean /= double(weight.size());

@@ -349,6 +349,16 @@ struct SceneView {
   }
 };
 
+// A textured light's cell, drawn from its table by u, and through *inside the point's place in
+// it from the bits the choice left over.
+ENVGI_INLINE int drawLightCell(const SceneView& sc, const LightPrim& lp, int cellCount, Vec2f u, float* pmf,
+                               Vec2f* inside) {
+  float rest;
+  const int cell = AliasTableView{sc.lightCells + lp.cellOffset, cellCount}.sample(u, pmf, &rest);
+  *inside = splitLeftover(rest);
+  return cell;
+}
+
 // A point on a light primitive: its position, normal, the radiance it emits there and its
 // density over the primitive's area (1 / area unless the primitive is drawn by its texture).
 ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2f u, Vec3f* p, Vec3f* n, Color* Le,
@@ -361,13 +371,11 @@ ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2
     Vec3f p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
     Vec2f b;
     if (lp.cells > 0) {
-      // The cell from both numbers, the point inside it from the bits the choice left over.
       const int cellCount = lp.cells * lp.cells;
-      float pmf, rest;
-      const int cell = AliasTableView{sc.lightCells + lp.cellOffset, cellCount}.sample(u, &pmf, &rest);
-      const float a = std::floor(rest * 4096.f), fine = rest * 4096.f - a;
-      b = sampleTriangleCell(cell, lp.cells,
-                             Vec2f((a + 0.5f) * (1.f / 4096.f), (std::floor(fine * 2048.f) + 0.5f) * (1.f / 2048.f)));
+      float pmf;
+      Vec2f inside;
+      const int cell = drawLightCell(sc, lp, cellCount, u, &pmf, &inside);
+      b = sampleTriangleCell(cell, lp.cells, inside);
       *areaPdf = pmf * float(cellCount) / lp.area;
     } else {
       b = sampleUniformTriangle(u);
@@ -384,12 +392,10 @@ ENVGI_INLINE void sampleLightPrim(const SceneView& sc, const LightPrim& lp, Vec2
     const SphereView& s = sc.spheres[lp.geomId - sc.meshCount];
     Vec3f d;
     if (lp.cells > 0) {
-      const int cellCount = sphereCellCount(lp.cells);
-      float pmf, rest;
-      const int cell = AliasTableView{sc.lightCells + lp.cellOffset, cellCount}.sample(u, &pmf, &rest);
-      const float a = std::floor(rest * 4096.f), fine = rest * 4096.f - a;
-      d = s.axes.toWorld(sampleSphereCell(
-          cell, lp.cells, Vec2f((a + 0.5f) * (1.f / 4096.f), (std::floor(fine * 2048.f) + 0.5f) * (1.f / 2048.f))));
+      float pmf;
+      Vec2f inside;
+      const int cell = drawLightCell(sc, lp, sphereCellCount(lp.cells), u, &pmf, &inside);
+      d = s.axes.toWorld(sampleSphereCell(cell, lp.cells, inside));
       *areaPdf = pmf / (sphereCellShare(cell, lp.cells) * lp.area);
     } else {
       d = sampleUniformSphere(u);
