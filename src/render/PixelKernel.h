@@ -233,11 +233,15 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
   for (int k = 0; k < n; ++k) b->acc[k] = Color(0.f), b->accSq[k] = 0.0, b->accW[k] = 0.f;
   for (int s = s0; s < s1; ++s) {
     int live = 0;
-    for (int k = 0; k < n; ++k) {
-      int x = x0 + k % tw, y = y0 + k / tw;
-      if (!film.takesSamples(size_t(y) * size_t(cam.width) + size_t(x))) continue;
-      b->sampler[k] = sequenceSampler(seq);
-      b->state[k] = integ.begin(startCameraSample(cam, b->sampler[k], x, y, s, &b->weight[k]));
+    // Every pixel's sampler starts from this one: sample s's share of start() is done once.
+    Sampler first = sequenceSampler(seq);
+    first.setIndex(uint32_t(s));
+    for (int k = 0, x = x0, y = y0; k < n; ++k, x = x + 1 < x1 ? x + 1 : x0, y += x == x0) {
+      const uint64_t pixel = uint64_t(y) * uint64_t(cam.width) + uint64_t(x);
+      if (!film.takesSamples(size_t(pixel))) continue;
+      b->sampler[k] = first;
+      b->sampler[k].startPixel(pixel);  // startCameraSample's start(), in its two halves
+      b->state[k] = integ.begin(sampleCameraRay(cam, b->sampler[k], x, y, &b->weight[k]));
       b->active[live++] = k;
     }
     for (bool cameraRays = true; live > 0; cameraRays = false) {

@@ -125,12 +125,21 @@ struct Sampler {
 
   // Begin sample `sampleIndex` of a pixel (a pixel id, or any stream id for non-image work).
   ENVGI_HD void start(uint64_t pixel, uint32_t sampleIndex) {
-    pixelHash = hashCombine(mixBits(pixel), seed);
+    setIndex(sampleIndex);
+    startPixel(pixel);
+  }
+  // start() in two halves, for an executor that starts sample s of many pixels at once: what
+  // depends on the sample index alone (a division and a loop), once; then each pixel's part.
+  ENVGI_HD void setIndex(uint32_t sampleIndex) {
     index = sampleIndex;
     indexInPixel = sampleIndex % spp;
     block = powerOfTwoBlock(indexInPixel, spp);
+  }
+  ENVGI_HD void startPixel(uint64_t pixel) {
+    pixelHash = hashCombine(mixBits(pixel), seed);
     dim = 0;
-    rng.setSeed(pixelHash, uint64_t(sampleIndex) + 1u);
+    // Sobol never reads the generator (nor steps it in skip1D/skip2D).
+    if (type != SamplerType::Sobol) rng.setSeed(pixelHash, uint64_t(index) + 1u);
   }
 
   ENVGI_HD float get1D() {

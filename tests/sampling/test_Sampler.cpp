@@ -79,6 +79,31 @@ TEST_P(SamplerTypes, SkippedDrawsLeaveTheLaterOnesAsTheyWere) {
   }
 }
 
+// start() in its two halves, as renderTileByBounce runs it (setIndex once for sample s, then a
+// copy per pixel and startPixel), draws what start() draws, at a power of two and not.
+TEST_P(SamplerTypes, StartInTwoHalvesDrawsAsStart) {
+  for (uint32_t spp : {16u, 19u}) {
+    Sampler whole, first;
+    whole.type = first.type = GetParam();
+    whole.spp = first.spp = spp;
+    whole.seed = first.seed = 7;
+    for (uint32_t s = 0; s < spp; ++s) {
+      first.setIndex(s);
+      for (uint64_t pixel : {0ull, 5ull, 1000003ull}) {
+        Sampler halves = first;
+        halves.startPixel(pixel);
+        whole.start(pixel, s);
+        for (int d = 0; d < 4; ++d) {
+          Vec2f a = whole.get2D(), b = halves.get2D();
+          EXPECT_EQ(a.x, b.x) << "sample " << s << ", pixel " << pixel;
+          EXPECT_EQ(a.y, b.y);
+          EXPECT_EQ(whole.get1D(), halves.get1D());
+        }
+      }
+    }
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(All, SamplerTypes,
                          ::testing::Values(SamplerType::Independent, SamplerType::Stratified, SamplerType::Sobol));
 
