@@ -117,7 +117,8 @@ TriangleMesh loadSerialized(const std::string& path, int shapeIndex, bool* faceN
     if (size_t(count) * entry + 4 > bytes.size()) throw std::runtime_error(path + ": corrupt dictionary of meshes");
     const size_t at = bytes.size() - 4 - size_t(count - uint32_t(shapeIndex)) * entry;
     offset = version == 4 ? size_t(readAt<uint64_t>(bytes, at)) : size_t(readAt<uint32_t>(bytes, at));
-    if (offset + 4 > bytes.size() || readAt<uint16_t>(bytes, offset) != kSerializedMagic)
+    // Compared as offset > size - 4 (size is at least 8 here): offset + 4 wraps for an offset near 2^64.
+    if (offset > bytes.size() - 4 || readAt<uint16_t>(bytes, offset) != kSerializedMagic)
       throw std::runtime_error(fmt::format("{}: mesh {} does not start with the 0x041C header", path, shapeIndex));
   }
   Inflater z(path, bytes.data() + offset + 4, bytes.size() - offset - 4);

@@ -106,6 +106,11 @@ TEST(SerializedReader, DamagedFilesGiveClearErrors) {
   uint64_t far = 1u << 30;
   std::memcpy(b.data() + b.size() - 12, &far, 8);
   EXPECT_NE(loadError(variant("dict.serialized", b), 1).find("does not start with the 0x041C header"), std::string::npos);
+  // One so near 2^64 that offset + 4 wraps round to a small number (found by the mesh fuzzer).
+  b = bytes;
+  far = ~uint64_t(0) - 1;
+  std::memcpy(b.data() + b.size() - 12, &far, 8);
+  EXPECT_NE(loadError(variant("wrap.serialized", b), 1).find("does not start with the 0x041C header"), std::string::npos);
   // A triangle whose index is past the vertices: validate()'s error.
   MeshData bad = triangle();
   bad.indices = {0, 1, 7};
