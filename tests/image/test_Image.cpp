@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <random>
 
 #include <filesystem>
@@ -168,6 +169,20 @@ TEST(Image, HeadersThatPromiseMoreThanTheFileHoldsThrow) {
   expectError("no-blank-line.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n-Y 2 +X 3\n" + pixels, "header does not end");
   expectError("huge.hdr", rgbe + "-Y 30000 +X 30000\n" + pixels, "truncated");
   expectError("huge.pfm", "PF\n40000 40000\n-1.0\n" + pixels, "truncated");
+  {
+    // An EXR whose dataWindow says 10 M x 2 pixels over a few hundred bytes (its offset table,
+    // one chunk, is whole): refused before its 240 MB are allocated.
+    Image small(4, 2);
+    saveImage(small, (d / "small.exr").string());
+    std::ifstream in(d / "small.exr", std::ios::binary);
+    std::string exr((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
+    const size_t at = exr.find(key);
+    ASSERT_NE(at, std::string::npos);
+    const int32_t big = 9999999;
+    std::memcpy(&exr[at + key.size() + 4 + 8], &big, 4);  // xMax
+    expectError("huge.exr", exr, "more than its");
+  }
 
   // A PNG whose second chunk claims 4 GB, and a JPEG cut inside its data.
   Image img(64, 32);
