@@ -9,11 +9,16 @@
 using namespace envgi;
 
 namespace {
-std::vector<Vec2f> draw(SamplerType t, uint32_t spp, uint32_t seed, uint64_t pixel) {
+Sampler sampler(SamplerType t, uint32_t spp, uint32_t seed) {
   Sampler s;
   s.type = t;
   s.spp = spp;
   s.seed = seed;
+  return s;
+}
+
+std::vector<Vec2f> draw(SamplerType t, uint32_t spp, uint32_t seed, uint64_t pixel) {
+  Sampler s = sampler(t, spp, seed);
   std::vector<Vec2f> out;
   for (uint32_t i = 0; i < spp; ++i) {
     s.start(pixel, i);
@@ -57,10 +62,7 @@ TEST_P(SamplerTypes, MeanIsOneHalf) {
 // map-only scene never uses), at sample counts that are and are not a square or a power of two.
 TEST_P(SamplerTypes, SkippedDrawsLeaveTheLaterOnesAsTheyWere) {
   for (uint32_t spp : {16u, 19u}) {
-    Sampler drawn, skipped;
-    drawn.type = skipped.type = GetParam();
-    drawn.spp = skipped.spp = spp;
-    drawn.seed = skipped.seed = 3;
+    Sampler drawn = sampler(GetParam(), spp, 3), skipped = drawn;
     for (uint32_t i = 0; i < spp; ++i) {
       drawn.start(42, i);
       skipped.start(42, i);
@@ -83,10 +85,7 @@ TEST_P(SamplerTypes, SkippedDrawsLeaveTheLaterOnesAsTheyWere) {
 // copy per pixel and startPixel), draws what start() draws, at a power of two and not.
 TEST_P(SamplerTypes, StartInTwoHalvesDrawsAsStart) {
   for (uint32_t spp : {16u, 19u}) {
-    Sampler whole, first;
-    whole.type = first.type = GetParam();
-    whole.spp = first.spp = spp;
-    whole.seed = first.seed = 7;
+    Sampler whole = sampler(GetParam(), spp, 7), first = whole;
     for (uint32_t s = 0; s < spp; ++s) {
       first.setIndex(s);
       for (uint64_t pixel : {0ull, 5ull, 1000003ull}) {
