@@ -1,3 +1,8 @@
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -169,19 +174,39 @@ TEST(Image, HeadersThatPromiseMoreThanTheFileHoldsThrow) {
   expectError("no-blank-line.hdr", "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n-Y 2 +X 3\n" + pixels, "header does not end");
   expectError("huge.hdr", rgbe + "-Y 30000 +X 30000\n" + pixels, "truncated");
   expectError("huge.pfm", "PF\n40000 40000\n-1.0\n" + pixels, "truncated");
+  // An EXR file's bytes with the int32 `skip` bytes after attribute `name` of `type` set to v.
+  auto patchedExr = [&](const std::string& file, const std::string& name, const std::string& type, size_t skip,
+                        int32_t v) {
+    std::ifstream in(d / file, std::ios::binary);
+    std::string exr((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string key = name + '\0' + type + '\0';
+    const size_t at = exr.find(key);
+    EXPECT_NE(at, std::string::npos) << name;
+    if (at != std::string::npos) std::memcpy(&exr[at + key.size() + skip], &v, 4);
+    return exr;
+  };
   {
     // An EXR whose dataWindow says 10 M x 2 pixels over a few hundred bytes (its offset table,
     // one chunk, is whole): refused before its 240 MB are allocated.
     Image small(4, 2);
     saveImage(small, (d / "small.exr").string());
-    std::ifstream in(d / "small.exr", std::ios::binary);
-    std::string exr((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const std::string key = std::string("dataWindow") + '\0' + "box2i" + '\0';
-    const size_t at = exr.find(key);
-    ASSERT_NE(at, std::string::npos);
-    const int32_t big = 9999999;
-    std::memcpy(&exr[at + key.size() + 4 + 8], &big, 4);  // xMax
-    expectError("huge.exr", exr, "more than its");
+    expectError("huge.exr", patchedExr("small.exr", "dataWindow", "box2i", 4 + 8, 9999999), "more than its");  // xMax
+  }
+  {
+    // A string attribute whose size field says 1.98 GB (a fuzz input's): refused from the
+    // header, where OpenEXR's InputFile allocated it and read to the end (21 s, 1.9 GB).
+    Imf::Header header(4, 2);
+    header.insert("generatedBy", Imf::StringAttribute("envgi's test"));
+    header.channels().insert("Y", Imf::Channel(Imf::FLOAT));
+    std::vector<float> grey(8, 0.5f);
+    Imf::FrameBuffer fb;
+    fb.insert("Y", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(grey.data()), sizeof(float), 4 * sizeof(float)));
+    {
+      Imf::OutputFile out((d / "attr.exr").string().c_str(), header);
+      out.setFrameBuffer(fb);
+      out.writePixels(2);
+    }
+    expectError("huge-attribute.exr", patchedExr("attr.exr", "generatedBy", "string", 0, 0x76000015), "generatedBy");
   }
 
   // A PNG whose second chunk claims 4 GB, and a JPEG cut inside its data.
