@@ -8,6 +8,7 @@
 
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
+#include "core/Files.h"
 #include "render/PhotonShooter.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
@@ -26,6 +27,7 @@ void runPhotons(const PhotonsArgs& a) {
   std::map<std::string, std::string> defs = parseDefines(a.defines);
   std::string ext = std::filesystem::path(a.output).extension().string();
   if (ext != ".png" && ext != ".exr") throw std::runtime_error("output '" + a.output + "' must end in .png or .exr");
+  requireWritableDirectoryOf(a.output);  // before the photons are shot
   Scene scene;
   loadScene(a.scene, defs, scene);
   scene.integrator = IntegratorSettings{};

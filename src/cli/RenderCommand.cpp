@@ -12,6 +12,7 @@
 #include "accel/Bvh.h"
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
+#include "core/Files.h"
 #include "gpu/CudaExecutor.h"
 #include "render/AovRenderer.h"
 #include "render/Renderer.h"
@@ -53,11 +54,12 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
 
 void runRender(const RenderArgs& a) {
   namespace fs = std::filesystem;
-  // Both images are checked before the render, so a bad name cannot cost its samples.
+  // Both images are checked before the render, so a bad name or folder cannot cost its samples.
   auto requireImageName = [](const std::string& path, const std::string& what) {
     std::string e = fs::path(path).extension().string();
     if (e != ".exr" && e != ".pfm" && e != ".hdr" && e != ".png")
       throw std::runtime_error(what + " '" + path + "' must end in .exr, .pfm, .hdr or .png");
+    requireWritableDirectoryOf(path);
     return e;
   };
   std::string ext = requireImageName(a.output, "output");

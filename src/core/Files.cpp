@@ -18,10 +18,17 @@ std::string temporarySibling(const std::string& path, const std::string& suffix)
   return (dir / name).string();
 }
 
-void writeFileAtomically(const std::string& path, const std::string& content) {
+void requireWritableDirectoryOf(const std::string& path) {
   fs::path p(path);
   fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir)) throw std::runtime_error("cannot write '" + path + "': directory does not exist");
+  // The temporary file is made beside the output and renamed onto it: both need w and x.
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw std::runtime_error("cannot write '" + path + "': directory '" + dir.string() + "' is not writable");
+}
+
+void writeFileAtomically(const std::string& path, const std::string& content) {
+  requireWritableDirectoryOf(path);
   fs::path tmp = temporarySibling(path, "");
   {
     std::ofstream f(tmp, std::ios::binary);

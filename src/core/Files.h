@@ -11,6 +11,10 @@ std::string temporarySibling(const std::string& path, const std::string& suffix)
 // Renames a finished temporary file onto `path`; removes it and throws if that fails.
 void renameIntoPlace(const std::string& tmp, const std::string& path);
 
+// Throws unless `path` could be written: its directory must exist and take new files. Commands
+// call it before long work, so that a mistyped folder does not cost a render its samples.
+void requireWritableDirectoryOf(const std::string& path);
+
 // Writes `content` to a hidden temporary file beside `path`, then renames it into place.
 void writeFileAtomically(const std::string& path, const std::string& content);
 

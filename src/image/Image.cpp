@@ -445,8 +445,7 @@ void saveImage(const Image& img, const std::string& path, const SaveOptions& opt
   if (!known)
     throw std::runtime_error("cannot write '" + path + "': no writer for '" + ext +
                              "' (envgi writes .exr, .pfm, .hdr, .png, .jpg)");
-  fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  if (!fs::is_directory(dir)) throw std::runtime_error("cannot write '" + path + "': directory does not exist");
+  requireWritableDirectoryOf(path);
   // Hidden, so a crash leaves no look-alike; renamed into place only once complete.
   fs::path tmp = temporarySibling(path, ext);
   bool ok = false;

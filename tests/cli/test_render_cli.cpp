@@ -96,6 +96,14 @@ TEST(CliRender, ErrorsLeaveNoOutput) {
   EXPECT_NE(runCli("render " + scene + " -o " + out + " --strategy nonsense").code, 0);
   EXPECT_NE(runCli("render " + scene + " -o " + out + " -D broken").code, 0);
   EXPECT_FALSE(fs::exists(out));
+  // A folder that is not there is said before the render, not after it (no progress bar ran).
+  CliResult noDir = runCli("render " + scene + " -o " + d.file("missing/x.exr"));
+  EXPECT_EQ(noDir.code, 1) << noDir.output;
+  EXPECT_NE(noDir.output.find("missing/x.exr': directory does not exist"), std::string::npos) << noDir.output;
+  EXPECT_EQ(noDir.output.find("100%"), std::string::npos) << noDir.output;
+  CliResult noMapDir = runCli("render " + scene + " -o " + out + " --sample-map " + d.file("missing/spp.png"));
+  EXPECT_NE(noMapDir.output.find("directory does not exist"), std::string::npos) << noMapDir.output;
+  EXPECT_FALSE(fs::exists(out));
   // A misspelt property (here the sphere's radius) is one error line naming the nearest name.
   std::string text;
   {
