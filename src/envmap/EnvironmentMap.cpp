@@ -25,11 +25,12 @@ std::vector<uint32_t> pixelsToWarp(const EnvironmentMapView& v) {
       for (const auto& row : l)
         for (float e : row) lo = std::min(lo, e), hi = std::max(hi, e);
       size_t i = size_t(y) * v.width + x;
-      // Not below 1e-15 either: the warp squares lattice values (sampleLinear) and takes ratios of
-      // their sums, which lose their digits to underflow near FLT_MIN (a draw's density then
-      // differed from pdf()'s by 1.6% on a map of 1e-43 texels: fuzz_envmap). Such a pixel is
-      // drawn uniformly inside, as a flat one is.
-      if (hi > 2.f * lo && hi >= 1e-15f) bits[i >> 5] |= 1u << (i & 31);
+      // Nor below 1e-15 or above 1e15: the warp squares lattice values (sampleLinear) and takes
+      // ratios of their sums, which lose their digits to underflow near FLT_MIN (a draw's density
+      // differed from pdf()'s by 1.6% on a map of 1e-43 texels: fuzz_envmap) and overflow to
+      // infinity past 1.8e19 (by 3.7x next to texels of 1e30, stop 52). Such a pixel is drawn
+      // uniformly inside, as a flat one is; a measured sun (about 1.6e9) stays well inside.
+      if (hi > 2.f * lo && hi >= 1e-15f && hi <= 1e15f) bits[i >> 5] |= 1u << (i & 31);
     }
   return bits;
 }

@@ -215,6 +215,10 @@ TEST(EnvSamplingSun, DrawsInsideAPixelFollowTheLookup) { expectDrawsFollowTheirP
 // (fuzz_envmap found a 1.6% gap between the two on a map of 1e-43 texels).
 TEST(EnvSamplingSun, DrawsOnAFaintMapFollowTheirDensity) { expectDrawsFollowTheirPdf(1e-30f); }
 
+// And on one so bright (1e28 and above) that squaring its lattice overflows (fuzz_envmap: a draw
+// next to texels of 1e30 reported 3.7x the density pdf() gave its direction).
+TEST(EnvSamplingSun, DrawsOnABlindingMapFollowTheirDensity) { expectDrawsFollowTheirPdf(1e28f); }
+
 // Estimating the map's luminance power, integral of Y(L), by each strategy's Monte Carlo
 // estimator: all agree with the exact sum (unbiasedness through sample + pdf + lookup).
 TEST(EnvSamplingSun, EstimatorsAreUnbiased) {
