@@ -1,6 +1,9 @@
 #include "photon/PhotonMap.h"
 
 #include <nanoflann.hpp>
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
 
 namespace envgi {
 
@@ -71,6 +74,44 @@ void PhotonMap::estimateIrradiance(size_t i, int k, float maxRadius) {
   }
   if (kept < kk) r2 = maxR2;
   irr_[i] = {c.p, c.n, kept > 0 ? sum / (kPi * r2) : Color(0.f), r2};
+}
+
+namespace {
+// 10 bits of x spread to every third bit (a Morton code's share of one axis).
+uint32_t spreadBits10(uint32_t x) {
+  x &= 0x3ffu;
+  x = (x | (x << 16)) & 0x030000ffu;
+  x = (x | (x << 8)) & 0x0300f00fu;
+  x = (x | (x << 4)) & 0x030c30c3u;
+  x = (x | (x << 2)) & 0x09249249u;
+  return x;
+}
+}  // namespace
+
+std::vector<uint32_t> PhotonMap::irradianceOrder() const {
+  const size_t n = irr_.size();
+  Vec3f lo(INFINITY), hi(-INFINITY);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3f p = photons_[i * size_t(irrStride_)].p;
+    lo = Vec3f(fminf(lo.x, p.x), fminf(lo.y, p.y), fminf(lo.z, p.z));
+    hi = Vec3f(fmaxf(hi.x, p.x), fmaxf(hi.y, p.y), fmaxf(hi.z, p.z));
+  }
+  // (code << 32 | index): one sort key, ties kept in index order.
+  std::vector<uint64_t> keys(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3f p = photons_[i * size_t(irrStride_)].p;
+    auto cell = [](float v, float a, float b) {
+      float t = b > a ? (v - a) / (b - a) : 0.f;
+      return uint32_t(std::clamp(t, 0.f, 1.f) * 1023.f);
+    };
+    const uint32_t code = spreadBits10(cell(p.x, lo.x, hi.x)) | spreadBits10(cell(p.y, lo.y, hi.y)) << 1 |
+                          spreadBits10(cell(p.z, lo.z, hi.z)) << 2;
+    keys[i] = uint64_t(code) << 32 | uint64_t(i);
+  }
+  tbb::parallel_sort(keys.begin(), keys.end());
+  std::vector<uint32_t> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = uint32_t(keys[i]);
+  return order;
 }
 
 void PhotonMap::endIrradiance() {

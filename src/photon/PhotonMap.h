@@ -41,6 +41,10 @@ class PhotonMap {
   // (any order, any thread), then end (builds their IrradianceCache).
   size_t beginIrradiance(int stride);
   void estimateIrradiance(size_t i, int k, float maxRadius);
+  // The points of beginIrradiance in Morton order of their positions: estimated in this order,
+  // consecutive queries walk the same kd-tree nodes and photons, which stay in cache (photons
+  // are stored in the order they were shot, all over the scene). Changes no estimate.
+  std::vector<uint32_t> irradianceOrder() const;
   void endIrradiance();
   // Irradiance near p on a surface facing n (IrradianceCacheView::irradiance).
   Color irradiance(Vec3f p, Vec3f n) const { return cache_.view().irradiance(p, n); }

@@ -165,7 +165,8 @@ void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* g
   if (s.irradianceStride > 0) {
     auto precompute = [&](PhotonMap* map, float radius) {
       size_t n = map->beginIrradiance(s.irradianceStride);
-      tbb::parallel_for(size_t(0), n, [&](size_t i) { map->estimateIrradiance(i, s.irradianceLookup, radius); });
+      const std::vector<uint32_t> order = map->irradianceOrder();
+      tbb::parallel_for(size_t(0), n, [&](size_t j) { map->estimateIrradiance(order[j], s.irradianceLookup, radius); });
       map->endIrradiance();
     };
     precompute(global, s.irradianceRadius);

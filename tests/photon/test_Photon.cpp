@@ -8,6 +8,7 @@
 #include "integrators/Sppm.h"
 #include "materials/BsdfFactory.h"
 #include "photon/HashGrid.h"
+#include "photon/PhotonMap.h"
 #include "render/PhotonShooter.h"
 #include "sampling/Pcg32.h"
 #include "support/TestScenes.h"
@@ -121,6 +122,49 @@ TEST(PhotonMapEstimate, UniformDensityGivesDiffuseRadiance) {
   EXPECT_EQ(map.irradiance(Vec3f(100.f, 0.f, 0.f), Vec3f(0, 0, 1)).x, 0.f);
   EXPECT_EQ(map.irradiance(Vec3f(0.f, 0.f, 3.f), Vec3f(0, 0, 1)).x, 0.f);
   EXPECT_GT(map.irradiance(Vec3f(0.99f, 0.f, 0.f), Vec3f(0, 0, 1)).x, 0.f) << "the plane's edge is still covered";
+}
+
+// The order the irradiance points are estimated in (PhotonShooter): every point once, neighbours
+// next to each other, and the same cache as estimating them in index order.
+TEST(PhotonMap, IrradianceOrderKeepsNeighboursTogetherAndChangesNoEstimate) {
+  Pcg32 rng(12);
+  std::vector<Photon> photons(20000);
+  for (Photon& ph : photons) {
+    ph.p = Vec3f(rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2, 0.f);  // shot order: all over the plane
+    ph.n = ph.wi = Vec3f(0, 0, 1);
+    ph.power = Color(rng.nextFloat());
+  }
+  PhotonMap inOrder, sorted;
+  inOrder.build(photons);
+  sorted.build(photons);
+  const size_t n = inOrder.beginIrradiance(4);
+  ASSERT_EQ(sorted.beginIrradiance(4), n);
+  const std::vector<uint32_t> order = sorted.irradianceOrder();
+  ASSERT_EQ(order.size(), n);
+  std::vector<char> seen(n, 0);
+  for (uint32_t i : order) {
+    ASSERT_LT(i, n);
+    EXPECT_FALSE(seen[i]) << i << " twice";
+    seen[i] = 1;
+  }
+  // Consecutive points: in Morton order a few photon spacings apart, in shot order about the
+  // plane's mean distance between two random points (about 2).
+  auto meanStep = [&](auto at) {
+    double sum = 0.0;
+    for (size_t j = 1; j < n; ++j) sum += length(photons[4 * at(j)].p - photons[4 * at(j - 1)].p);
+    return sum / double(n - 1);
+  };
+  const double shot = meanStep([](size_t j) { return j; }), morton = meanStep([&](size_t j) { return size_t(order[j]); });
+  EXPECT_GT(shot, 1.5);
+  EXPECT_LT(morton, 0.1) << "shot order " << shot;
+  for (size_t i = 0; i < n; ++i) inOrder.estimateIrradiance(i, 50, 0.5f);
+  for (uint32_t i : order) sorted.estimateIrradiance(i, 50, 0.5f);
+  inOrder.endIrradiance();
+  sorted.endIrradiance();
+  for (int t = 0; t < 200; ++t) {
+    Vec3f q(rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2, 0.f);
+    EXPECT_EQ(inOrder.irradiance(q, Vec3f(0, 0, 1)).x, sorted.irradiance(q, Vec3f(0, 0, 1)).x);
+  }
 }
 
 TEST(HashGrid, FindsEveryPointWithinTheCellSize) {
