@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 #include <chrono>
 #include <stdexcept>
@@ -160,8 +161,8 @@ void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* g
     stats->storedCaustic = c.size();
     stats->device = tracer->deviceName();
   }
-  global->build(std::move(g));
-  caustic->build(std::move(c));
+  // nanoflann (1.4 in Debian 12) builds a tree on one thread: the two maps' trees side by side.
+  tbb::parallel_invoke([&] { global->build(std::move(g)); }, [&] { caustic->build(std::move(c)); });
   if (s.irradianceStride > 0) {
     auto precompute = [&](PhotonMap* map, float radius) {
       size_t n = map->beginIrradiance(s.irradianceStride);
