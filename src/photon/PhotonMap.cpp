@@ -101,8 +101,8 @@ std::vector<uint32_t> PhotonMap::irradianceOrder() const {
   for (size_t i = 0; i < n; ++i) {
     const Vec3f p = photons_[i * size_t(irrStride_)].p;
     auto cell = [](float v, float a, float b) {
-      float t = b > a ? (v - a) / (b - a) : 0.f;
-      return uint32_t(std::clamp(t, 0.f, 1.f) * 1023.f);
+      float t = (v - a) / (b - a);  // NaN where b == a (or the box is infinite): cell 0
+      return t > 0.f ? uint32_t(fminf(t, 1.f) * 1023.f) : 0u;
     };
     const uint32_t code = spreadBits10(cell(p.x, lo.x, hi.x)) | spreadBits10(cell(p.y, lo.y, hi.y)) << 1 |
                           spreadBits10(cell(p.z, lo.z, hi.z)) << 2;
