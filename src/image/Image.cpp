@@ -89,8 +89,7 @@ Image loadExr(const std::string& path) {
   try {
     Imf::InputFile in(path.c_str());
     const Imath::Box2i dw = in.header().dataWindow();
-    int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;
-    if (w <= 0 || h <= 0) throw std::runtime_error("image '" + path + "' has no pixels");
+    const int w = dw.max.x - dw.min.x + 1, h = dw.max.y - dw.min.y + 1;  // > 0: checkExrHeader
     const Imf::ChannelList& ch = in.header().channels();
     bool rgb = ch.findChannel("R") && ch.findChannel("G") && ch.findChannel("B");
     bool grey = !rgb && ch.findChannel("Y");

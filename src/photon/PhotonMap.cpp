@@ -93,8 +93,8 @@ std::vector<uint32_t> PhotonMap::irradianceOrder() const {
   Vec3f lo(INFINITY), hi(-INFINITY);
   for (size_t i = 0; i < n; ++i) {
     const Vec3f p = photons_[i * size_t(irrStride_)].p;
-    lo = Vec3f(fminf(lo.x, p.x), fminf(lo.y, p.y), fminf(lo.z, p.z));
-    hi = Vec3f(fmaxf(hi.x, p.x), fmaxf(hi.y, p.y), fmaxf(hi.z, p.z));
+    lo = vmin(lo, p);
+    hi = vmax(hi, p);
   }
   // (code << 32 | index): one sort key, ties kept in index order.
   std::vector<uint64_t> keys(n);
