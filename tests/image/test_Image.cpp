@@ -191,6 +191,7 @@ TEST(Image, HeadersThatPromiseMoreThanTheFileHoldsThrow) {
     Image small(4, 2);
     saveImage(small, (d / "small.exr").string());
     expectError("huge.exr", patchedExr("small.exr", "dataWindow", "box2i", 4 + 8, 9999999), "more than its");  // xMax
+    expectError("inverted.exr", patchedExr("small.exr", "dataWindow", "box2i", 4 + 8, -7), "Invalid data window");  // xMax < xMin
   }
   {
     // A string attribute whose size field says 1.98 GB (a fuzz input's): refused from the
