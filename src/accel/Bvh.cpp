@@ -97,6 +97,9 @@ Bvh::Bvh(const Scene& scene) {
     for (int p = 0; p < m.triangleCount; ++p) {
       Vec3f a = m.positions[m.indices[3 * p]], b = m.positions[m.indices[3 * p + 1]],
             c = m.positions[m.indices[3 * p + 2]];
+      // An instance's triangles go into this one-level BVH as placed copies (the GPU's memory
+      // grows with the instances, Embree's does not).
+      if (m.toWorld) a = m.toWorld->point(a), b = m.toWorld->point(b), c = m.toWorld->point(c);
       tris.push_back({a, b - a, c - a, g, p});
       Vec3f lo = vmin(a, vmin(b, c)), hi = vmax(a, vmax(b, c));
       RTCBuildPrimitive bp;

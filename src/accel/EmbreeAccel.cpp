@@ -22,9 +22,15 @@ void maskFilter(const RTCFilterFunctionNArguments* args) {
     Ray r{{RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i), RTCRayN_org_z(args->ray, args->N, i)},
           {RTCRayN_dir_x(args->ray, args->N, i), RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i)},
           INFINITY};
+    if (ctx->rays) {
+      r = ctx->rays[RTCRayN_id(args->ray, args->N, i)];
+      r.tMax = INFINITY;
+    }
     Hit h;
-    h.t = RTCRayN_tfar(args->ray, args->N, i);  // the candidate's distance, while the filter runs
-    h.geomId = int(RTCHitN_geomID(args->hit, args->N, i));
+    // The candidate's distance while the filter runs: the same along the ray inside an
+    // instance, whose transform is affine.
+    h.t = RTCRayN_tfar(args->ray, args->N, i);
+    h.geomId = EmbreeAccel::geometryOf(RTCHitN_geomID(args->hit, args->N, i), RTCHitN_instID(args->hit, args->N, i, 0));
     h.primId = int(RTCHitN_primID(args->hit, args->N, i));
     h.u = RTCHitN_u(args->hit, args->N, i);
     h.v = RTCHitN_v(args->hit, args->N, i);
@@ -49,18 +55,43 @@ EmbreeAccel::EmbreeAccel(const Scene& scene) {
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
   const SceneView& sv = scene.view();
   if (sv.hasMasks) masks_ = std::make_unique<SceneView>(sv);
-  for (int i = 0; i < sv.meshCount; ++i) {
-    const MeshView& m = sv.meshes[i];
-    const TriangleMesh& tm = scene.meshes[size_t(i)];
+  auto triangles = [&](const MeshView& m) {
     RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
     // Shared, not copied: Scene::finalize leaves one element of padding after the vertices,
     // which Embree's 16-byte loads need.
     rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, m.positions, 0, sizeof(Vec3f),
-                               tm.positions.size());
+                               size_t(m.vertexCount));
     rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.indices, 0, 3 * sizeof(uint32_t),
                                size_t(m.triangleCount));
     attachMaskFilter(g, masks_.get(), m.bsdf);
     rtcCommitGeometry(g);
+    return g;
+  };
+  // Each shapegroup mesh that instances place gets one scene of its own (its BVH, built once),
+  // and each placement an instance of it: Embree's two-level instancing.
+  std::vector<RTCScene> prototypes(scene.prototypes.size(), nullptr);
+  for (int i = 0; i < sv.meshCount; ++i) {
+    const MeshView& m = sv.meshes[i];
+    RTCGeometry g;
+    if (size_t(i) < scene.meshes.size()) {
+      g = triangles(m);
+    } else {
+      const MeshInstance& inst = scene.instances[size_t(i) - scene.meshes.size()];
+      RTCScene& proto = prototypes[size_t(inst.prototype)];
+      if (!proto) {
+        proto = rtcNewScene(device_);
+        rtcSetSceneBuildQuality(proto, RTC_BUILD_QUALITY_HIGH);
+        RTCGeometry t = triangles(m);
+        rtcAttachGeometryByID(proto, t, 0);
+        rtcReleaseGeometry(t);
+        rtcCommitScene(proto);
+      }
+      g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_INSTANCE);
+      rtcSetGeometryInstancedScene(g, proto);
+      // The first three rows of the row-major 4 x 4 matrix: Embree's 3 x 4 row-major layout.
+      rtcSetGeometryTransform(g, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, &inst.toWorld.mat.m[0][0]);
+      rtcCommitGeometry(g);
+    }
     rtcAttachGeometryByID(scene_, g, unsigned(i));
     rtcReleaseGeometry(g);
   }
@@ -78,6 +109,8 @@ EmbreeAccel::EmbreeAccel(const Scene& scene) {
     rtcReleaseGeometry(g);
   }
   rtcCommitScene(scene_);
+  for (RTCScene p : prototypes)
+    if (p) rtcReleaseScene(p);  // the instances hold their own references
   if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) throw std::runtime_error("Embree failed to build the scene");
 }
 

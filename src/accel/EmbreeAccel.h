@@ -31,7 +31,16 @@ class EmbreeAccel {
   struct Context {
     RTCIntersectContext rtc;
     bool throughMasks;  // false: intersectSurface, which sees every surface
+    // The rays as given, by RTCRay::id: inside an instance the filter sees the ray in the
+    // instance's space, and the mask's hash is of the world-space ray (as in envgi's own BVH).
+    const Ray* rays = nullptr;
   };
+
+  // Embree reports a hit inside an instance by the instance's id; envgi numbers each placement
+  // as a geometry of its own (Scene::geometryId), which is that id.
+  static int geometryOf(unsigned geomID, unsigned instID) {
+    return int(instID != RTC_INVALID_GEOMETRY_ID ? instID : geomID);
+  }
 
   // The nearest hit; a masked surface that SceneView::stopsAtMask lets the ray through is
   // passed unless throughMasks is false.
@@ -40,6 +49,7 @@ class EmbreeAccel {
     Context ctx;
     rtcInitIntersectContext(&ctx.rtc);
     ctx.throughMasks = throughMasks;
+    ctx.rays = &ray;
     RTCRayHit rh;
     fillRay(ray, rh.ray);
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
@@ -47,7 +57,7 @@ class EmbreeAccel {
     rtcIntersect1(scene_, &ctx.rtc, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
     hit->t = rh.ray.tfar;
-    hit->geomId = int(rh.hit.geomID);
+    hit->geomId = geometryOf(rh.hit.geomID, rh.hit.instID[0]);
     hit->primId = int(rh.hit.primID);
     hit->u = rh.hit.u;
     hit->v = rh.hit.v;
@@ -63,19 +73,22 @@ class EmbreeAccel {
   void intersectCoherent(int n, Rays rays, Out out) const {
     alignas(64) RTCRayHit16 rh;
     alignas(64) int valid[16];
+    Ray given[16];
     Context ctx;
     rtcInitIntersectContext(&ctx.rtc);
     ctx.rtc.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
     ctx.throughMasks = true;
+    ctx.rays = given;
     for (int b = 0; b < n; b += 16) {
       const int m = n - b < 16 ? n - b : 16;
       for (int j = 0; j < 16; ++j) {
         const Ray& r = rays(b + (j < m ? j : 0));
+        given[j] = r;
         valid[j] = j < m && traceable(r) ? -1 : 0;
         rh.ray.org_x[j] = r.o.x, rh.ray.org_y[j] = r.o.y, rh.ray.org_z[j] = r.o.z;
         rh.ray.dir_x[j] = r.d.x, rh.ray.dir_y[j] = r.d.y, rh.ray.dir_z[j] = r.d.z;
         rh.ray.tnear[j] = 0.f, rh.ray.tfar[j] = r.tMax, rh.ray.mask[j] = 0xFFFFFFFFu;
-        rh.ray.time[j] = 0.f, rh.ray.flags[j] = 0, rh.ray.id[j] = 0;
+        rh.ray.time[j] = 0.f, rh.ray.flags[j] = 0, rh.ray.id[j] = unsigned(j);
         rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;
         rh.hit.instID[0][j] = RTC_INVALID_GEOMETRY_ID;
       }
@@ -85,7 +98,7 @@ class EmbreeAccel {
         const bool found = valid[j] && rh.hit.geomID[j] != RTC_INVALID_GEOMETRY_ID;
         if (found) {
           h.t = rh.ray.tfar[j];
-          h.geomId = int(rh.hit.geomID[j]);
+          h.geomId = geometryOf(rh.hit.geomID[j], rh.hit.instID[0][j]);
           h.primId = int(rh.hit.primID[j]);
           h.u = rh.hit.u[j];
           h.v = rh.hit.v[j];
@@ -101,6 +114,7 @@ class EmbreeAccel {
     Context ctx;
     rtcInitIntersectContext(&ctx.rtc);
     ctx.throughMasks = true;
+    ctx.rays = &ray;
     RTCRay r;
     fillRay(ray, r);
     rtcOccluded1(scene_, &ctx.rtc, &r);

@@ -1,6 +1,7 @@
 #include "gpu/DeviceScene.h"
 
 #include <map>
+#include <type_traits>
 
 namespace envgi::gpu {
 
@@ -44,14 +45,30 @@ DeviceScene::DeviceScene(const Scene& scene, const Bvh& hostBvh) {
   const SceneView& hv = scene.view();
   view = hv;
   std::vector<MeshView> meshes(hv.meshes, hv.meshes + hv.meshCount);
+  // Instances of one shapegroup mesh point at the same host arrays: each is uploaded once.
+  std::map<const void*, const void*> uploaded;
+  auto once = [&](auto* host, size_t n, const char* what) {
+    using T = std::remove_const_t<std::remove_pointer_t<decltype(host)>>;
+    if (!host) return static_cast<const T*>(nullptr);
+    auto it = uploaded.find(host);
+    if (it == uploaded.end()) it = uploaded.emplace(host, arena.upload(host, n, what)).first;
+    return static_cast<const T*>(it->second);
+  };
+  std::vector<Transform> placements;
+  placements.reserve(size_t(hv.meshCount));
   for (int i = 0; i < hv.meshCount; ++i) {
-    const TriangleMesh& tm = scene.meshes[size_t(i)];
     MeshView& m = meshes[size_t(i)];
-    m.positions = arena.upload(m.positions, tm.positions.size(), "mesh positions");
-    m.normals = m.normals ? arena.upload(m.normals, tm.normals.size(), "mesh normals") : nullptr;
-    m.uvs = m.uvs ? arena.upload(m.uvs, tm.uvs.size(), "mesh uvs") : nullptr;
-    m.indices = arena.upload(m.indices, tm.indices.size(), "mesh indices");
+    const size_t nv = size_t(m.vertexCount);
+    m.positions = once(m.positions, nv, "mesh positions");
+    m.normals = once(m.normals, nv, "mesh normals");
+    m.uvs = once(m.uvs, nv, "mesh uvs");
+    m.indices = once(m.indices, 3 * size_t(m.triangleCount), "mesh indices");
+    if (m.toWorld) placements.push_back(*m.toWorld);
   }
+  const Transform* deviceTransforms =
+      placements.empty() ? nullptr : arena.upload(placements.data(), placements.size(), "instance transforms");
+  for (size_t i = 0, k = 0; i < meshes.size(); ++i)
+    if (meshes[i].toWorld) meshes[i].toWorld = deviceTransforms + k++;
   view.meshes = arena.upload(meshes.data(), meshes.size(), "meshes");
   view.spheres = arena.upload(hv.spheres, size_t(hv.sphereCount), "spheres");
   // Rough plastics point at their coat's tables on the host: upload each table once.

@@ -29,12 +29,10 @@ std::vector<ImageChannel> renderAovs(const Scene& scene, const EmbreeAccel& acce
     for (const std::string& name : aovChannelNames(a)) out.push_back({name, std::vector<float>(pixels, 0.f)});
   const size_t nc = out.size();
   if (nc == 0) return out;
-  // Mitsuba's shape_index counts shapes in the file's order; Hit::geomId counts meshes, then spheres.
-  std::vector<float> shapeOfGeom(scene.meshes.size() + scene.spheres.size(), -1.f);
-  for (size_t i = 0; i < scene.shapes.size(); ++i) {
-    const ShapeEntry& e = scene.shapes[i];
-    shapeOfGeom[e.isSphere ? scene.meshes.size() + e.index : e.index] = float(i);
-  }
+  // Mitsuba's shape_index counts shapes in the file's order; Hit::geomId counts meshes, then
+  // instanced meshes, then spheres.
+  std::vector<float> shapeOfGeom(scene.meshGeometryCount() + scene.spheres.size(), -1.f);
+  for (size_t i = 0; i < scene.shapes.size(); ++i) shapeOfGeom[scene.geometryId(scene.shapes[i])] = float(i);
   const EmbreeTracer tracer{&accel};
   const bool envSeen = scene.env && !scene.integrator.hidesEmitters();
 

@@ -172,7 +172,8 @@ void Scene::finalize() {
   }
   // Embree reads vertices with 16-byte loads: keep one element of slack after the last one.
   for (TriangleMesh& m : meshes) m.positions.reserve(m.positions.size() + 1);
-  meshViews_.assign(meshes.size(), MeshView{});
+  for (TriangleMesh& m : prototypes) m.positions.reserve(m.positions.size() + 1);
+  meshViews_.assign(meshGeometryCount(), MeshView{});
   sphereViews_.assign(spheres.size(), SphereView{});
   lights_.clear();
   Vec3f lo(INFINITY), hi(-INFINITY);
@@ -190,18 +191,31 @@ void Scene::finalize() {
       if (s.emissive) {
         v.light = int(lights_.size());
         lights_.push_back(
-            {int(meshes.size() + s.index), 0, s.radiance, 4.f * kPi * sp.radius * sp.radius, s.radianceTexture});
+            {int(geometryId(s)), 0, s.radiance, 4.f * kPi * sp.radius * sp.radius, s.radianceTexture});
       }
     } else {
-      const TriangleMesh& m = meshes[s.index];
-      MeshView& v = meshViews_[s.index];
+      const size_t id = geometryId(s);
+      const TriangleMesh& m = meshOfGeometry(id);
+      MeshView& v = meshViews_[id];
       v.positions = m.positions.data();
       v.normals = m.normals.empty() ? nullptr : m.normals.data();
       v.uvs = m.uvs.empty() ? nullptr : m.uvs.data();
       v.indices = m.indices.data();
       v.triangleCount = int(m.triangleCount());
+      v.vertexCount = int(m.positions.size());
       v.bsdf = s.bsdf;
       v.anisotropic = s.bsdf >= 0 && size_t(s.bsdf) < bsdfs.size() && needsTangentFrame(bsdfs, s.bsdf);
+      if (s.isInstance) {
+        if (s.emissive) throw std::runtime_error("internal: an instanced mesh cannot be an area light");
+        const MeshInstance& inst = instances[s.index];
+        v.toWorld = &inst.toWorld;
+        for (const Vec3f& p : m.positions) {
+          Vec3f w = inst.toWorld.point(p);
+          lo = vmin(lo, w);
+          hi = vmax(hi, w);
+        }
+        continue;
+      }
       for (const Vec3f& p : m.positions) {
         lo = vmin(lo, p);
         hi = vmax(hi, p);
@@ -255,13 +269,15 @@ void Scene::finalize() {
 size_t Scene::triangleCount() const {
   size_t n = 0;
   for (const TriangleMesh& m : meshes) n += m.triangleCount();
+  for (const MeshInstance& i : instances) n += prototypes[size_t(i.prototype)].triangleCount();
   return n;
 }
 
 size_t Scene::geometryBytes() const {
   size_t b = 0;
   for (const TriangleMesh& m : meshes) b += m.bytes();
-  return b + spheres.size() * sizeof(Sphere);
+  for (const TriangleMesh& m : prototypes) b += m.bytes();
+  return b + instances.size() * sizeof(MeshInstance) + spheres.size() * sizeof(Sphere);
 }
 
 }  // namespace envgi

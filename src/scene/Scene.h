@@ -31,11 +31,20 @@ struct Texture {
 // A shape with its material and, when it is an area light, its radiance.
 struct ShapeEntry {
   bool isSphere = false;
-  size_t index = 0;  // into meshes or spheres
+  size_t index = 0;  // into meshes, spheres or (isInstance) instances
   int bsdf = 0;
   bool emissive = false;
   Color radiance;            // an area light's; with a texture, the texture's mean (its power)
   int radianceTexture = -1;  // an area light's radiance texture, read at the (u, v) it leaves from
+  bool isInstance = false;   // a shapegroup's mesh placed by an instance (never a light)
+};
+
+// A shapegroup's mesh placed by an instance: prototypes[prototype], in the group's space, under
+// toWorld. Every placement shares the prototype's arrays (and, in Embree, its BVH), so memory
+// grows with the distinct meshes, not with the instances.
+struct MeshInstance {
+  int prototype = 0;
+  Transform toWorld;
 };
 
 struct SamplerSettings {
@@ -47,6 +56,8 @@ struct SamplerSettings {
 class Scene {
  public:
   std::vector<TriangleMesh> meshes;
+  std::vector<TriangleMesh> prototypes;  // shapegroups' meshes, which instances place
+  std::vector<MeshInstance> instances;
   std::vector<Sphere> spheres;
   std::vector<ShapeEntry> shapes;
   std::vector<Bsdf> bsdfs;
@@ -64,6 +75,16 @@ class Scene {
   // call after loading and again after changing any of the above.
   void finalize();
   const SceneView& view() const { return view_; }
+  // Geometry ids (Hit::geomId): the meshes, then the instances, then the spheres.
+  size_t meshGeometryCount() const { return meshes.size() + instances.size(); }
+  size_t geometryId(const ShapeEntry& e) const {
+    return e.isSphere ? meshGeometryCount() + e.index : e.isInstance ? meshes.size() + e.index : e.index;
+  }
+  // The mesh behind a geometry id below meshGeometryCount(): its own, or its instance's prototype.
+  const TriangleMesh& meshOfGeometry(size_t id) const {
+    return id < meshes.size() ? meshes[id] : prototypes[size_t(instances[id - meshes.size()].prototype)];
+  }
+  // Triangles as placed: an instance's count every time it is placed.
   size_t triangleCount() const;
   size_t lightCount() const { return lights_.size(); }
   size_t geometryBytes() const;

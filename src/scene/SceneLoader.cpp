@@ -76,7 +76,8 @@ class Loader {
   void finish() {
     if (!haveSensor_) throw std::runtime_error(files_.front()->path + ": the scene has no <sensor>");
     if (instances_ > 0)
-      spdlog::info("{} instances placed {} shapes, each a copy of its shapegroup's", instances_, instancedShapes_);
+      spdlog::info("{} instances placed {} shapes; their meshes share {} shapegroup meshes ({} triangles stored for {} placed)",
+                   instances_, instancedShapes_, scene_.prototypes.size(), prototypeTriangles(), instancedTriangles());
     // A -D value that nothing in the scene reads (a misspelt name, or a parameter of another
     // scene) leaves the render as it would be without it: said once, with the nearest name.
     std::vector<std::string> names(paramNames_.begin(), paramNames_.end());
@@ -1200,10 +1201,21 @@ class Loader {
   };
   struct ShapeGroup {
     std::vector<ShapeTemplate> shapes;
+    std::vector<int> prototypes;  // each mesh's index in Scene::prototypes once an instance placed it, else -1
     std::string where;  // "file:line" of its definition, for a duplicate's error
   };
   std::map<std::string, ShapeGroup> groups_;
   size_t instances_ = 0, instancedShapes_ = 0;  // for the log
+  size_t prototypeTriangles() const {
+    size_t n = 0;
+    for (const TriangleMesh& m : scene_.prototypes) n += m.triangleCount();
+    return n;
+  }
+  size_t instancedTriangles() const {
+    size_t n = 0;
+    for (const MeshInstance& i : scene_.instances) n += scene_.prototypes[size_t(i.prototype)].triangleCount();
+    return n;
+  }
 
   // A top-level <shape>: a shape group is kept for its instances, an instance places its group,
   // anything else goes into the scene as it is.
@@ -1249,13 +1261,13 @@ class Loader {
     return g;
   }
 
-  // Mitsuba's instance: its group's shapes placed under its to_world. Each becomes a copy in the
-  // scene, transformed as a shape whose to_world is the instance's times its own, so every
-  // tracer, integrator and the GPU see plain meshes and spheres (memory grows with the count).
+  // Mitsuba's instance: its group's shapes placed under its to_world. A mesh is placed as a
+  // MeshInstance of the group's mesh (made once, with the shape's own to_world, normals and
+  // flip applied), which every instance of the group shares; a sphere as a sphere of its own.
   void instance(const SourceFile* f, pugi::xml_node n) {
     Props p = collectProps(f, n);
     Transform toWorld = getTransform(f, p, "to_world");
-    const ShapeGroup* group = nullptr;
+    ShapeGroup* group = nullptr;
     ShapeGroup inlineGroup;
     for (pugi::xml_node c : n.children()) {
       if (c.type() != pugi::node_element) continue;
@@ -1282,7 +1294,24 @@ class Loader {
     }
     if (!group) fail(f, n, "an instance needs a <ref id=\"...\"/> to a shapegroup");
     reportUnused(f, p, "shape", "instance");
-    for (const ShapeTemplate& t : group->shapes) placeShape(t, toWorld);
+    group->prototypes.resize(group->shapes.size(), -1);
+    for (size_t i = 0; i < group->shapes.size(); ++i) {
+      const ShapeTemplate& t = group->shapes[i];
+      if (t.isSphere) {
+        placeShape(t, toWorld);
+        continue;
+      }
+      int& proto = group->prototypes[i];
+      if (proto < 0) {
+        proto = int(scene_.prototypes.size());
+        scene_.prototypes.push_back(placedMesh(t, Transform{}));
+      }
+      ShapeEntry entry = t.entry;
+      entry.isInstance = true;
+      entry.index = scene_.instances.size();
+      scene_.instances.push_back({proto, toWorld});
+      scene_.shapes.push_back(entry);
+    }
     ++instances_;
     instancedShapes_ += group->shapes.size();
   }
@@ -1392,19 +1421,25 @@ class Loader {
       entry.index = scene_.spheres.size();
       scene_.spheres.push_back(s);
     } else {
-      TriangleMesh mesh = std::move(t.mesh);
-      mesh.transform(toWorld);
-      if (t.faceNormals) mesh.normals.clear();
-      else if (mesh.normals.empty() && t.fromFile) mesh.computeVertexNormals();
-      if (t.flip) {
-        // Mitsuba flips the normals; reversing the winding keeps geometric and shading normals together.
-        for (size_t i = 0; i < mesh.indices.size(); i += 3) std::swap(mesh.indices[i + 1], mesh.indices[i + 2]);
-        for (Vec3f& nn : mesh.normals) nn = -nn;
-      }
       entry.index = scene_.meshes.size();
-      scene_.meshes.push_back(std::move(mesh));
+      scene_.meshes.push_back(placedMesh(std::move(t), outer));
     }
     scene_.shapes.push_back(entry);
+  }
+
+  // A mesh shape's triangles under outer times its own to_world, with its normals as the file
+  // asks (computed where it has none) and flipped where it asks.
+  static TriangleMesh placedMesh(ShapeTemplate t, const Transform& outer) {
+    TriangleMesh mesh = std::move(t.mesh);
+    mesh.transform(outer * t.toWorld);
+    if (t.faceNormals) mesh.normals.clear();
+    else if (mesh.normals.empty() && t.fromFile) mesh.computeVertexNormals();
+    if (t.flip) {
+      // Mitsuba flips the normals; reversing the winding keeps geometric and shading normals together.
+      for (size_t i = 0; i < mesh.indices.size(); i += 3) std::swap(mesh.indices[i + 1], mesh.indices[i + 2]);
+      for (Vec3f& nn : mesh.normals) nn = -nn;
+    }
+    return mesh;
   }
 };
 

@@ -20,14 +20,18 @@
 namespace envgi {
 
 struct MeshView {
-  const Vec3f* positions = nullptr;  // world space
-  const Vec3f* normals = nullptr;    // world space, may be null (face normals)
+  const Vec3f* positions = nullptr;  // world space, or toWorld's object space
+  const Vec3f* normals = nullptr;    // as positions, may be null (face normals)
   const Vec2f* uvs = nullptr;        // may be null
   const uint32_t* indices = nullptr; // 3 a triangle
   int triangleCount = 0;
   int bsdf = 0;
   int lightOffset = -1;  // index of triangle 0 in the light list, -1 when not emissive
   bool anisotropic = false;  // its material needs a frame along dp/du (bsdfNeedsTangentFrame)
+  int vertexCount = 0;
+  // An instance's placement of a shared mesh (Scene::instances); null for a mesh of its own.
+  // Only light-free meshes are placed so: lights read positions as world space.
+  const Transform* toWorld = nullptr;
 };
 
 struct SphereView {
@@ -150,12 +154,16 @@ struct SceneView {
       const MeshView& m = meshes[h.geomId];
       uint32_t i0 = m.indices[3 * h.primId], i1 = m.indices[3 * h.primId + 1], i2 = m.indices[3 * h.primId + 2];
       Vec3f p0 = m.positions[i0], p1 = m.positions[i1], p2 = m.positions[i2];
+      // An instance's triangle is placed first, so that everything below (the geometric
+      // normal's side under a mirroring transform included) is what a copy of it would give.
+      if (m.toWorld) p0 = m.toWorld->point(p0), p1 = m.toWorld->point(p1), p2 = m.toWorld->point(p2);
       float b1 = h.u, b2 = h.v, b0 = 1.f - b1 - b2;
       si.p = p0 * b0 + p1 * b1 + p2 * b2;
       Vec3f ng = normalize(cross(p1 - p0, p2 - p0));
       Vec3f ns = ng;
       if (m.normals) {
         Vec3f n = m.normals[i0] * b0 + m.normals[i1] * b1 + m.normals[i2] * b2;
+        if (m.toWorld) n = m.toWorld->normal(n);
         if (lengthSq(n) > 0.f) ns = normalize(n);
         if (dot(ns, ng) < 0.f) ng = -ng;  // geometric normal agrees with the mesh's own normals
       }

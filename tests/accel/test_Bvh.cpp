@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 
 #include "accel/Bvh.h"
 #include "accel/EmbreeAccel.h"
@@ -22,7 +23,9 @@ struct Agreement {
 
 // Traces `paths` random walks of up to 4 bounces from the camera through both tracers,
 // following Embree's hits, and counts disagreements.
-Agreement compare(const Scene& scene, int paths, uint64_t seed) {
+// tTolerance: relative; an instance's hits are computed in its own space by Embree and among
+// placed copies by the BVH, two roundings of the vertices apart.
+Agreement compare(const Scene& scene, int paths, uint64_t seed, float tTolerance = 1e-5f) {
   EmbreeAccel embree(scene);
   Bvh bvh(scene);
   BvhView bv = bvh.view();
@@ -42,8 +45,8 @@ Agreement compare(const Scene& scene, int paths, uint64_t seed) {
       if (!he_) break;
       if (he.geomId != hb.geomId || he.primId != hb.primId) {
         // An exact tie: both primitives are hit at the same distance (shared edges, vertices).
-        if (std::fabs(he.t - hb.t) > 1e-5f * he.t) ++a.primMismatch;
-      } else if (std::fabs(he.t - hb.t) > 1e-5f * std::max(he.t, 1e-3f)) {
+        if (std::fabs(he.t - hb.t) > tTolerance * he.t) ++a.primMismatch;
+      } else if (std::fabs(he.t - hb.t) > tTolerance * std::max(he.t, 1e-3f)) {
         ++a.tMismatch;
       }
       SurfaceInteraction si = sc.interaction(ray, he);
@@ -106,6 +109,39 @@ TEST(Bvh, MatchesEmbreeOnTheDragon) {
   Agreement a = compare(scene, 120000, 23);
   expectAgreement(a, "dragon");
   EXPECT_GT(a.rays + a.shadowRays, 250000u);
+}
+
+// Instances go into Embree as instances of one BVH per shapegroup mesh, and into this BVH as
+// placed copies: both must find the same surfaces, a masked group's (whose filter must hash the
+// world-space ray, as this BVH does) and one mirrored by a negative scale included.
+TEST(Bvh, MatchesEmbreeOnInstances) {
+  const std::string dir = std::string(ENVGI_SOURCE_DIR) + "/scenes/";
+  for (bool masked : {false, true}) {
+    const std::string bsdf = masked ? R"(<bsdf type="mask"><float name="opacity" value="0.5"/><bsdf type="diffuse"/></bsdf>)"
+                                    : R"(<bsdf type="diffuse"/>)";
+    std::string xml = R"(<scene version="3.0.0">
+      <sensor type="perspective"><float name="fov" value="40"/>
+        <transform name="to_world"><lookat origin="0,2.6,6.2" target="0,0.5,0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="64"/></film></sensor>
+      <shape type="rectangle"><transform name="to_world"><scale value="4"/><rotate x="1" angle="-90"/></transform></shape>
+      <shape type="shapegroup" id="g"><shape type="ply"><string name="filename" value=")" +
+                      dir + R"(meshes/bun_zipper_res2.ply"/>
+        <transform name="to_world"><scale value="8"/></transform>)" + bsdf + R"(</shape>
+        <shape type="cube"><transform name="to_world"><scale value="0.3"/><translate y="-0.3"/></transform></shape></shape>
+      <shape type="instance"><ref id="g"/><transform name="to_world"><translate x="-1.2"/></transform></shape>
+      <shape type="instance"><ref id="g"/><transform name="to_world"><rotate y="1" angle="40"/><scale x="1.5" y="0.7" z="1"/><translate x="1" z="0.5"/></transform></shape>
+      <shape type="instance"><ref id="g"/><transform name="to_world"><scale x="-1" y="1" z="1"/><translate z="-1" y="0.3"/></transform></shape>
+    </scene>)";
+    const std::string path = ::testing::TempDir() + "instances-bvh.xml";
+    std::ofstream(path) << xml;
+    Scene scene;
+    loadScene(path, {}, scene);
+    ASSERT_EQ(scene.instances.size(), 6u);
+    ASSERT_EQ(scene.prototypes.size(), 2u);
+    Agreement a = compare(scene, 40000, 29, 1e-4f);
+    expectAgreement(a, masked ? "instances, masked" : "instances");
+    EXPECT_GT(a.rays, 60000u);
+  }
 }
 
 TEST(Bvh, EmptySceneAndSpheresOnly) {

@@ -37,7 +37,7 @@ std::vector<Ray> raysFor(const SceneView& sc, int n, uint64_t seed) {
 }  // namespace
 
 TEST(EmbreeAccel, PacketsGiveTheOneRayHits) {
-  for (std::string name : {"buddha", "mask", "cornell-box", "teapot-glass"}) {
+  for (std::string name : {"buddha", "mask", "cornell-box", "teapot-glass", "instances"}) {
     Scene scene;
     loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/" + name + ".xml", {{"res", "64"}}, scene);
     scene.finalize();

@@ -757,15 +757,26 @@ TEST(CliRender, InstancesRenderAsTheShapesTheyPlace) {
                          d.file(std::string(name) + ".exr") + " --threads 1 --no-progress");
     ASSERT_EQ(r.code, 0) << name << ": " << r.output;
     if (std::string(name) == "grouped") {
-      EXPECT_NE(r.output.find("2 instances placed 4 shapes"), std::string::npos) << r.output;
+      EXPECT_NE(r.output.find("2 instances placed 4 shapes; their meshes share 1 shapegroup meshes (12 triangles stored for 24 placed)"),
+                std::string::npos)
+          << r.output;
     }
   }
+  // The sphere is a copy either way; the cube is placed by Embree's instancing in one and
+  // written out in the other, so its hit points differ in their last bits: the same image up to
+  // float rounding, and the odd pixel where a ray grazes an edge.
   envgi::Image a = envgi::loadImage(d.file("grouped.exr")), b = envgi::loadImage(d.file("plain.exr"));
   ASSERT_EQ(a.rgb.size(), b.rgb.size());
-  EXPECT_TRUE(a.rgb == b.rgb) << "the instanced scene differs from the plain one";
-  double mean = 0.0;
-  for (float v : a.rgb) mean += v / double(a.rgb.size());
+  double mean = 0.0, meanB = 0.0;
+  size_t close = 0;
+  for (size_t i = 0; i < a.rgb.size(); ++i) {
+    mean += a.rgb[i] / double(a.rgb.size());
+    meanB += b.rgb[i] / double(b.rgb.size());
+    close += std::fabs(a.rgb[i] - b.rgb[i]) <= 1e-3f * (1.f + std::fabs(b.rgb[i]));
+  }
   EXPECT_GT(mean, 0.05);
+  EXPECT_GE(double(close), 0.99 * double(a.rgb.size())) << "the instanced scene differs from the plain one";
+  EXPECT_NEAR(mean, meanB, 1e-3 * meanB);
 }
 TEST(CliRender, BlendSceneRenders) { expectPathAndSppmAgree("blend"); }
 

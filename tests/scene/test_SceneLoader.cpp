@@ -1126,10 +1126,20 @@ TEST(SceneLoader, ShapeGroupAndInstance) {
     <shape type="instance"><shape type="shapegroup"><shape type="rectangle"/></shape></shape>)"),
             {}, s);
   ASSERT_EQ(s.shapes.size(), 5u) << "two instances of two shapes, and one of an inline group's rectangle";
-  ASSERT_EQ(s.meshes.size(), 3u);
+  EXPECT_TRUE(s.meshes.empty()) << "an instance's meshes are placements, not copies";
+  ASSERT_EQ(s.prototypes.size(), 2u) << "the group's mesh once, however many instances place it, and the rectangle";
+  ASSERT_EQ(s.instances.size(), 3u);
   ASSERT_EQ(s.spheres.size(), 2u);
+  EXPECT_EQ(s.instances[0].prototype, s.instances[1].prototype);
+  EXPECT_TRUE(s.shapes[0].isInstance && s.shapes[2].isInstance && s.shapes[4].isInstance);
   EXPECT_EQ(s.shapes[0].bsdf, s.shapes[2].bsdf) << "the group's material is shared";
   EXPECT_FLOAT_EQ(s.bsdfs[size_t(s.shapes[0].bsdf)].reflectance.x, 0.3f);
+  EXPECT_EQ(s.triangleCount(), 1u + 1u + 2u) << "triangles as placed";
+  EXPECT_EQ(s.view().meshCount, 3);
+  // Geometry ids: the instanced meshes, then the spheres.
+  EXPECT_EQ(s.geometryId(s.shapes[0]), 0u);
+  EXPECT_EQ(s.geometryId(s.shapes[1]), 3u);
+  EXPECT_EQ(s.geometryId(s.shapes[4]), 2u);
   // The plain shapes under the second instance's transform, as one scene would write them.
   Scene plain;
   loadScene(f.scene(std::string(kSensor) + R"(
@@ -1138,18 +1148,26 @@ TEST(SceneLoader, ShapeGroupAndInstance) {
     <shape type="sphere"><point name="center" x="1" y="0" z="0"/><float name="radius" value="0.5"/>
       <transform name="to_world"><rotate y="1" angle="90"/><scale value="2"/><translate x="5"/></transform></shape>)"),
             {}, plain);
-  EXPECT_TRUE(sameVec(s.meshes[0].positions[1], Vec3f(1.f, 0.f, 0.f))) << "the identity instance";
-  ASSERT_EQ(s.meshes[1].positions.size(), 3u);
+  const TriangleMesh& tri = s.prototypes[size_t(s.instances[0].prototype)];
+  EXPECT_TRUE(sameVec(tri.positions[1], Vec3f(1.f, 0.f, 0.f))) << "the group's mesh in its own space";
+  ASSERT_EQ(tri.positions.size(), 3u);
+  const MeshView& placed = s.view().meshes[1];
+  ASSERT_NE(placed.toWorld, nullptr);
+  EXPECT_EQ(placed.positions, tri.positions.data()) << "the placement reads the group's arrays";
   for (int i = 0; i < 3; ++i) {
-    EXPECT_TRUE(sameVec(s.meshes[1].positions[i], plain.meshes[0].positions[i])) << i;
-    EXPECT_TRUE(sameVec(s.meshes[1].normals[i], plain.meshes[0].normals[i])) << i;
+    Vec3f p = placed.toWorld->point(tri.positions[size_t(i)]), q = plain.meshes[0].positions[size_t(i)];
+    EXPECT_LT(length(p - q), 1e-5f) << i;
+    Vec3f n = normalize(placed.toWorld->normal(tri.normals[size_t(i)]));
+    EXPECT_LT(length(n - plain.meshes[0].normals[size_t(i)]), 1e-6f) << i;
   }
-  EXPECT_NEAR(s.meshes[1].positions[1].x, 5.f, 1e-6f);  // (1, 0, 0) turned to -z, doubled, moved by 5
-  EXPECT_NEAR(s.meshes[1].positions[1].z, -2.f, 1e-6f);
+  EXPECT_NEAR(placed.toWorld->point(tri.positions[1]).x, 5.f, 1e-6f);  // (1, 0, 0) turned to -z, doubled, moved by 5
+  EXPECT_NEAR(placed.toWorld->point(tri.positions[1]).z, -2.f, 1e-6f);
   EXPECT_TRUE(sameVec(s.spheres[1].center, plain.spheres[0].center));
   EXPECT_FLOAT_EQ(s.spheres[1].radius, 1.f);
   EXPECT_TRUE(sameVec(s.spheres[0].center, Vec3f(1.f, 0.f, 0.f)));
-  EXPECT_EQ(s.meshes[2].positions.size(), 4u) << "the inline group's rectangle";
+  EXPECT_EQ(s.prototypes[size_t(s.instances[2].prototype)].positions.size(), 4u) << "the inline group's rectangle";
+  // The scene's bounds take in each placement.
+  EXPECT_NEAR(s.view().boundsMin.z, plain.view().boundsMin.z, 1e-5f);
 
   const std::pair<const char*, const char*> bad[] = {
       {R"(<shape type="shapegroup"><shape type="sphere"/></shape>)", "a shapegroup needs an id"},
