@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <chrono>
+#include <map>
 #include <stdexcept>
 
 namespace envgi {
@@ -82,6 +83,65 @@ struct Flattener {
 
 }  // namespace
 
+namespace {
+RTCBuildPrimitive buildPrimitive(Vec3f lo, Vec3f hi, size_t index) {
+  RTCBuildPrimitive bp;
+  bp.lower_x = lo.x;
+  bp.lower_y = lo.y;
+  bp.lower_z = lo.z;
+  bp.upper_x = hi.x;
+  bp.upper_y = hi.y;
+  bp.upper_z = hi.z;
+  bp.geomID = 0;
+  bp.primID = unsigned(index);
+  return bp;
+}
+}  // namespace
+
+namespace {
+// Builds a tree over `entries` (prims[i] the box of entries[i]) and appends it to nodes and
+// triangles; returns its root node.
+int buildTree(const std::vector<BvhTriangle>& entries, std::vector<RTCBuildPrimitive>& prims, RTCDevice device,
+              std::vector<BvhNode>& nodes_, std::vector<BvhTriangle>& triangles_, BvhBuildStats& stats_) {
+  RTCBVH bvh = rtcNewBVH(device);
+  RTCBuildArguments args = rtcDefaultBuildArguments();
+  args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
+  args.maxBranchingFactor = 2;
+  args.maxDepth = kBvhStackSize - 4;  // traversal's fixed stack holds one entry a level
+  args.minLeafSize = 1;
+  args.maxLeafSize = 4;
+  args.traversalCost = 1.f;
+  args.intersectionCost = 1.f;
+  args.bvh = bvh;
+  // The builder reorders (and may overwrite) the primitive array: the root's box is read first.
+  Vec3f lo(INFINITY), hi(-INFINITY);
+  for (const RTCBuildPrimitive& p : prims) {
+    lo = vmin(lo, Vec3f(p.lower_x, p.lower_y, p.lower_z));
+    hi = vmax(hi, Vec3f(p.upper_x, p.upper_y, p.upper_z));
+  }
+  args.primitives = prims.data();
+  args.primitiveCount = prims.size();
+  args.primitiveArrayCapacity = prims.size();
+  args.createNode = createNode;
+  args.setNodeChildren = setChildren;
+  args.setNodeBounds = setBounds;
+  args.createLeaf = createLeaf;
+  auto* root = static_cast<BuildNode*>(rtcBuildBVH(&args));
+  if (!root) {
+    rtcReleaseBVH(bvh);
+    throw std::runtime_error("the BVH build failed");
+  }
+  const size_t at = nodes_.size();
+  nodes_.resize(at + 1);
+  RTCBounds rb{lo.x, lo.y, lo.z, 0.f, hi.x, hi.y, hi.z, 0.f};
+  Flattener f{entries, nodes_, triangles_, stats_};
+  f.setBox(nodes_[at], rb);
+  f.fill(at, root, 0);
+  rtcReleaseBVH(bvh);
+  return int(at);
+}
+}  // namespace
+
 Bvh::Bvh(const Scene& scene) {
   auto t0 = std::chrono::steady_clock::now();
   const SceneView& sv = scene.view();
@@ -90,73 +150,71 @@ Bvh::Bvh(const Scene& scene) {
   sphereGeomOffset_ = sv.meshCount;
   if (sv.hasMasks) masks_ = std::make_unique<SceneView>(sv);
 
+  // The scene's tree: the triangles of the meshes of their own, in world space, and one entry
+  // per instance, boxed by its group mesh's box placed (its eight corners).
   std::vector<BvhTriangle> tris;
   std::vector<RTCBuildPrimitive> prims;
+  std::vector<int> instanceOfGeom(size_t(sv.meshCount), -1);
   for (int g = 0; g < sv.meshCount; ++g) {
     const MeshView& m = sv.meshes[g];
+    if (m.toWorld) {
+      Vec3f lo(INFINITY), hi(-INFINITY);
+      for (int i = 0; i < m.vertexCount; ++i) lo = vmin(lo, m.positions[i]), hi = vmax(hi, m.positions[i]);
+      Vec3f wlo(INFINITY), whi(-INFINITY);
+      for (int c = 0; c < 8 && lo.x <= hi.x; ++c) {
+        Vec3f w = m.toWorld->point(Vec3f(c & 1 ? hi.x : lo.x, c & 2 ? hi.y : lo.y, c & 4 ? hi.z : lo.z));
+        wlo = vmin(wlo, w), whi = vmax(whi, w);
+      }
+      if (!(wlo.x <= whi.x)) continue;  // an empty group mesh
+      // Widened by a little: the corners are rounded, the triangles placed by the ray's inverse.
+      Vec3f pad = (whi - wlo) * 1e-6f + Vec3f(1e-30f);
+      instanceOfGeom[size_t(g)] = int(instances_.size());
+      instances_.push_back({*m.toWorld, -1, g});
+      tris.push_back({Vec3f(0.f), Vec3f(0.f), Vec3f(0.f), g, -1 - int32_t(instances_.size() - 1)});
+      prims.push_back(buildPrimitive(wlo - pad, whi + pad, tris.size() - 1));
+      continue;
+    }
     for (int p = 0; p < m.triangleCount; ++p) {
       Vec3f a = m.positions[m.indices[3 * p]], b = m.positions[m.indices[3 * p + 1]],
             c = m.positions[m.indices[3 * p + 2]];
-      // An instance's triangles go into this one-level BVH as placed copies (the GPU's memory
-      // grows with the instances, Embree's does not).
-      if (m.toWorld) a = m.toWorld->point(a), b = m.toWorld->point(b), c = m.toWorld->point(c);
       tris.push_back({a, b - a, c - a, g, p});
-      Vec3f lo = vmin(a, vmin(b, c)), hi = vmax(a, vmax(b, c));
-      RTCBuildPrimitive bp;
-      bp.lower_x = lo.x;
-      bp.lower_y = lo.y;
-      bp.lower_z = lo.z;
-      bp.upper_x = hi.x;
-      bp.upper_y = hi.y;
-      bp.upper_z = hi.z;
-      bp.geomID = 0;
-      bp.primID = unsigned(tris.size() - 1);
-      prims.push_back(bp);
+      prims.push_back(buildPrimitive(vmin(a, vmin(b, c)), vmax(a, vmax(b, c)), tris.size() - 1));
     }
   }
-  stats_.triangles = tris.size();
   if (!tris.empty()) {
     RTCDevice device = rtcNewDevice(nullptr);
     if (!device) throw std::runtime_error("cannot create an Embree device for the BVH build");
-    RTCBVH bvh = rtcNewBVH(device);
-    RTCBuildArguments args = rtcDefaultBuildArguments();
-    args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
-    args.maxBranchingFactor = 2;
-    args.maxDepth = kBvhStackSize - 4;  // traversal's fixed stack holds one entry a level
-    args.minLeafSize = 1;
-    args.maxLeafSize = 4;
-    args.traversalCost = 1.f;
-    args.intersectionCost = 1.f;
-    args.bvh = bvh;
-    args.primitives = prims.data();
-    args.primitiveCount = prims.size();
-    args.primitiveArrayCapacity = prims.size();
-    args.createNode = createNode;
-    args.setNodeChildren = setChildren;
-    args.setNodeBounds = setBounds;
-    args.createLeaf = createLeaf;
-    auto* root = static_cast<BuildNode*>(rtcBuildBVH(&args));
-    if (!root) {
-      rtcReleaseBVH(bvh);
+    try {
+      nodes_.reserve(2 * tris.size());
+      buildTree(tris, prims, device, nodes_, triangles_, stats_);
+      // Each group mesh's own tree, once, in the group's space, for every instance of it.
+      std::map<const Vec3f*, int> roots;
+      for (BvhInstance& in : instances_) {
+        const MeshView& m = sv.meshes[in.geomId];
+        auto it = roots.find(m.positions);
+        if (it == roots.end()) {
+          std::vector<BvhTriangle> local;
+          std::vector<RTCBuildPrimitive> lp;
+          for (int p = 0; p < m.triangleCount; ++p) {
+            Vec3f a = m.positions[m.indices[3 * p]], b = m.positions[m.indices[3 * p + 1]],
+                  c = m.positions[m.indices[3 * p + 2]];
+            local.push_back({a, b - a, c - a, -1, p});
+            lp.push_back(buildPrimitive(vmin(a, vmin(b, c)), vmax(a, vmax(b, c)), local.size() - 1));
+          }
+          it = roots.emplace(m.positions, buildTree(local, lp, device, nodes_, triangles_, stats_)).first;
+          stats_.groupTriangles += local.size();
+        }
+        in.root = it->second;
+      }
+    } catch (...) {
       rtcReleaseDevice(device);
-      throw std::runtime_error("the BVH build failed");
+      throw;
     }
-    Vec3f lo(INFINITY), hi(-INFINITY);
-    for (const BvhTriangle& t : tris) {
-      lo = vmin(lo, vmin(t.v0, vmin(t.v0 + t.e1, t.v0 + t.e2)));
-      hi = vmax(hi, vmax(t.v0, vmax(t.v0 + t.e1, t.v0 + t.e2)));
-    }
-    nodes_.reserve(2 * tris.size());
-    triangles_.reserve(tris.size());
-    nodes_.resize(1);
-    RTCBounds rb{lo.x, lo.y, lo.z, 0.f, hi.x, hi.y, hi.z, 0.f};
-    Flattener f{tris, nodes_, triangles_, stats_};
-    f.setBox(nodes_[0], rb);
-    f.fill(0, root, 0);
-    rtcReleaseBVH(bvh);
     rtcReleaseDevice(device);
     nodes_.shrink_to_fit();
   }
+  stats_.triangles = triangles_.size() - instances_.size();
+  stats_.instances = instances_.size();
   stats_.nodes = nodes_.size();
   stats_.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -166,6 +224,8 @@ BvhView Bvh::view() const {
   v.nodes = nodes_.data();
   v.triangles = triangles_.data();
   v.nodeCount = int(nodes_.size());
+  v.instances = instances_.empty() ? nullptr : instances_.data();
+  v.instanceCount = int(instances_.size());
   v.spheres = spheres_;
   v.sphereCount = sphereCount_;
   v.sphereGeomOffset = sphereGeomOffset_;

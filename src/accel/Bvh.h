@@ -13,8 +13,9 @@ namespace envgi {
 struct BvhBuildStats {
   double seconds = 0.0;
   size_t triangles = 0, nodes = 0, leaves = 0;
+  size_t instances = 0, groupTriangles = 0;  // placements, and the triangles of their group meshes' trees
   int maxDepth = 0;
-  size_t bytes() const { return nodes * sizeof(BvhNode) + triangles * sizeof(BvhTriangle); }
+  size_t bytes() const { return nodes * sizeof(BvhNode) + (triangles + instances) * sizeof(BvhTriangle) + instances * sizeof(BvhInstance); }
 };
 
 class Bvh {
@@ -26,10 +27,12 @@ class Bvh {
   const BvhBuildStats& stats() const { return stats_; }
   const std::vector<BvhNode>& nodes() const { return nodes_; }
   const std::vector<BvhTriangle>& triangles() const { return triangles_; }
+  const std::vector<BvhInstance>& instances() const { return instances_; }
 
  private:
   std::vector<BvhNode> nodes_;
-  std::vector<BvhTriangle> triangles_;
+  std::vector<BvhTriangle> triangles_;  // the scene's tree's leaves, then each group mesh's tree's
+  std::vector<BvhInstance> instances_;
   const SphereView* spheres_ = nullptr;
   int sphereCount_ = 0, sphereGeomOffset_ = 0;
   std::unique_ptr<SceneView> masks_;  // a copy of the scene's view where it has masks (BvhView::masks)

@@ -17,10 +17,20 @@ struct BvhNode {
 };
 
 // A triangle ready for the Moeller-Trumbore test (vertex 0 and two edges), with the mesh
-// and primitive it came from so hits read like Embree's.
+// and primitive it came from so hits read like Embree's. In the scene's tree, primId -1 - k
+// stands for instance k instead (BvhInstance); in a group mesh's tree, geomId is unused (-1):
+// a hit there reports the placement's.
 struct BvhTriangle {
   Vec3f v0, e1, e2;
   int32_t geomId, primId;
+};
+
+// An instance's placement of a shapegroup mesh's own tree (built once, in the group's space):
+// two levels, as Embree's instancing, so that memory grows with the distinct meshes.
+struct BvhInstance {
+  Transform toWorld;  // the ray goes into the group's space by its inverse
+  int32_t root;       // the group mesh's tree: its root node
+  int32_t geomId;     // the placement's geometry id (Scene::geometryId)
 };
 
 constexpr int kBvhStackSize = 64;
@@ -29,6 +39,8 @@ struct BvhView {
   const BvhNode* nodes = nullptr;
   const BvhTriangle* triangles = nullptr;
   int nodeCount = 0;
+  const BvhInstance* instances = nullptr;
+  int instanceCount = 0;
   const SphereView* spheres = nullptr;  // tested one by one: scenes hold a handful
   int sphereCount = 0;
   int sphereGeomOffset = 0;  // geometry id of sphere 0 (meshes come first)
@@ -133,23 +145,46 @@ struct BvhView {
       }
     }
     if (nodeCount == 0) return found;
-    Vec3f invD(1.f / r.d.x, 1.f / r.d.y, 1.f / r.d.z);
+    return walk<AnyHit, true>(0, r, r, -1, &tMax, hit, masks) || found;
+  }
+
+  // Walks the tree at `root` with `local`, the world ray r moved into an instance's space (or r
+  // itself in the scene's tree, Top), lowering *tMax to each hit (t is the same along both: the
+  // transform is affine and the direction is not renormalised). The scene's tree's leaves may
+  // hold instances, walked in turn; a hit inside one reports its geomId. Masks hash the world ray.
+  template <bool AnyHit, bool Top>
+  ENVGI_HD bool walk(int root, const Ray& local, const Ray& world, int geomId, float* tMax, Hit* hit,
+                     const SceneView* masks) const {
+    Vec3f invD(1.f / local.d.x, 1.f / local.d.y, 1.f / local.d.z);
     int stack[kBvhStackSize];
     int sp = 0;
-    int node = 0;
-    if (boxEntry(nodes[0], r.o, invD, tMax) == INFINITY) return found;
+    int node = root;
+    bool found = false;
+    if (boxEntry(nodes[root], local.o, invD, *tMax) == INFINITY) return false;
     for (;;) {
       const BvhNode& n = nodes[node];
       if (n.count > 0) {
         for (int i = n.index; i < n.index + n.count; ++i) {
+          const BvhTriangle& tri = triangles[i];
+          if constexpr (Top) {
+            if (tri.primId < 0) {
+              const BvhInstance& in = instances[-1 - tri.primId];
+              Ray l{in.toWorld.inversePoint(world.o), in.toWorld.inverseVector(world.d), *tMax};
+              if (walk<AnyHit, false>(in.root, l, world, in.geomId, tMax, hit, masks)) {
+                if (AnyHit) return true;
+                found = true;
+              }
+              continue;
+            }
+          }
+          const int g = Top ? tri.geomId : geomId;
           float t, u, v;
-          if (triangleHit(triangles[i], r, tMax, &t, &u, &v) &&
-              !passesMask(masks, r, t, triangles[i].geomId, triangles[i].primId, u, v)) {
+          if (triangleHit(tri, local, *tMax, &t, &u, &v) && !passesMask(masks, world, t, g, tri.primId, u, v)) {
             if (AnyHit) return true;
-            tMax = t;
+            *tMax = t;
             hit->t = t;
-            hit->geomId = triangles[i].geomId;
-            hit->primId = triangles[i].primId;
+            hit->geomId = g;
+            hit->primId = tri.primId;
             hit->u = u;
             hit->v = v;
             found = true;
@@ -158,7 +193,7 @@ struct BvhView {
       } else {
         // Visit the nearer child first; push the farther one.
         int c0 = n.index, c1 = n.index + 1;
-        float d0 = boxEntry(nodes[c0], r.o, invD, tMax), d1 = boxEntry(nodes[c1], r.o, invD, tMax);
+        float d0 = boxEntry(nodes[c0], local.o, invD, *tMax), d1 = boxEntry(nodes[c1], local.o, invD, *tMax);
         if (d0 != INFINITY || d1 != INFINITY) {
           if (d1 < d0) {
             int c = c0;
@@ -177,7 +212,7 @@ struct BvhView {
       for (;;) {
         if (sp == 0) return found;
         node = stack[--sp];
-        if (AnyHit || boxEntry(nodes[node], r.o, invD, tMax) != INFINITY) break;
+        if (AnyHit || boxEntry(nodes[node], local.o, invD, *tMax) != INFINITY) break;
       }
     }
   }

@@ -98,6 +98,7 @@ DeviceScene::DeviceScene(const Scene& scene, const Bvh& hostBvh) {
   bvh = b;
   bvh.nodes = arena.upload(b.nodes, size_t(b.nodeCount), "BVH nodes");
   bvh.triangles = arena.upload(b.triangles, hostBvh.triangles().size(), "BVH triangles");
+  bvh.instances = arena.upload(b.instances, hostBvh.instances().size(), "BVH instances");
   bvh.spheres = view.spheres;
   bvh.masks = hv.hasMasks ? deviceView : nullptr;
 }

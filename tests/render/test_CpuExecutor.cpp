@@ -98,6 +98,23 @@ TEST(CpuExecutor, SameSeedSameImageUpToTraversalRounding) {
   EXPECT_GT(double(same) / double(a.img.rgb.size()), 0.95);
 }
 
+// Instances as the GPU traverses them (two levels: a tree per group mesh, placed by each
+// instance) against Embree's instancing, same seed: the same image up to traversal rounding,
+// with path (the map and glossy bunnies) and sppm (photons through the instances).
+TEST(CpuExecutor, InstancesOnTheBvhMatchEmbree) {
+  for (IntegratorType type : {IntegratorType::Path, IntegratorType::Sppm}) {
+    Scene s;
+    loadSmall("instances", type, &s);
+    s.integrator.sppm.photonCount = 20000;
+    s.finalize();
+    ASSERT_EQ(s.instances.size(), 10u);
+    test::ImageAgreement ag = embreeAgainstBvh(s, 4);
+    EXPECT_GT(ag.meanA, 0.0);
+    EXPECT_NEAR(ag.meanRatio, 1.0, 0.01);
+    EXPECT_GT(ag.sameShare, 0.9);
+  }
+}
+
 // SPPM's steps as the GPU runs them (the envgi BVH) against Embree, with the same seed: the same
 // visible points and photon paths, so the images agree up to traversal rounding.
 TEST(CpuExecutor, SppmStepsOnTheBvhMatchEmbree) {
