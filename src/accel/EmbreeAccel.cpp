@@ -51,6 +51,7 @@ EmbreeAccel::EmbreeAccel(const Scene& scene) {
   device_ = rtcNewDevice(nullptr);
   if (!device_) throw std::runtime_error("cannot create an Embree device");
   rtcSetDeviceErrorFunction(device_, embreeError, nullptr);
+  rtcSetDeviceMemoryMonitorFunction(device_, countBytes, this);
   scene_ = rtcNewScene(device_);
   rtcSetSceneBuildQuality(scene_, RTC_BUILD_QUALITY_HIGH);
   const SceneView& sv = scene.view();

@@ -3,6 +3,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <atomic>
 #include <cmath>
 #include <memory>
 
@@ -125,6 +126,10 @@ class EmbreeAccel {
   // EmbreeAccel::Context, which the mask filter reads, in place of a bare RTCIntersectContext.
   RTCScene handle() const { return scene_; }
 
+  // What Embree holds for this scene (its BVHs and any buffers of its own), as its memory
+  // monitor counted it while building.
+  size_t bytes() const { return size_t(bytes_.load() > 0 ? bytes_.load() : 0); }
+
  private:
   static void fillRay(const Ray& ray, RTCRay& r) {
     r.org_x = ray.o.x;
@@ -141,8 +146,14 @@ class EmbreeAccel {
     r.id = 0;
   }
 
+  static bool countBytes(void* accel, ssize_t bytes, bool) {
+    static_cast<EmbreeAccel*>(accel)->bytes_ += bytes;
+    return true;
+  }
+
   RTCDevice device_ = nullptr;
   RTCScene scene_ = nullptr;
+  std::atomic<long long> bytes_{0};
   std::unique_ptr<SceneView> masks_;  // the scene's view, for the masked geometries' filter
 };
 

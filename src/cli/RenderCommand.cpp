@@ -178,7 +178,7 @@ void runRender(const RenderArgs& a) {
   } else {
     auto t1 = std::chrono::steady_clock::now();
     EmbreeAccel accel(scene);
-    spdlog::info("device: CPU; Embree BVH built in {:.2f} s", secondsSince(t1));
+    spdlog::info("device: CPU; Embree BVH built in {:.2f} s ({:.1f} MB)", secondsSince(t1), double(accel.bytes()) / 1e6);
     traceAovs(accel, requestedSpp);
     img = render(scene, accel, ro, &st);
   }
