@@ -96,9 +96,16 @@ RTCBuildPrimitive buildPrimitive(Vec3f lo, Vec3f hi, size_t index) {
   bp.primID = unsigned(index);
   return bp;
 }
-}  // namespace
 
-namespace {
+// A mesh's triangles as BVH entries with their boxes, in the mesh's own space, tagged geomId.
+void appendTriangles(const MeshView& m, int geomId, std::vector<BvhTriangle>* tris, std::vector<RTCBuildPrimitive>* prims) {
+  for (int p = 0; p < m.triangleCount; ++p) {
+    Vec3f a = m.positions[m.indices[3 * p]], b = m.positions[m.indices[3 * p + 1]], c = m.positions[m.indices[3 * p + 2]];
+    tris->push_back({a, b - a, c - a, geomId, p});
+    prims->push_back(buildPrimitive(vmin(a, vmin(b, c)), vmax(a, vmax(b, c)), tris->size() - 1));
+  }
+}
+
 // Builds a tree over `entries` (prims[i] the box of entries[i]) and appends it to nodes and
 // triangles; returns its root node.
 int buildTree(const std::vector<BvhTriangle>& entries, std::vector<RTCBuildPrimitive>& prims, RTCDevice device,
@@ -174,12 +181,7 @@ Bvh::Bvh(const Scene& scene) {
       prims.push_back(buildPrimitive(wlo - pad, whi + pad, tris.size() - 1));
       continue;
     }
-    for (int p = 0; p < m.triangleCount; ++p) {
-      Vec3f a = m.positions[m.indices[3 * p]], b = m.positions[m.indices[3 * p + 1]],
-            c = m.positions[m.indices[3 * p + 2]];
-      tris.push_back({a, b - a, c - a, g, p});
-      prims.push_back(buildPrimitive(vmin(a, vmin(b, c)), vmax(a, vmax(b, c)), tris.size() - 1));
-    }
+    appendTriangles(m, g, &tris, &prims);
   }
   if (!tris.empty()) {
     RTCDevice device = rtcNewDevice(nullptr);
@@ -195,12 +197,7 @@ Bvh::Bvh(const Scene& scene) {
         if (it == roots.end()) {
           std::vector<BvhTriangle> local;
           std::vector<RTCBuildPrimitive> lp;
-          for (int p = 0; p < m.triangleCount; ++p) {
-            Vec3f a = m.positions[m.indices[3 * p]], b = m.positions[m.indices[3 * p + 1]],
-                  c = m.positions[m.indices[3 * p + 2]];
-            local.push_back({a, b - a, c - a, -1, p});
-            lp.push_back(buildPrimitive(vmin(a, vmin(b, c)), vmax(a, vmax(b, c)), local.size() - 1));
-          }
+          appendTriangles(m, -1, &local, &lp);
           it = roots.emplace(m.positions, buildTree(local, lp, device, nodes_, triangles_, stats_)).first;
           stats_.groupTriangles += local.size();
         }
