@@ -45,20 +45,11 @@ ENVGI_INLINE float areaLightPdf(const SceneView& sc, int light, Vec3f p, Vec3f l
   return sc.areaSelectProb() * sc.lightSelect.pmf(light) * sc.lightAreaPdf(sc.lights[light], lp) * dist2 / cosL;
 }
 
-ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si, Vec3f axis, EnvStrategy strategy,
-                              float uSel, Vec2f u, Vec2f u2, LightSample* ls) {
-  float pe = sc.envSelectProb();
-  if (uSel < pe) {
-    EnvSample es = sc.env.sample(strategy, u, axis);
-    if (!(es.pdf > 0.f)) return false;
-    ls->dir = es.dir;
-    ls->dist = INFINITY;
-    ls->radiance = es.radiance;
-    ls->pdf = es.pdf * pe;
-    ls->environment = true;
-    ls->delta = es.delta;
-    return true;
-  }
+// sampleLight's choice of a delta or an area light (uSel at or past the map's share pe). Out of
+// line on the GPU: most scenes are lit by the map alone, and this code in the path kernel's hot
+// loop cost instruction fetch (docs/gpu.md, stop 54).
+inline ENVGI_HD_NOINLINE bool sampleDeltaOrAreaLight(const SceneView& sc, const SurfaceInteraction& si, float pe, float uSel,
+                                                     Vec2f u, Vec2f u2, LightSample* ls) {
   float pa = sc.areaSelectProb();
   if (sc.deltaLightCount > 0 && !(uSel < pe + pa)) {
     // One delta light, all alike; the kind's share of uSel picks it.
@@ -90,6 +81,21 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
   ls->environment = false;
   ls->delta = false;
   return ls->pdf > 0.f;
+}
+
+ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si, Vec3f axis, EnvStrategy strategy,
+                              float uSel, Vec2f u, Vec2f u2, LightSample* ls) {
+  float pe = sc.envSelectProb();
+  if (!(uSel < pe)) return sampleDeltaOrAreaLight(sc, si, pe, uSel, u, u2, ls);
+  EnvSample es = sc.env.sample(strategy, u, axis);
+  if (!(es.pdf > 0.f)) return false;
+  ls->dir = es.dir;
+  ls->dist = INFINITY;
+  ls->radiance = es.radiance;
+  ls->pdf = es.pdf * pe;
+  ls->environment = true;
+  ls->delta = es.delta;
+  return true;
 }
 
 }  // namespace envgi

@@ -228,6 +228,9 @@ struct SceneView {
   // its weight at uv by a hash of the crossing (apart from the mask's, which decides whether the
   // ray stopped there, and apart for each level of blends nested in blends).
   ENVGI_HD int blendChoice(int index, Vec2f uv, const Ray& ray, int geomId, uint32_t crossing) const {
+    return bsdfIsBlend(bsdfs[index]) ? blendChoiceOf(index, uv, ray, geomId, crossing) : index;
+  }
+  ENVGI_HD_NOINLINE int blendChoiceOf(int index, Vec2f uv, const Ray& ray, int geomId, uint32_t crossing) const {
     for (int level = 0; level < kMaxBlendDepth && bsdfIsBlend(bsdfs[index]); ++level) {
       const Bsdf& b = bsdfs[index];
       float w = b.blendWeightTexture >= 0 ? luminance(textureEval(textures[b.blendWeightTexture], uv)) : b.blendWeight;
@@ -305,6 +308,11 @@ struct SceneView {
   ENVGI_HD const Bsdf& bsdfAt(int index, Vec2f uv, Vec2f dpdu, Vec2f dpdv, BsdfScratch* scratch) const {
     const Bsdf& b = bsdfs[index];
     if (!bsdfHasTexture(b)) return b;
+    return texturedCopy(index, uv, dpdu, dpdv, scratch);
+  }
+  // bsdfAt's copy of a textured material. Out of line on the GPU, as the rarer branches of the
+  // path kernel are, to keep its hot code small (docs/gpu.md, stop 54).
+  ENVGI_HD_NOINLINE const Bsdf& texturedCopy(int index, Vec2f uv, Vec2f dpdu, Vec2f dpdv, BsdfScratch* scratch) const {
     Bsdf* copy = new (scratch->bytes) Bsdf(bsdfAt(index, uv));
     if (copy->bumpTexture >= 0)
       copy->mappedNormal = bumpedNormal(textureLuminanceGradient(textures[copy->bumpTexture], uv) * copy->bumpScale, dpdu, dpdv);
