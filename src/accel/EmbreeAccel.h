@@ -128,7 +128,10 @@ class EmbreeAccel {
 
   // What Embree holds for this scene (its BVHs and any buffers of its own), as its memory
   // monitor counted it while building.
-  size_t bytes() const { return size_t(bytes_.load() > 0 ? bytes_.load() : 0); }
+  size_t bytes() const {
+    const long long b = bytes_.load();
+    return b > 0 ? size_t(b) : 0;
+  }
 
  private:
   static void fillRay(const Ray& ray, RTCRay& r) {

@@ -230,6 +230,7 @@ struct SceneView {
   ENVGI_HD int blendChoice(int index, Vec2f uv, const Ray& ray, int geomId, uint32_t crossing) const {
     return bsdfIsBlend(bsdfs[index]) ? blendChoiceOf(index, uv, ray, geomId, crossing) : index;
   }
+  // blendChoice's walk down nested blends, out of line on the GPU (docs/gpu.md, stop 54).
   ENVGI_HD_NOINLINE int blendChoiceOf(int index, Vec2f uv, const Ray& ray, int geomId, uint32_t crossing) const {
     for (int level = 0; level < kMaxBlendDepth && bsdfIsBlend(bsdfs[index]); ++level) {
       const Bsdf& b = bsdfs[index];
