@@ -33,7 +33,13 @@ bool hasMachineCodeFor(int major, int minor);
 // fetch, so more warps beat fewer spills: on an H200, path 420 -> 611 M samples/s and SPPM
 // 3.5 -> 2.7 ms a pass. The grid's one-thread-a-pixel kernel lost 20% so capped, and keeps its
 // registers (docs/gpu.md, stop 31).
-constexpr int kTracingThreadsPerSM = 1536;
+// The build may set another count (CMake's ENVGI_CUDA_THREADS_PER_SM, for A/B runs).
+#ifndef ENVGI_CUDA_THREADS_PER_SM
+#define ENVGI_CUDA_THREADS_PER_SM 1536
+#endif
+constexpr int kTracingThreadsPerSM = ENVGI_CUDA_THREADS_PER_SM;
+static_assert(kTracingThreadsPerSM >= 128 && kTracingThreadsPerSM <= 2048 && kTracingThreadsPerSM % 128 == 0,
+              "ENVGI_CUDA_THREADS_PER_SM: 128 to 2048, a multiple of the kernels' 128-thread block");
 
 // The path/direct kernel's registers a thread and its resident blocks an SM on device `gpu`
 // (path regeneration's launch); zeros without CUDA.
