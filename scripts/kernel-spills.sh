@@ -32,9 +32,14 @@ for n in "${counts[@]}"; do
     --expt-relaxed-constexpr -std=c++17 -DENVGI_CUDA_THREADS_PER_SM=$n -Xptxas -v -x cu -c "$work/probe.cu" \
     -o "$work/probe.o" >"$work/ptxas.txt" 2>&1 || { cat "$work/ptxas.txt" >&2; exit 1; }
   echo "threads per SM $n:"
+  # One line a function: the kernel, then each function ptxas kept out of it (name without its
+  # namespaces, template arguments and parameters).
   c++filt <"$work/ptxas.txt" | awk '
-    /Function properties for/ { n = ""; if ($0 ~ /regenKernel/) n = "kernel"; else if ($0 ~ /pathShade/) n = "pathShade";
-                                else if ($0 ~ /directLighting/) n = "directLighting" }
-    /stack frame/ && n != "" { printf "  %-15s stack frame %5d B, spill stores %5d B, spill loads %5d B\n", n, $1, $5, $9 }
-    /Used [0-9]+ registers/ && n == "kernel" { printf "  %-15s %d registers\n", "kernel", $5 }'
+    /Function properties for/ {
+      n = $0; sub(/.*Function properties for /, "", n)
+      if (n ~ /regenKernel/) n = "kernel"
+      else { sub(/\(.*/, "", n); while (n ~ /<[^<>]*>/) gsub(/<[^<>]*>/, "", n); sub(/.* /, "", n); sub(/.*::/, "", n) }
+    }
+    /stack frame/ { printf "  %-26s stack frame %5d B, spill stores %5d B, spill loads %5d B\n", n, $1, $5, $9 }
+    /Used [0-9]+ registers/ && n == "kernel" { printf "  %-26s %d registers\n", "kernel", $5 }'
 done
