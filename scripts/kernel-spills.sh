@@ -10,6 +10,13 @@ root=$(cd "${1:-$(dirname "$0")/..}" && pwd)
 shift || true
 counts=("$@")
 [[ ${#counts[@]} -gt 0 ]] || counts=(1536)
+# Every count checked before the first 2-minute compile (CMakeLists.txt's rule for the setting).
+for n in "${counts[@]}"; do
+  if ! [[ $n =~ ^[0-9]+$ ]] || ((n < 128 || n > 2048 || n % 128 != 0)); then
+    echo "error: threads per SM must be 128 to 2048, a multiple of 128, not '$n'" >&2
+    exit 2
+  fi
+done
 nvcc=${CUDACXX:-/usr/local/cuda/bin/nvcc}
 [[ -x $nvcc ]] || { echo "error: nvcc not found (set CUDACXX)" >&2; exit 2; }
 work=$(mktemp -d)
@@ -24,10 +31,6 @@ template __global__ void regenKernel<SampleIntegrator<BvhTracer>>(SampleIntegrat
 }  // namespace envgi::gpu
 CU
 for n in "${counts[@]}"; do
-  if ! [[ $n =~ ^[0-9]+$ ]] || ((n < 128 || n > 2048 || n % 128 != 0)); then
-    echo "error: threads per SM must be 128 to 2048, a multiple of 128, not '$n'" >&2
-    exit 2
-  fi
   "$nvcc" -DENVGI_HAS_CUDA=1 -I"$root/src" -O3 -DNDEBUG --generate-code=arch=compute_90,code=sm_90 \
     --expt-relaxed-constexpr -std=c++17 -DENVGI_CUDA_THREADS_PER_SM=$n -Xptxas -v -x cu -c "$work/probe.cu" \
     -o "$work/probe.o" >"$work/ptxas.txt" 2>&1 || { cat "$work/ptxas.txt" >&2; exit 1; }
