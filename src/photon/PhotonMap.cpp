@@ -4,6 +4,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace envgi {
 
@@ -18,6 +19,18 @@ struct Cloud {
   }
 };
 using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, uint32_t>;
+
+// The k nearest points within squared distance maxR2 (inclusive), nearest first: knnSearch's
+// answer less the farther ones, which every caller drops. The search starts with maxR2 as its
+// bound instead of infinity, so a query far from every photon (a floor point under a caustic
+// map that lives on the glass's shadow) no longer walks the tree out to k photons it drops.
+size_t nearestWithin(const Tree& tree, const float q[3], size_t k, float maxR2, uint32_t* idx, float* d2) {
+  nanoflann::KNNResultSet<float, uint32_t> found(k);
+  found.init(idx, d2);
+  d2[k - 1] = std::nextafter(maxR2, INFINITY);  // the tree takes a point if its distance is below this
+  tree.findNeighbors(found, q, nanoflann::SearchParams());
+  return found.size();
+}
 }  // namespace
 
 struct PhotonMap::Index {
@@ -61,19 +74,15 @@ void PhotonMap::estimateIrradiance(size_t i, int k, float maxRadius) {
   uint32_t idx[kMaxPhotonLookup];
   float d2[kMaxPhotonLookup];
   float q[3] = {c.p.x, c.p.y, c.p.z};
-  size_t found = index_->tree.knnSearch(q, kk, idx, d2);
+  size_t found = nearestWithin(index_->tree, q, kk, maxR2, idx, d2);
   Color sum(0.f);
-  float r2 = 0.f;
-  size_t kept = 0;
   for (size_t j = 0; j < found; ++j) {
-    if (d2[j] > maxR2) continue;
     const Photon& ph = photons_[idx[j]];
-    r2 = fmaxf(r2, d2[j]);
-    ++kept;
     if (dot(ph.n, c.n) > kSameSurfaceCos) sum += ph.power;
   }
-  if (kept < kk) r2 = maxR2;
-  irr_[i] = {c.p, c.n, kept > 0 ? sum / (kPi * r2) : Color(0.f), r2};
+  // The k-th photon's distance (they come nearest first), or maxRadius where fewer lie within it.
+  float r2 = found < kk ? maxR2 : d2[found - 1];
+  irr_[i] = {c.p, c.n, found > 0 ? sum / (kPi * r2) : Color(0.f), r2};
 }
 
 namespace {
@@ -121,30 +130,22 @@ void PhotonMap::endIrradiance() {
 
 Color PhotonMap::estimate(const SceneView& sc, const SurfaceInteraction& si, Vec3f woWorld, const PhotonLookup& q) const {
   if (!index_ || q.k <= 0) return Color(0.f);
-  BsdfScratch textured;
-  const Bsdf& bsdf = sc.bsdfAt(si, &textured);
-  Vec3f woLocal = si.shading.toLocal(woWorld);
   size_t k = size_t(q.k);
   uint32_t idx[kMaxPhotonLookup];
   float d2[kMaxPhotonLookup];
   if (k > size_t(kMaxPhotonLookup)) k = size_t(kMaxPhotonLookup);
   float query[3] = {si.p.x, si.p.y, si.p.z};
-  size_t found = index_->tree.knnSearch(query, k, idx, d2);
   float maxR2 = q.maxRadius * q.maxRadius;
-  size_t kept = 0;
-  float r2 = 0.f;
-  for (size_t i = 0; i < found; ++i)
-    if (d2[i] <= maxR2) {
-      r2 = fmaxf(r2, d2[i]);
-      ++kept;
-    }
-  if (kept == 0) return Color(0.f);
-  if (kept < k) r2 = maxR2;
+  size_t found = nearestWithin(index_->tree, query, k, maxR2, idx, d2);
+  if (found == 0) return Color(0.f);
+  float r2 = found < k ? maxR2 : d2[found - 1];  // as in estimateIrradiance
+  BsdfScratch textured;
+  const Bsdf& bsdf = sc.bsdfAt(si, &textured);
+  Vec3f woLocal = si.shading.toLocal(woWorld);
   float r = std::sqrt(r2);
   const float coneK = 1.1f;
   Color sum(0.f);
   for (size_t i = 0; i < found; ++i) {
-    if (d2[i] > maxR2) continue;
     const Photon& ph = photons_[idx[i]];
     Vec3f wiLocal = si.shading.toLocal(ph.wi);
     if (dot(ph.wi, si.ng) * dot(woWorld, si.ng) <= 0.f && !bsdfTransmits(bsdf)) continue;

@@ -2,6 +2,7 @@
 // known flux density, the hashed grid, and black maps.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "integrators/PhotonIntegrator.h"
@@ -39,6 +40,14 @@ std::unique_ptr<Scene> closedBox(float rho) {
   return s;
 }
 
+// No geometry, one diffuse BSDF (index 0) of albedo rho: enough for PhotonMap::estimate.
+void withOneDiffuseBsdf(Scene& s, float rho) {
+  Bsdf d;
+  d.reflectance = Color(rho);
+  s.bsdfs = {d};
+  s.finalize();
+}
+
 }  // namespace
 
 // Stored power = emitted power x (rho + rho^2 + ...) = Phi rho / (1 - rho): the first hit is
@@ -68,10 +77,7 @@ TEST(PhotonShooting, ClosedBoxEnergyBalance) {
 // surface (Eq. 12).
 TEST(PhotonMapEstimate, UniformDensityGivesDiffuseRadiance) {
   Scene s;
-  Bsdf d;
-  d.reflectance = Color(0.5f);
-  s.bsdfs = {d};
-  s.finalize();
+  withOneDiffuseBsdf(s, 0.5f);
   std::vector<Photon> ph;
   Pcg32 rng(2);
   const int n = 200000;
@@ -165,6 +171,56 @@ TEST(PhotonMap, IrradianceOrderKeepsNeighboursTogetherAndChangesNoEstimate) {
     Vec3f q(rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2, 0.f);
     EXPECT_EQ(inOrder.irradiance(q, Vec3f(0, 0, 1)).x, sorted.irradiance(q, Vec3f(0, 0, 1)).x);
   }
+}
+
+// The radiance estimate (Eq. 11-12) reads the k nearest photons within the search radius, and
+// the radius is the k-th one's distance, or the search radius where fewer lie within it: against
+// a brute-force search, on queries inside two clusters, at their rims, between them and far out
+// (where the search, bounded by the radius, must find nothing rather than far photons).
+TEST(PhotonMapEstimate, KNearestWithinTheRadiusAsBruteForceFindsThem) {
+  Scene s;
+  withOneDiffuseBsdf(s, 0.8f);
+  Pcg32 rng(21);
+  std::vector<Photon> ph(6000);
+  for (size_t i = 0; i < ph.size(); ++i) {
+    // Two discs of photons on the plane z = 0, a dense one and a sparse one.
+    const bool dense = i % 3 != 0;
+    const float cx = dense ? 0.f : 3.f, spread = dense ? 0.5f : 1.5f;
+    const float x = cx + spread * (2.f * rng.nextFloat() - 1.f), y = spread * (2.f * rng.nextFloat() - 1.f);
+    ph[i] = {Vec3f(x, y, 0.f), Vec3f(0, 0, 1), Vec3f(0, 0, 1), Color(1.f + rng.nextFloat())};
+  }
+  PhotonMap map;
+  map.build(ph);
+  PhotonLookup q;
+  q.k = 40;
+  q.maxRadius = 0.12f;
+  const float maxR2 = q.maxRadius * q.maxRadius;
+  int full = 0, partial = 0, none = 0;
+  for (int t = 0; t < 600; ++t) {
+    SurfaceInteraction si;
+    const float a = rng.nextFloat(), b = rng.nextFloat();
+    if (t % 5 < 2) si.p = Vec3f(1.2f * a - 0.6f, 1.2f * b - 0.6f, 0.f);          // the dense disc and its rim
+    else if (t % 5 < 4) si.p = Vec3f(3.f + 3.4f * a - 1.7f, 3.4f * b - 1.7f, 0.f);  // the sparse one
+    else si.p = Vec3f(50.f + float(t), -20.f * a, 1.f);                           // far from every photon
+    si.ng = Vec3f(0, 0, 1);
+    si.shading = Frame::fromNormal(si.ng);
+    si.bsdf = 0;
+    std::vector<std::pair<float, size_t>> byDistance;
+    for (size_t i = 0; i < ph.size(); ++i) byDistance.push_back({lengthSq(ph[i].p - si.p), i});
+    std::sort(byDistance.begin(), byDistance.end());
+    size_t kept = 0;
+    while (kept < size_t(q.k) && byDistance[kept].first <= maxR2) ++kept;
+    const float r2 = kept < size_t(q.k) ? maxR2 : byDistance[kept - 1].first;
+    double expect = 0.0;
+    for (size_t j = 0; j < kept; ++j) expect += double(ph[byDistance[j].second].power.x);
+    expect *= 0.8 / kPi / (kPi * double(r2));  // f = albedo / pi, over the disc pi r^2
+    const float got = map.estimate(s.view(), si, Vec3f(0, 0, 1), q).x;
+    ASSERT_NEAR(got, expect, 1e-5 * expect + 1e-30) << "query " << t << " with " << kept << " photons";
+    (kept == size_t(q.k) ? full : kept > 0 ? partial : none) += 1;
+  }
+  EXPECT_GT(full, 100);
+  EXPECT_GT(partial, 20);
+  EXPECT_GT(none, 60);
 }
 
 TEST(HashGrid, FindsEveryPointWithinTheCellSize) {
