@@ -30,9 +30,12 @@ IrradianceCacheView uploadCache(DeviceArena& a, const IrradianceCache& c) {
   IrradianceCacheView v = c.view();
   size_t n = c.points().size();
   v.points = a.upload(c.points().data(), n, "photon irradiance");
-  v.grid.bucketStart = a.upload(v.grid.bucketStart, size_t(v.grid.tableSize) + 1, "photon irradiance");
-  v.grid.items = a.upload(v.grid.items, n, "photon irradiance");
-  if (n == 0) v.grid.tableSize = 0;
+  for (int l = 0; l < v.levelCount; ++l) {
+    HashGridView& g = v.levels[l];
+    const size_t items = size_t(g.bucketStart[g.tableSize]);  // the points on this level
+    g.bucketStart = a.upload(g.bucketStart, size_t(g.tableSize) + 1, "photon irradiance");
+    g.items = a.upload(g.items, items, "photon irradiance");
+  }
   return v;
 }
 

@@ -57,6 +57,26 @@ struct HashGridView {
           for (int i = bucketStart[b]; i < bucketStart[b + 1]; ++i) visit(items[i]);
         }
   }
+
+  // Calls visit(index) for every point stored in the cells that the box p +- h overlaps: two a
+  // side where h is at most half a cell (three at most in any case). A point may be visited
+  // twice where two of those cells share a bucket; callers that keep a minimum do not mind.
+  template <class Visit>
+  ENVGI_HD void forCellsAround(Vec3f p, float h, Visit&& visit) const {
+    if (tableSize == 0) return;
+    int x0, y0, z0, x1, y1, z1;
+    cellOf(p - Vec3f(h), &x0, &y0, &z0);
+    cellOf(p + Vec3f(h), &x1, &y1, &z1);
+    // Unsigned spans, capped, so that a far or non-finite p cannot make a long loop.
+    auto span = [](int a, int b) { return unsigned(b) - unsigned(a) > 2u ? 2 : int(unsigned(b) - unsigned(a)); };
+    const int nx = span(x0, x1), ny = span(y0, y1), nz = span(z0, z1);
+    for (int dz = 0; dz <= nz; ++dz)
+      for (int dy = 0; dy <= ny; ++dy)
+        for (int dx = 0; dx <= nx; ++dx) {
+          int b = bucket(x0 + dx, y0 + dy, z0 + dz);
+          for (int i = bucketStart[b]; i < bucketStart[b + 1]; ++i) visit(items[i]);
+        }
+  }
 };
 
 // One thread's share of finding bucket starts from keys sorted ascending (n of them, keys in

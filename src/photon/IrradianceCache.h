@@ -1,9 +1,14 @@
 // Christensen's precomputed photon irradiance (1999) as a lookup that runs on the CPU and in
 // CUDA kernels: irradiance points (position, normal, irradiance, and the squared radius of the
-// photons it came from) in a hashed grid whose cell is the largest radius, so every point that
-// can cover a query lies in the 27 cells around it.
+// photons it came from) in hashed grids, one a level of radius. Level l holds the points whose
+// radius is at most the largest over 2^l (and more than half that), in cells twice that size,
+// so the points that can cover a query lie in the 2 x 2 x 2 cells its box of that half-size
+// overlaps. One grid sized by the largest radius made a query in a dense region (small radii)
+// read every point within three of the sparsest region's radii: 2600 a gather ray in the glass
+// teapot, whose radii span 0.07 to 1.
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include "photon/HashGrid.h"
@@ -14,6 +19,10 @@ namespace envgi {
 // this close to its normal (not the far side of a thin wall, not a nearby crease).
 inline constexpr float kSameSurfaceCos = 0.9f;
 
+// Levels of radius the cache's grids span: radii below the largest / 2^(levels - 1) share the
+// finest level.
+inline constexpr int kIrradianceLevels = 6;
+
 struct IrradiancePoint {
   Vec3f p, n;
   Color e;
@@ -22,7 +31,9 @@ struct IrradiancePoint {
 
 struct IrradianceCacheView {
   const IrradiancePoint* points = nullptr;
-  HashGridView grid;
+  HashGridView levels[kIrradianceLevels];  // the levels that hold points, coarsest first
+  float reach[kIrradianceLevels] = {};     // each one's largest radius (half its cell), a hair over
+  int levelCount = 0;
 
   // Irradiance near p on a surface facing n: that of the nearest point facing the same way
   // whose own estimate covered p, zero where none does (a gather ray that lands where no
@@ -30,7 +41,7 @@ struct IrradianceCacheView {
   ENVGI_HD Color irradiance(Vec3f p, Vec3f n) const {
     float best = INFINITY;
     int bestIdx = -1;
-    grid.forNeighbours(p, [&](int i) {
+    auto visit = [&](int i) {
       const IrradiancePoint& ip = points[i];
       float d2 = lengthSq(ip.p - p);
       // Ties go to the lower index, so the answer does not depend on the buckets' order.
@@ -38,7 +49,8 @@ struct IrradianceCacheView {
         best = d2;
         bestIdx = i;
       }
-    });
+    };
+    for (int l = 0; l < levelCount; ++l) levels[l].forCellsAround(p, reach[l], visit);
     return bestIdx >= 0 ? points[bestIdx].e : Color(0.f);
   }
 };
@@ -47,24 +59,48 @@ class IrradianceCache {
  public:
   void build(std::vector<IrradiancePoint> points) {
     points_ = std::move(points);
-    std::vector<Vec3f> pos(points_.size());
-    std::vector<char> valid(points_.size(), 1);
     float maxR2 = 0.f;
+    for (const IrradiancePoint& ip : points_) maxR2 = fmaxf(maxR2, ip.r2);
+    // Level l's reach: the largest radius over 2^l (exact in floats). A point's level is the
+    // finest whose reach's square is at least its r2.
+    const float reach0 = std::sqrt(fmaxf(maxR2, 1e-12f));
+    std::vector<int> levelOf(points_.size());
     for (size_t i = 0; i < points_.size(); ++i) {
-      pos[i] = points_[i].p;
-      maxR2 = fmaxf(maxR2, points_[i].r2);
+      int l = 0;
+      for (float h = reach0 * 0.5f; l + 1 < kIrradianceLevels && h * h >= points_[i].r2; h *= 0.5f) ++l;
+      levelOf[i] = l;
     }
-    grid_.build(pos, valid, std::sqrt(fmaxf(maxR2, 1e-12f)));
+    std::vector<Vec3f> pos(points_.size());
+    for (size_t i = 0; i < points_.size(); ++i) pos[i] = points_[i].p;
+    grids_.clear();
+    view_ = IrradianceCacheView();
     view_.points = points_.data();
-    view_.grid = grid_.view();
+    for (int l = 0; l < kIrradianceLevels; ++l) {
+      std::vector<char> here(points_.size());
+      bool any = false;
+      for (size_t i = 0; i < points_.size(); ++i) any |= (here[i] = levelOf[i] == l) != 0;
+      if (!any) continue;
+      const float h = std::ldexp(reach0, -l);
+      grids_.emplace_back();
+      grids_.back().build(pos, here, 2.f * h);
+      // A hair over the reach, so that a point exactly at it, across a cell boundary that
+      // float rounding moves, is still in the box's cells.
+      view_.reach[grids_.size() - 1] = h * (1.f + 1e-5f);
+    }
+    for (size_t g = 0; g < grids_.size(); ++g) view_.levels[g] = grids_[g].view();
+    view_.levelCount = int(grids_.size());
   }
   const IrradianceCacheView& view() const { return view_; }
   const std::vector<IrradiancePoint>& points() const { return points_; }
-  size_t bytes() const { return points_.size() * sizeof(IrradiancePoint) + grid_.bytes(); }
+  size_t bytes() const {
+    size_t b = points_.size() * sizeof(IrradiancePoint);
+    for (const HashGrid& g : grids_) b += g.bytes();
+    return b;
+  }
 
  private:
   std::vector<IrradiancePoint> points_;
-  HashGrid grid_;
+  std::vector<HashGrid> grids_;  // HashGrid moves keep their views valid
   IrradianceCacheView view_;
 };
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include "integrators/PhotonIntegrator.h"
@@ -245,6 +246,36 @@ TEST(HashGrid, FindsEveryPointWithinTheCellSize) {
   }
 }
 
+// The box query the irradiance cache's levels use: every point within h (half a cell) of the
+// query, whichever side of a cell boundary it lies on; far and non-finite queries end at once.
+TEST(HashGrid, BoxOfHalfACellFindsEveryPointWithinIt) {
+  Pcg32 rng(5);
+  std::vector<Vec3f> pts(5000);
+  std::vector<char> valid(pts.size(), 1);
+  for (Vec3f& p : pts) p = Vec3f(rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2);
+  const float h = 0.15f;
+  HashGrid g;
+  g.build(pts, valid, 2.f * h);
+  for (int t = 0; t < 300; ++t) {
+    Vec3f q(rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2);
+    if (t % 10 == 0) q = Vec3f(0.3f * float(t / 10), 0.f, -0.3f);  // on cell boundaries
+    std::vector<int> found, expect;
+    g.view().forCellsAround(q, h, [&](int i) {
+      if (lengthSq(pts[size_t(i)] - q) <= h * h) found.push_back(i);
+    });
+    for (size_t i = 0; i < pts.size(); ++i)
+      if (lengthSq(pts[i] - q) <= h * h) expect.push_back(int(i));
+    std::sort(found.begin(), found.end());
+    found.erase(std::unique(found.begin(), found.end()), found.end());
+    ASSERT_EQ(found, expect) << "query " << t;
+  }
+  for (Vec3f q : {Vec3f(1e30f, 0.f, 0.f), Vec3f(NAN, 0.f, 0.f), Vec3f(-INFINITY, 1.f, 2.f)}) {
+    int visits = 0;
+    g.view().forCellsAround(q, h, [&](int) { ++visits; });
+    EXPECT_LT(visits, 5000) << "at most 27 buckets' points";
+  }
+}
+
 // The GPU builds the grid by radix-sorting (key, index) pairs and finding the bucket starts per
 // sorted position; the same steps here, with a stable sort, give the CPU's counting sort.
 TEST(HashGrid, SortedKeysGiveTheCountingSortsArrays) {
@@ -277,12 +308,15 @@ TEST(IrradianceCache, NearestCoveringPointFacingTheSameWay) {
     IrradiancePoint& ip = pts[i];
     ip.p = Vec3f(rng.nextFloat() * 2, rng.nextFloat() * 2, rng.nextFloat() * 0.1f);
     ip.n = rng.nextFloat() < 0.8f ? Vec3f(0, 0, 1) : Vec3f(0, 0, -1);
-    float r = 0.01f + 0.09f * rng.nextFloat();
+    // Radii from 0.002 to 0.2, spread evenly in their logarithm: the cache's levels of radius
+    // all hold points.
+    float r = 0.002f * std::pow(100.f, rng.nextFloat());
     ip.r2 = r * r;
     ip.e = Color(float(i));
   }
   IrradianceCache cache;
   cache.build(pts);
+  EXPECT_EQ(cache.view().levelCount, kIrradianceLevels);
   int hits = 0;
   for (int t = 0; t < 3000; ++t) {
     Vec3f q(rng.nextFloat() * 2, rng.nextFloat() * 2, rng.nextFloat() * 0.1f);
