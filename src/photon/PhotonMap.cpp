@@ -9,35 +9,54 @@
 namespace envgi {
 
 namespace {
+// The photons' positions as nanoflann reads them.
 struct Cloud {
-  const std::vector<Photon>* pts;
+  const std::vector<Vec3f>* pts;
   size_t kdtree_get_point_count() const { return pts->size(); }
-  float kdtree_get_pt(size_t i, size_t dim) const { return (*pts)[i].p[int(dim)]; }
+  float kdtree_get_pt(size_t i, size_t dim) const { return (*pts)[i][int(dim)]; }
   template <class BBox>
   bool kdtree_get_bbox(BBox&) const {
     return false;
   }
 };
 using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Cloud>, Cloud, 3, uint32_t>;
-
-// The k nearest points within squared distance maxR2 (inclusive), nearest first: knnSearch's
-// answer less the farther ones, which every caller drops. The search starts with maxR2 as its
-// bound instead of infinity, so a query far from every photon (a floor point under a caustic
-// map that lives on the glass's shadow) no longer walks the tree out to k photons it drops.
-size_t nearestWithin(const Tree& tree, const float q[3], size_t k, float maxR2, uint32_t* idx, float* d2) {
-  nanoflann::KNNResultSet<float, uint32_t> found(k);
-  found.init(idx, d2);
-  d2[k - 1] = std::nextafter(maxR2, INFINITY);  // the tree takes a point if its distance is below this
-  tree.findNeighbors(found, q, nanoflann::SearchParams());
-  return found.size();
-}
 }  // namespace
 
+// The kd-tree over the photons' positions, kept in the order of the tree's leaves: a leaf's
+// points are then neighbours in memory, where in the photons' own (shot) order each one the
+// search looked at was a cache miss of its own.
 struct PhotonMap::Index {
+  std::vector<Vec3f> pos;          // after the build: in leaf order
+  std::vector<uint32_t> photonOf;  // leaf order -> index in the map's photons
   Cloud cloud;
   Tree tree;
-  explicit Index(const std::vector<Photon>* p) : cloud{p}, tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+  explicit Index(const std::vector<Photon>& photons)
+      : pos(photons.size()), cloud{&pos},
+        // Built below, once the positions are in: the constructor would otherwise build it over
+        // zeros first (it used to build twice, over the photons).
+        tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex)) {
+    for (size_t i = 0; i < photons.size(); ++i) pos[i] = photons[i].p;
     tree.buildIndex();
+    // The built tree's leaves address positions through vAcc: lay the positions out in that
+    // order and make vAcc the identity. Nodes and bounds stay as built, so every search visits
+    // the same points in the same order as before.
+    photonOf.assign(tree.vAcc.begin(), tree.vAcc.end());
+    for (size_t j = 0; j < pos.size(); ++j) pos[j] = photons[photonOf[j]].p;
+    for (size_t j = 0; j < pos.size(); ++j) tree.vAcc[j] = uint32_t(j);
+  }
+
+  // The k nearest photons within squared distance maxR2 (inclusive), nearest first, as indices
+  // into the map's photons: knnSearch's answer less the farther ones, which every caller drops.
+  // The search starts with maxR2 as its bound instead of infinity, so a query far from every
+  // photon (a floor point under a caustic map that lives on the glass's shadow) no longer walks
+  // the tree out to k photons it would drop.
+  size_t nearestWithin(const float q[3], size_t k, float maxR2, uint32_t* idx, float* d2) const {
+    nanoflann::KNNResultSet<float, uint32_t> found(k);
+    found.init(idx, d2);
+    d2[k - 1] = std::nextafter(maxR2, INFINITY);  // the tree takes a point if its distance is below this
+    tree.findNeighbors(found, q, nanoflann::SearchParams());
+    for (size_t i = 0; i < found.size(); ++i) idx[i] = photonOf[idx[i]];
+    return found.size();
   }
 };
 
@@ -49,13 +68,13 @@ PhotonMap& PhotonMap::operator=(PhotonMap&&) noexcept = default;
 void PhotonMap::build(std::vector<Photon> photons) {
   photons_ = std::move(photons);
   index_.reset();
-  if (!photons_.empty()) index_ = std::make_unique<Index>(&photons_);
+  if (!photons_.empty()) index_ = std::make_unique<Index>(photons_);
 }
 
 size_t PhotonMap::bytes() const {
-  // The kd-trees hold one index per point plus nodes of about 16 points each.
+  // The kd-tree holds a position and two indices per point plus nodes of about 16 points each.
   size_t n = photons_.size();
-  return n * (sizeof(Photon) + sizeof(uint32_t)) + n / 16 * 48 + cache_.bytes();
+  return n * (sizeof(Photon) + sizeof(Vec3f) + 2 * sizeof(uint32_t)) + n / 16 * 48 + cache_.bytes();
 }
 
 size_t PhotonMap::beginIrradiance(int stride) {
@@ -74,7 +93,7 @@ void PhotonMap::estimateIrradiance(size_t i, int k, float maxRadius) {
   uint32_t idx[kMaxPhotonLookup];
   float d2[kMaxPhotonLookup];
   float q[3] = {c.p.x, c.p.y, c.p.z};
-  size_t found = nearestWithin(index_->tree, q, kk, maxR2, idx, d2);
+  size_t found = index_->nearestWithin(q, kk, maxR2, idx, d2);
   Color sum(0.f);
   for (size_t j = 0; j < found; ++j) {
     const Photon& ph = photons_[idx[j]];
@@ -136,7 +155,7 @@ Color PhotonMap::estimate(const SceneView& sc, const SurfaceInteraction& si, Vec
   if (k > size_t(kMaxPhotonLookup)) k = size_t(kMaxPhotonLookup);
   float query[3] = {si.p.x, si.p.y, si.p.z};
   float maxR2 = q.maxRadius * q.maxRadius;
-  size_t found = nearestWithin(index_->tree, query, k, maxR2, idx, d2);
+  size_t found = index_->nearestWithin(query, k, maxR2, idx, d2);
   if (found == 0) return Color(0.f);
   float r2 = found < k ? maxR2 : d2[found - 1];  // as in estimateIrradiance
   BsdfScratch textured;
