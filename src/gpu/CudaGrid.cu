@@ -30,11 +30,12 @@ IrradianceCacheView uploadCache(DeviceArena& a, const IrradianceCache& c) {
   IrradianceCacheView v = c.view();
   size_t n = c.points().size();
   v.points = a.upload(c.points().data(), n, "photon irradiance");
+  v.id = a.upload(c.ids().data(), n, "photon irradiance");
   for (int l = 0; l < v.levelCount; ++l) {
+    // The lookup reads its points in bucket order from v.points, not through items.
     HashGridView& g = v.levels[l];
-    const size_t items = size_t(g.bucketStart[g.tableSize]);  // the points on this level
     g.bucketStart = a.upload(g.bucketStart, size_t(g.tableSize) + 1, "photon irradiance");
-    g.items = a.upload(g.items, items, "photon irradiance");
+    g.items = nullptr;
   }
   return v;
 }

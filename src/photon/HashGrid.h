@@ -63,6 +63,14 @@ struct HashGridView {
   // twice where two of those cells share a bucket; callers that keep a minimum do not mind.
   template <class Visit>
   ENVGI_HD void forCellsAround(Vec3f p, float h, Visit&& visit) const {
+    forBucketsAround(p, h, [&](int begin, int end) {
+      for (int i = begin; i < end; ++i) visit(items[i]);
+    });
+  }
+  // forCellsAround's buckets, as ranges [begin, end) of positions in items, for a caller that
+  // keeps its points in the grid's order and reads them without items.
+  template <class VisitRange>
+  ENVGI_HD void forBucketsAround(Vec3f p, float h, VisitRange&& visit) const {
     if (tableSize == 0) return;
     int x0, y0, z0, x1, y1, z1;
     cellOf(p - Vec3f(h), &x0, &y0, &z0);
@@ -74,7 +82,7 @@ struct HashGridView {
       for (int dy = 0; dy <= ny; ++dy)
         for (int dx = 0; dx <= nx; ++dx) {
           int b = bucket(x0 + dx, y0 + dy, z0 + dz);
-          for (int i = bucketStart[b]; i < bucketStart[b + 1]; ++i) visit(items[i]);
+          visit(bucketStart[b], bucketStart[b + 1]);
         }
   }
 };

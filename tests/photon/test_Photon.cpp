@@ -337,6 +337,19 @@ TEST(IrradianceCache, NearestCoveringPointFacingTheSameWay) {
   EXPECT_LT(hits, 3000);
 }
 
+// Points at one place, on different levels (the finer one, read last, has the lower index):
+// the lookup answers with the lower index, whatever order its levels and buckets come in.
+TEST(IrradianceCache, TiesGoToTheLowerIndexAcrossLevels) {
+  std::vector<IrradiancePoint> pts(2);
+  pts[0] = {Vec3f(1.f, 2.f, 3.f), Vec3f(0, 0, 1), Color(10.f), 0.05f * 0.05f};
+  pts[1] = {Vec3f(1.f, 2.f, 3.f), Vec3f(0, 0, 1), Color(20.f), 0.5f * 0.5f};
+  IrradianceCache cache;
+  cache.build(pts);
+  ASSERT_EQ(cache.view().levelCount, 2);
+  EXPECT_EQ(cache.view().irradiance(Vec3f(1.01f, 2.f, 3.f), Vec3f(0, 0, 1)).x, 10.f);
+  EXPECT_EQ(cache.view().irradiance(Vec3f(1.2f, 2.f, 3.f), Vec3f(0, 0, 1)).x, 20.f) << "only the wide one covers";
+}
+
 // An all-black map is a light of zero power: no photons, a black image, no NaN.
 TEST(PhotonIntegrators, BlackMapShootsNothingAndRendersBlack) {
   Bsdf b;
