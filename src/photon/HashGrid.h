@@ -58,17 +58,10 @@ struct HashGridView {
         }
   }
 
-  // Calls visit(index) for every point stored in the cells that the box p +- h overlaps: two a
-  // side where h is at most half a cell (three at most in any case). A point may be visited
-  // twice where two of those cells share a bucket; callers that keep a minimum do not mind.
-  template <class Visit>
-  ENVGI_HD void forCellsAround(Vec3f p, float h, Visit&& visit) const {
-    forBucketsAround(p, h, [&](int begin, int end) {
-      for (int i = begin; i < end; ++i) visit(items[i]);
-    });
-  }
-  // forCellsAround's buckets, as ranges [begin, end) of positions in items, for a caller that
-  // keeps its points in the grid's order and reads them without items.
+  // Calls visit(begin, end) for the bucket of each cell that the box p +- h overlaps: two cells
+  // a side where h is at most half a cell (three at most in any case), each bucket's points at
+  // items[begin, end). A bucket comes twice where two of those cells share it; callers that
+  // keep a minimum do not mind.
   template <class VisitRange>
   ENVGI_HD void forBucketsAround(Vec3f p, float h, VisitRange&& visit) const {
     if (tableSize == 0) return;

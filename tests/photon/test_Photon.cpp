@@ -260,8 +260,10 @@ TEST(HashGrid, BoxOfHalfACellFindsEveryPointWithinIt) {
     Vec3f q(rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2, rng.nextFloat() * 4 - 2);
     if (t % 10 == 0) q = Vec3f(0.3f * float(t / 10), 0.f, -0.3f);  // on cell boundaries
     std::vector<int> found, expect;
-    g.view().forCellsAround(q, h, [&](int i) {
-      if (lengthSq(pts[size_t(i)] - q) <= h * h) found.push_back(i);
+    const HashGridView& v = g.view();
+    v.forBucketsAround(q, h, [&](int begin, int end) {
+      for (int j = begin; j < end; ++j)
+        if (lengthSq(pts[size_t(v.items[j])] - q) <= h * h) found.push_back(v.items[j]);
     });
     for (size_t i = 0; i < pts.size(); ++i)
       if (lengthSq(pts[i] - q) <= h * h) expect.push_back(int(i));
@@ -271,7 +273,7 @@ TEST(HashGrid, BoxOfHalfACellFindsEveryPointWithinIt) {
   }
   for (Vec3f q : {Vec3f(1e30f, 0.f, 0.f), Vec3f(NAN, 0.f, 0.f), Vec3f(-INFINITY, 1.f, 2.f)}) {
     int visits = 0;
-    g.view().forCellsAround(q, h, [&](int) { ++visits; });
+    g.view().forBucketsAround(q, h, [&](int begin, int end) { visits += end - begin; });
     EXPECT_LT(visits, 5000) << "at most 27 buckets' points";
   }
 }
