@@ -65,9 +65,12 @@ struct HashGridView {
   template <class VisitRange>
   ENVGI_HD void forBucketsAround(Vec3f p, float h, VisitRange&& visit) const {
     if (tableSize == 0) return;
+    // Widened by a few ulps of p's largest coordinate: rounding in p +- h and in the division
+    // by the cell can then add a cell at the box's edge, never drop one.
+    const float m = h + 4e-7f * fmaxf(std::fabs(p.x), fmaxf(std::fabs(p.y), std::fabs(p.z)));
     int x0, y0, z0, x1, y1, z1;
-    cellOf(p - Vec3f(h), &x0, &y0, &z0);
-    cellOf(p + Vec3f(h), &x1, &y1, &z1);
+    cellOf(p - Vec3f(m), &x0, &y0, &z0);
+    cellOf(p + Vec3f(m), &x1, &y1, &z1);
     // Unsigned spans, capped, so that a far or non-finite p cannot make a long loop.
     auto span = [](int a, int b) { return unsigned(b) - unsigned(a) > 2u ? 2 : int(unsigned(b) - unsigned(a)); };
     const int nx = span(x0, x1), ny = span(y0, y1), nz = span(z0, z1);

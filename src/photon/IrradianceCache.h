@@ -91,8 +91,7 @@ class IrradianceCache {
       HashGrid grid;
       grid.build(pos, here, 2.f * h);
       const int g = int(grids_.size());
-      // A hair over the reach, so that a point exactly at it, across a cell boundary that
-      // float rounding moves, is still in the box's cells.
+      // A hair over the reach: r2 <= h * h, rounded, may still put r a few ulps past h.
       view_.reach[g] = h * (1.f + 1e-5f);
       view_.first[g] = int(points_.size());
       const HashGridView& gv = grid.view();
