@@ -49,14 +49,17 @@ struct PhotonMap::Index {
   // into the map's photons: knnSearch's answer less the farther ones, which every caller drops.
   // The search starts with maxR2 as its bound instead of infinity, so a query far from every
   // photon (a floor point under a caustic map that lives on the glass's shadow) no longer walks
-  // the tree out to k photons it would drop.
-  size_t nearestWithin(const float q[3], size_t k, float maxR2, uint32_t* idx, float* d2) const {
+  // the tree out to k photons it would drop. *r2 is the estimate's squared radius (Eq. 11): the
+  // k-th photon's distance, or maxR2 where fewer lie within it.
+  size_t nearestWithin(const float q[3], size_t k, float maxR2, uint32_t* idx, float* d2, float* r2) const {
     nanoflann::KNNResultSet<float, uint32_t> found(k);
     found.init(idx, d2);
     d2[k - 1] = std::nextafter(maxR2, INFINITY);  // the tree takes a point if its distance is below this
     tree.findNeighbors(found, q, nanoflann::SearchParams());
-    for (size_t i = 0; i < found.size(); ++i) idx[i] = photonOf[idx[i]];
-    return found.size();
+    const size_t n = found.size();
+    for (size_t i = 0; i < n; ++i) idx[i] = photonOf[idx[i]];
+    *r2 = n < k ? maxR2 : d2[n - 1];
+    return n;
   }
 };
 
@@ -93,14 +96,13 @@ void PhotonMap::estimateIrradiance(size_t i, int k, float maxRadius) {
   uint32_t idx[kMaxPhotonLookup];
   float d2[kMaxPhotonLookup];
   float q[3] = {c.p.x, c.p.y, c.p.z};
-  size_t found = index_->nearestWithin(q, kk, maxR2, idx, d2);
+  float r2;
+  size_t found = index_->nearestWithin(q, kk, maxR2, idx, d2, &r2);
   Color sum(0.f);
   for (size_t j = 0; j < found; ++j) {
     const Photon& ph = photons_[idx[j]];
     if (dot(ph.n, c.n) > kSameSurfaceCos) sum += ph.power;
   }
-  // The k-th photon's distance (they come nearest first), or maxRadius where fewer lie within it.
-  float r2 = found < kk ? maxR2 : d2[found - 1];
   irr_[i] = {c.p, c.n, found > 0 ? sum / (kPi * r2) : Color(0.f), r2};
 }
 
@@ -155,9 +157,9 @@ Color PhotonMap::estimate(const SceneView& sc, const SurfaceInteraction& si, Vec
   if (k > size_t(kMaxPhotonLookup)) k = size_t(kMaxPhotonLookup);
   float query[3] = {si.p.x, si.p.y, si.p.z};
   float maxR2 = q.maxRadius * q.maxRadius;
-  size_t found = index_->nearestWithin(query, k, maxR2, idx, d2);
+  float r2;
+  size_t found = index_->nearestWithin(query, k, maxR2, idx, d2, &r2);
   if (found == 0) return Color(0.f);
-  float r2 = found < k ? maxR2 : d2[found - 1];  // as in estimateIrradiance
   BsdfScratch textured;
   const Bsdf& bsdf = sc.bsdfAt(si, &textured);
   Vec3f woLocal = si.shading.toLocal(woWorld);
