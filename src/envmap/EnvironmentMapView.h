@@ -246,6 +246,11 @@ struct EnvironmentMapView {
     return out;
   }
 
+  // Asks for the emission table's bin that sampleEmission(u) reads first (CPU only: the photon
+  // pass prefetches a block of photons' bins, so that their misses overlap). Its texels were
+  // tried too and cost more than they saved.
+  void prefetchEmission(Vec2f u) const { prefetchLine(emission.bins + emission.column(u)); }
+
   ENVGI_HD float importancePdfUV(Vec2f uv) const { return solidAnglePdf(dist.pdf(uv), uv.y); }
 
   // The strategy that draws for this normal: a zero normal (a BSDF that also transmits) means

@@ -15,7 +15,7 @@ namespace {
 constexpr int kThreads = 128;
 
 __global__ void photonMapKernel(const SceneView* sc, BvhTracer tracer, PhotonEmitter emitter, uint32_t seed,
-                                uint64_t first, int count, int maxDepth, int stride, bool wantGlobal,
+                                bool aimed, uint64_t first, int count, int maxDepth, int stride, bool wantGlobal,
                                 bool wantCaustic, Photon* slots, uint8_t* isGlobal, uint8_t* isCaustic) {
   int i = int(blockIdx.x * blockDim.x + threadIdx.x);
   if (i >= count) return;
@@ -23,7 +23,7 @@ __global__ void photonMapKernel(const SceneView* sc, BvhTracer tracer, PhotonEmi
   for (int k = 0; k < stride; ++k) isGlobal[base + k] = isCaustic[base + k] = 0;
   int k = 0;
   // tracePhoton stores at bounces 1 .. maxDepth - 1, so maxDepth <= stride slots are enough.
-  shootPhoton(*sc, tracer, emitter, seed ^ kPhotonMapStream, first + uint64_t(i), 0, maxDepth,
+  shootPhoton(*sc, tracer, emitter, seed, first + uint64_t(i), 0, maxDepth, aimed,
               [&](const SurfaceInteraction& si, Vec3f wi, Color pw, bool caustic, int) {
                 if (!(caustic ? wantCaustic : wantGlobal)) return;
                 slots[base + k] = makePhoton(si, wi, pw);
@@ -58,9 +58,9 @@ class CudaPhotonTracer final : public PhotonBatchTracer {
   void trace(const PhotonTraceRequest& r, std::vector<PhotonBatch>* out) override {
     if (r.maxDepth > maxDepth_) throw std::runtime_error("photon tracer: made for a smaller max_depth");
     int count = subs_ * kPhotonSubBatch;
-    photonMapKernel<<<(count + kThreads - 1) / kThreads, kThreads>>>(scene_.deviceView, BvhTracer{scene_.bvh},
-                                                                     emitter_, r.seed, r.first, count, r.maxDepth, maxDepth_,
-                                                                     r.global, r.caustic, slots_, isGlobal_, isCaustic_);
+    photonMapKernel<<<(count + kThreads - 1) / kThreads, kThreads>>>(
+        scene_.deviceView, BvhTracer{scene_.bvh}, emitter_, r.seed ^ r.stream, r.aimed, r.first, count, r.maxDepth,
+        maxDepth_, r.global, r.caustic, slots_, isGlobal_, isCaustic_);
     check(cudaGetLastError(), "launching the photon kernel");
     out->assign(size_t(subs_), PhotonBatch{});
     int perSub = kPhotonSubBatch * maxDepth_;

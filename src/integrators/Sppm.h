@@ -141,11 +141,15 @@ ENVGI_HD uint64_t sppmCameraStep(const SceneView& sc, const Tracer& tracer, cons
 
 // Photon j of pass `pass`: traced from the lights, splatted into every visible point within
 // its radius (atomics: photons from many threads meet at one pixel). Returns the splats made.
+// Photon j of pass `pass` draws from this sampler (shootPhoton's, on SPPM's stream).
+ENVGI_INLINE Sampler sppmPhotonSampler(const SppmParams& s, uint64_t j, int pass) {
+  return photonSampler(s.seed ^ kSppmPhotonStream, uint64_t(pass) * s.photonsPerPass + j, 1);
+}
+
 template <class Tracer>
 ENVGI_HD uint32_t sppmPhotonStep(const SceneView& sc, const Tracer& tracer, const PhotonEmitter& emitter,
                                  const SppmParams& s, SppmPixels px, const HashGridView& grid, uint64_t j, int pass) {
   uint32_t hits = 0;
-  uint64_t index = uint64_t(pass) * s.photonsPerPass + j;
   auto splat = [&](const SurfaceInteraction& si, Vec3f wi, Color pw, bool, int) {
     grid.forNeighbours(si.p, [&](int idx) {
       const VisiblePoint& vp = px.vp[idx];
@@ -159,7 +163,7 @@ ENVGI_HD uint32_t sppmPhotonStep(const SceneView& sc, const Tracer& tracer, cons
       ++hits;
     });
   };
-  shootPhoton(sc, tracer, emitter, s.seed ^ kSppmPhotonStream, index, 1, s.maxDepth, splat);
+  shootPhoton(sc, tracer, emitter, sppmPhotonSampler(s, j, pass), s.maxDepth, false, splat);
   return hits;
 }
 

@@ -18,31 +18,86 @@ struct Photon {
   Color power;  // flux carried, already divided by the number of photons emitted
 };
 
+// A shape that can start a caustic (a material with a delta lobe), bounded by a sphere: caustic
+// photons from the map and the suns are aimed at these (Jensen's projection maps, with spheres
+// for the map's cells), so that most of them meet glass or a mirror first.
+constexpr int kMaxPhotonTargets = 16;
+struct PhotonTarget {
+  Vec3f center;
+  float radius = 0.f;
+  float cdf = 1.f;      // chance of aiming at this target or an earlier one
+  float density = 0.f;  // chance of aiming at it over its disk's area, pick / (pi r^2)
+};
+
 struct PhotonEmitter {
   Vec3f center;        // of the scene's bounding sphere
   float radius = 1.f;
   float envProb = 1.f; // chance a photon leaves the environment rather than an area light
   float deltaProb = 0.f;  // chance it leaves a delta light (the area lights have the rest)
+  PhotonTarget targets[kMaxPhotonTargets];
+  int targetCount = 0;  // 0: photons are never aimed
+
+  // An aimed photon's line, for a direction w towards the light: a point of the disk of radius r
+  // about target k's centre, facing w, moved back along w until it lies beyond the scene's
+  // bounding sphere, so nothing on the line is skipped.
+  ENVGI_HD Vec3f aimedOrigin(Vec3f w, int k, Vec2f disk) const {
+    const PhotonTarget& t = targets[k];
+    Frame f = Frame::fromNormal(w);
+    float back = length(t.center - center) + radius + t.radius;
+    return t.center + w * back + (f.s * disk.x + f.t * disk.y) * t.radius;
+  }
+  // The density of aimed lines of direction w through o, per unit area across w: the sum over
+  // every target the line passes through (the chosen one counts whatever rounding says).
+  ENVGI_HD float aimedDensity(Vec3f o, Vec3f w, int chosen) const {
+    float sum = 0.f;
+    for (int j = 0; j < targetCount; ++j) {
+      Vec3f v = targets[j].center - o;
+      if (j == chosen || lengthSq(v - w * dot(v, w)) <= targets[j].radius * targets[j].radius)
+        sum += targets[j].density;
+    }
+    return sum;
+  }
+  ENVGI_HD int pickTarget(float u) const {
+    int k = 0;
+    while (k + 1 < targetCount && !(u < targets[k].cdf)) ++k;
+    return k;
+  }
 
   // False when nothing in the scene emits (a black map and no area or delta lights): no photons.
   ENVGI_HD bool emitsLight(const SceneView& sc) const {
     return envProb > 0.f || sc.lightCount > 0 || deltaProb > 0.f;
   }
 
-  // Origin, direction and flux (times the photon count) of one emitted photon.
-  ENVGI_HD bool emit(const SceneView& sc, Sampler& smp, Ray* ray, Color* power) const {
+  // Asks for what emit() with this sampler is sure to miss on, the map's emission bin (CPU only).
+  void prefetch(const SceneView& sc, Sampler& smp) const {
+    float uSel = smp.get1D();
+    Vec2f u1 = smp.get2D();
+    if (uSel < envProb && sc.hasEnvironment) sc.env.prefetchEmission(u1);
+  }
+
+  // Origin, direction and flux (times the photon count) of one emitted photon. Aimed, the map's
+  // and the suns' photons leave only along lines through the targets, with the flux their
+  // density gives (lines that miss every target carry no caustic); other lights' are as unaimed.
+  ENVGI_HD bool emit(const SceneView& sc, Sampler& smp, Ray* ray, Color* power, bool aimed = false) const {
     float uSel = smp.get1D();
     Vec2f u1 = smp.get2D(), u2 = smp.get2D();
+    aimed = aimed && targetCount > 0;
+    int target = aimed ? pickTarget(smp.get1D()) : -1;
     if (uSel < envProb && sc.hasEnvironment) {
       // Direction by the map's luminance (Algorithm 1's density, never the MIS-compensated
       // one); origin on a disk facing it that covers the bounding sphere.
       EnvSample es = sc.env.sampleEmission(u1);
       if (!(es.pdf > 0.f) || isBlack(es.radiance)) return false;
-      Frame f = Frame::fromNormal(es.dir);
       Vec2f d = sampleConcentricDisk(u2);
-      ray->o = center + (es.dir + f.s * d.x + f.t * d.y) * radius;
       ray->d = -es.dir;
       ray->tMax = INFINITY;
+      if (aimed) {
+        ray->o = aimedOrigin(es.dir, target, d);
+        *power = es.radiance / (es.pdf * envProb * aimedDensity(ray->o, es.dir, target));
+        return true;
+      }
+      Frame f = Frame::fromNormal(es.dir);
+      ray->o = center + (es.dir + f.s * d.x + f.t * d.y) * radius;
       *power = es.radiance * (kPi * radius * radius / (es.pdf * envProb));
       return true;
     }
@@ -64,6 +119,10 @@ struct PhotonEmitter {
         ray->o = l.v;
         ray->d = sampleUniformSphere(u1);
         *power = l.value * (4.f * kPi / pick);
+      } else if (aimed) {
+        ray->o = aimedOrigin(-l.v, target, sampleConcentricDisk(u2));
+        ray->d = l.v;
+        *power = l.value / (pick * aimedDensity(ray->o, -l.v, target));
       } else {
         Frame f = Frame::fromNormal(l.v);
         Vec2f d = sampleConcentricDisk(u2);
@@ -141,19 +200,28 @@ ENVGI_HD int tracePhoton(const SceneView& sc, const Tracer& tracer, Ray ray, Col
 }
 
 // One photon from the lights: its own random stream (streamSeed, index, sampleIndex), emitted
-// and traced; store as tracePhoton's. The photon-map pass and SPPM's photon step, on either
-// device, start every photon here.
-template <class Tracer, class Store>
-ENVGI_HD void shootPhoton(const SceneView& sc, const Tracer& tracer, const PhotonEmitter& emitter, uint32_t streamSeed,
-                          uint64_t index, uint32_t sampleIndex, int maxDepth, Store&& store) {
+// (aimed at the targets or not) and traced; store as tracePhoton's. The photon-map pass and
+// SPPM's photon step, on either device, start every photon here.
+ENVGI_INLINE Sampler photonSampler(uint32_t streamSeed, uint64_t index, uint32_t sampleIndex) {
   Sampler smp;
   smp.type = SamplerType::Independent;
   smp.seed = streamSeed;
   smp.start(index, sampleIndex);
+  return smp;
+}
+
+template <class Tracer, class Store>
+ENVGI_HD void shootPhoton(const SceneView& sc, const Tracer& tracer, const PhotonEmitter& emitter, Sampler smp,
+                          int maxDepth, bool aimed, Store&& store) {
   Ray ray;
   Color power;
-  if (!emitter.emit(sc, smp, &ray, &power)) return;
+  if (!emitter.emit(sc, smp, &ray, &power, aimed)) return;
   tracePhoton(sc, tracer, ray, power, smp, maxDepth, store);
+}
+template <class Tracer, class Store>
+ENVGI_HD void shootPhoton(const SceneView& sc, const Tracer& tracer, const PhotonEmitter& emitter, uint32_t streamSeed,
+                          uint64_t index, uint32_t sampleIndex, int maxDepth, bool aimed, Store&& store) {
+  shootPhoton(sc, tracer, emitter, photonSampler(streamSeed, index, sampleIndex), maxDepth, aimed, store);
 }
 
 // The photon a map stores at a hit: where, from where, the normal facing it, and its power.

@@ -26,6 +26,8 @@ struct PhotonBatch {
 struct PhotonTraceRequest {
   uint64_t first = 0;
   uint32_t seed = 0;
+  uint32_t stream = kPhotonMapStream;  // photons are drawn from seed ^ stream
+  bool aimed = false;                  // aimed at the emitter's targets (the caustic stream)
   int maxDepth = kSpecularChainDepth;
   bool global = true, caustic = true;  // which maps still want photons
 };
@@ -38,7 +40,7 @@ class PhotonBatchTracer {
   // How many sub-batches one trace() call does (a GPU wants many photons in flight).
   virtual int subBatchesPerCall() const { return 1; }
   // Photons [r.first, r.first + subBatchesPerCall() * kPhotonSubBatch), emitted from the stream
-  // r.seed ^ kPhotonMapStream: out receives one PhotonBatch a sub-batch.
+  // r.seed ^ r.stream: out receives one PhotonBatch a sub-batch.
   virtual void trace(const PhotonTraceRequest& r, std::vector<PhotonBatch>* out) = 0;
 };
 
@@ -52,6 +54,9 @@ struct PhotonShootSettings {
   int maxDepth = kSpecularChainDepth;
   uint32_t seed = 0;
   bool progress = true;
+  // The caustic map from photons aimed at the shapes that can start a caustic (a stream of its
+  // own), where those are small beside the scene; false: from the global map's photons.
+  bool aimCaustics = true;
   // Precomputed irradiance (Christensen 1999) at every stride-th photon, for final-gather
   // lookups; 0 skips it (nothing reads it unless the photon integrator gathers).
   int irradianceStride = 0;
@@ -65,6 +70,7 @@ struct PhotonShootSettings {
 struct PhotonShootStats {
   uint64_t emittedGlobal = 0, emittedCaustic = 0;  // photons emitted while each map was filling
   size_t storedGlobal = 0, storedCaustic = 0;
+  int causticTargets = 0;  // the spheres the caustic photons were aimed at (0: not aimed)
   double traceSeconds = 0.0, buildSeconds = 0.0;
   size_t bytes = 0;
   std::string device;  // where the photons were traced

@@ -78,8 +78,16 @@ void SppmExecutor<Tracer>::iteration(int pass, PassCounters* counters) {
     arena_.execute([&] {
       tbb::parallel_for(size_t(0), chunks, [&](size_t ci) {
         uint64_t local = 0;
-        for (size_t j = ci * chunk; j < std::min(p_.photonsPerPass, (ci + 1) * chunk); ++j)
-          local += sppmPhotonStep(sc, tracer_, emitter_, p_, px, gv, j, pass);
+        size_t end = std::min(p_.photonsPerPass, (ci + 1) * chunk);
+        // A block's emission bins asked for first, as the photon map's pass does.
+        for (size_t j0 = ci * chunk; j0 < end; j0 += 64) {
+          for (size_t j = j0; j < std::min(end, j0 + 64); ++j) {
+            Sampler smp = sppmPhotonSampler(p_, j, pass);
+            emitter_.prefetch(sc, smp);
+          }
+          for (size_t j = j0; j < std::min(end, j0 + 64); ++j)
+            local += sppmPhotonStep(sc, tracer_, emitter_, p_, px, gv, j, pass);
+        }
         hits += local;
       });
     });

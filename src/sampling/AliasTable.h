@@ -22,6 +22,19 @@ struct AliasTableView {
 
   ENVGI_HD float pmf(int i) const { return bins[i].pmf; }
 
+  // The column sample() reads first (its bin, the one miss a draw from a large table is sure to
+  // take), and the rest of u's 48 bits within it.
+  ENVGI_HD int column(Vec2f u, uint64_t* rem = nullptr) const {
+    const uint64_t k24 = uint64_t(1) << 24, mask24 = k24 - 1;
+    uint64_t hi = uint64_t(u.x * float(k24)) & mask24, lo = uint64_t(u.y * float(k24)) & mask24;
+    // (hi 2^24 + lo) n / 2^48 without 128-bit arithmetic: both products fit in 55 bits.
+    uint64_t a = hi * uint64_t(n), b = lo * uint64_t(n);
+    uint64_t a2 = a + (b >> 24);
+    uint64_t i64 = a2 >> 24;
+    if (rem) *rem = ((a2 & mask24) << 24) | (b & mask24);
+    return i64 < uint64_t(n) ? int(i64) : n - 1;
+  }
+
   // Picks a bin from both coordinates of u, read as one 48-bit number (samplers give 24-bit
   // floats): its top part times n chooses the column, so every column is chosen with its exact
   // probability to 2^-48 however many there are (u.x alone would pick 2^24 columns at most, some
@@ -29,15 +42,9 @@ struct AliasTableView {
   // is then stretched back to a uniform number, *rest, with the bits the choice left over
   // (48 - log2 n, less a few for the coin).
   ENVGI_HD int sample(Vec2f u, float* pmfOut, float* rest) const {
-    const uint64_t k24 = uint64_t(1) << 24, mask24 = k24 - 1;
-    uint64_t hi = uint64_t(u.x * float(k24)) & mask24, lo = uint64_t(u.y * float(k24)) & mask24;
-    // (hi 2^24 + lo) n / 2^48 without 128-bit arithmetic: both products fit in 55 bits.
-    uint64_t a = hi * uint64_t(n), b = lo * uint64_t(n);
-    uint64_t a2 = a + (b >> 24);
-    uint64_t i64 = a2 >> 24;
-    int i = i64 < uint64_t(n) ? int(i64) : n - 1;
-    uint64_t rem = ((a2 & mask24) << 24) | (b & mask24);  // uniform in [0, 2^48) within the column
-    const double k48 = 281474976710656.0;                  // 2^48
+    uint64_t rem;  // uniform in [0, 2^48) within the column
+    int i = column(u, &rem);
+    const double k48 = 281474976710656.0;  // 2^48
     const AliasBin bin = bins[i];
     double t = double(bin.prob) * k48, r = double(rem);
     int chosen;

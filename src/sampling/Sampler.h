@@ -103,7 +103,7 @@ inline constexpr uint32_t kSobolShuffle1D = 0x5bd1e995u, kSobolShuffle2D = 0x68e
 inline constexpr uint32_t kOwenSeedX = 0x1234567u, kOwenSeedY = 0x89abcdeu;
 // Photon emission draws from its own streams of the scene's seed, never the camera's.
 inline constexpr uint32_t kPhotonMapStream = 0x9e3779b9u, kSppmPhotonStream = 0x85ebca6bu;
-inline constexpr uint32_t kGridGatherStream = 0xc2b2ae35u;
+inline constexpr uint32_t kGridGatherStream = 0xc2b2ae35u, kCausticPhotonStream = 0x27d4eb2fu;
 
 struct Sampler {
   SamplerType type = SamplerType::Independent;

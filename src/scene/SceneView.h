@@ -329,15 +329,15 @@ struct SceneView {
   // What interaction() reads for a triangle hit, asked for ahead (CPU only: a batch of hits
   // prefetches its triangles' indices, then their vertices, so that the misses overlap).
   void prefetchTriangle(const Hit& h) const {
-    if (h.geomId < meshCount) __builtin_prefetch(meshes[h.geomId].indices + 3 * size_t(h.primId));
+    if (h.geomId < meshCount) prefetchLine(meshes[h.geomId].indices + 3 * size_t(h.primId));
   }
   void prefetchVertices(const Hit& h) const {
     if (h.geomId >= meshCount) return;
     const MeshView& m = meshes[h.geomId];
     const uint32_t* ix = m.indices + 3 * size_t(h.primId);
     for (int c = 0; c < 3; ++c) {
-      __builtin_prefetch(m.positions + ix[c]);
-      if (m.normals) __builtin_prefetch(m.normals + ix[c]);
+      prefetchLine(m.positions + ix[c]);
+      if (m.normals) prefetchLine(m.normals + ix[c]);
     }
   }
 

@@ -513,6 +513,63 @@ TEST(PhotonEmission, ConstantSkyDeliversPiLAToAPlane) {
   EXPECT_NEAR(arrived, expected, 0.02 * expected);
 }
 
+// Caustic photons aimed at two glass balls whose disks overlap from many directions: through
+// each ball pass, from a constant sky of radiance L, the lines of every unaimed photon, with
+// flux L 4 pi pi r^2; from a sun of irradiance E, E pi r^2. Each aimed photon leaves beyond the
+// scene's bounding sphere, so nothing on its line is skipped.
+TEST(PhotonEmission, AimedPhotonsCarryTheFluxThroughEachBall) {
+  Bsdf floor, glass;
+  glass.type = BsdfType::Dielectric;
+  glass.ior = 1.5f;
+  Image sky(32, 16);
+  for (float& v : sky.rgb) v = 2.f;
+  auto s = test::sphereOnFloor(floor, glass, 8.f, std::move(sky), Vec3f(0, 2, 5), Vec3f(0, 0, 0), 8, 40.f);
+  s->spheres.push_back({Vec3f(1.5f, 1.3f, 0.4f), 0.7f, false});
+  s->shapes.push_back({true, 1, 1, false, Color(0.f)});
+  s->finalize();
+  const Sphere balls[2] = {s->spheres[0], s->spheres[1]};
+  for (bool sun : {false, true}) {
+    if (sun) {
+      s->env.reset();
+      DeltaLight l;
+      l.v = normalize(Vec3f(0.6f, -1.f, 0.1f));  // along the line of centres, partly: overlaps
+      l.value = Color(3.f);
+      s->deltaLights = {l};
+      s->finalize();
+    }
+    PhotonEmitter em = makePhotonEmitter(*s);
+    ASSERT_EQ(em.targetCount, 2);
+    const SceneView& sc = s->view();
+    const int n = 400000;
+    double flux[2] = {0.0, 0.0}, both = 0.0;
+    int upstream = 0, emitted = 0;
+    Sampler smp;
+    for (int i = 0; i < n; ++i) {
+      smp.start(uint64_t(i), 0);
+      Ray r;
+      Color pw;
+      if (!em.emit(sc, smp, &r, &pw, true)) continue;
+      ++emitted;
+      upstream += dot(r.o - em.center, -r.d) >= em.radius;
+      bool through[2];
+      for (int k = 0; k < 2; ++k) {
+        Vec3f v = balls[k].center - r.o;
+        through[k] = lengthSq(v - r.d * dot(v, r.d)) < balls[k].radius * balls[k].radius;
+        if (through[k]) flux[k] += pw.y / n;
+      }
+      if (through[0] && through[1]) both += pw.y / n;
+    }
+    EXPECT_EQ(upstream, emitted);
+    EXPECT_GT(both, 0.02 * flux[1]) << "the balls' disks should overlap from some directions";
+    for (int k = 0; k < 2; ++k) {
+      double r2 = double(balls[k].radius) * balls[k].radius;
+      double expected = sun ? 3.0 * kPi * r2 : 2.0 * 4.0 * kPi * kPi * r2;
+      std::printf("%s: ball %d receives %.4f (expected %.4f)\n", sun ? "sun" : "sky", k, flux[k], expected);
+      EXPECT_NEAR(flux[k], expected, 0.01 * expected) << (sun ? "sun" : "sky") << ", ball " << k;
+    }
+  }
+}
+
 // An area light whose radiance is a checkerboard texture (9 and 1) sends each square's photons
 // with that square's flux, pi L A: 9 : 1 between the squares, where the texture's mean on every
 // photon would give 1 : 1 and the same total.

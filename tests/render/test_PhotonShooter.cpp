@@ -6,6 +6,7 @@
 #include "accel/Bvh.h"
 #include "render/PhotonShooter.h"
 #include "scene/SceneLoader.h"
+#include "support/CausticScene.h"
 #include "support/TestScenes.h"
 
 using namespace envgi;
@@ -125,4 +126,78 @@ TEST(PhotonShooter, AMapNothingCanReachStopsAfterAMillionPhotons) {
   shoot(*lit, litAccel, nullptr, &full);
   EXPECT_GT(full.stats.storedGlobal, 0u);
   EXPECT_GT(full.stats.emittedGlobal, 2 * million);
+}
+
+// The caustic map from photons aimed at the glass ball holds what the unaimed map holds: the
+// flux stored in each ring about the caustic's centre agrees within 4 sigma (each photon's
+// power counted as independent), while the aimed stream stores over 20 times as many caustic
+// photons an emitted photon (the unaimed one stops at the pass's cap, 64 times the count).
+TEST(PhotonShooter, AimedCausticMapHoldsTheUnaimedFlux) {
+  test::CausticSetup cs = test::causticScene(8);
+  Scene& s = *cs.scene;
+  EmbreeAccel accel(s);
+  const float rings[] = {0.f, 0.25f, 0.6f, 1.2f, 2.5f, 1e9f};
+  struct Binned {
+    double sum[5] = {}, sumSq[5] = {};
+    PhotonShootStats stats;
+  };
+  auto shootBinned = [&](bool aim) {
+    PhotonShootSettings ps;
+    ps.globalPhotons = 0;
+    ps.causticPhotons = 40000;
+    ps.seed = 3;
+    ps.progress = false;
+    ps.aimCaustics = aim;
+    PhotonMap g, c;
+    Binned b;
+    shootPhotons(s, accel, ps, &g, &c, &b.stats);
+    for (const Photon& ph : c.photons()) {
+      float d = length(ph.p - cs.causticCentre);
+      for (int k = 0; k < 5; ++k)
+        if (d >= rings[k] && d < rings[k + 1]) {
+          b.sum[k] += luminance(ph.power);
+          b.sumSq[k] += sqr(double(luminance(ph.power)));
+        }
+    }
+    return b;
+  };
+  Binned aimed = shootBinned(true), unaimed = shootBinned(false);
+  EXPECT_EQ(aimed.stats.causticTargets, 1);
+  EXPECT_EQ(unaimed.stats.causticTargets, 0);
+  EXPECT_GE(aimed.stats.storedCaustic, 40000u);
+  auto yield = [](const Binned& b) { return double(b.stats.storedCaustic) / double(b.stats.emittedCaustic); };
+  std::printf("caustic photons stored an emitted photon: aimed %.4f, unaimed %.5f\n", yield(aimed), yield(unaimed));
+  EXPECT_GT(yield(aimed), 20.0 * yield(unaimed));
+  for (int k = 0; k < 5; ++k) {
+    double sigma = std::sqrt(aimed.sumSq[k] + unaimed.sumSq[k]);
+    std::printf("ring %d: aimed %.4f, unaimed %.4f (sigma %.4f)\n", k, aimed.sum[k], unaimed.sum[k], sigma);
+    EXPECT_GT(aimed.sum[k], 0.0) << "ring " << k;
+    EXPECT_NEAR(aimed.sum[k], unaimed.sum[k], 4.0 * sigma) << "ring " << k;
+  }
+}
+
+// Caustic photons are aimed only where it pays: at the teapot scene's two glass balls (lit by a
+// map), not in the Cornell box (lit by an area light, whose photons are never aimed), nor at a
+// mirror floor as wide as the scene.
+TEST(PhotonShooter, AimsOnlyWhereTheMapOrASunLightsSmallTargets) {
+  Scene teapot, cornell;
+  loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/teapot-glass.xml", {}, teapot);
+  loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml", {}, cornell);
+  teapot.finalize();
+  cornell.finalize();
+  PhotonEmitter e = makePhotonEmitter(teapot);
+  ASSERT_EQ(e.targetCount, 2);
+  EXPECT_FLOAT_EQ(e.targets[1].cdf, 1.f);
+  EXPECT_NEAR(e.targets[0].radius, 1.2f, 0.01f);  // the larger ball, first in the file
+  EXPECT_EQ(makePhotonEmitter(cornell).targetCount, 0);
+  Bsdf ball, mirror;
+  mirror.type = BsdfType::Conductor;
+  mirror.perfectMirror = true;
+  Image sky(8, 4);
+  for (float& v : sky.rgb) v = 1.f;
+  auto wide = test::sphereOnFloor(mirror, ball, 8.f, sky, Vec3f(0, 2, 5), Vec3f(0, 0, 0), 8, 40.f);
+  EXPECT_EQ(makePhotonEmitter(*wide).targetCount, 0);
+  // The same mirror as a ball on a wide diffuse floor is aimed at.
+  auto small = test::sphereOnFloor(ball, mirror, 8.f, std::move(sky), Vec3f(0, 2, 5), Vec3f(0, 0, 0), 8, 40.f);
+  EXPECT_EQ(makePhotonEmitter(*small).targetCount, 1);
 }
