@@ -25,8 +25,9 @@ constexpr int kMaxPhotonTargets = 16;
 struct PhotonTarget {
   Vec3f center;
   float radius = 0.f;
+  float pick = 1.f;     // chance of aiming at this target
   float cdf = 1.f;      // chance of aiming at this target or an earlier one
-  float density = 0.f;  // chance of aiming at it over its disk's area, pick / (pi r^2)
+  float density = 0.f;  // pick over its disk's area, pick / (pi r^2)
 };
 
 struct PhotonEmitter {
@@ -57,6 +58,25 @@ struct PhotonEmitter {
     }
     return sum;
   }
+  // A point light at p aimed at target k: directions uniform over the cone its sphere subtends
+  // (the whole sphere of directions from inside it). 1 - cos of the cone's half-angle, in a form
+  // that keeps its digits for small, far spheres.
+  ENVGI_HD float aimedConeOneMinusCos(Vec3f p, int k) const {
+    float x = targets[k].radius * targets[k].radius / lengthSq(targets[k].center - p);
+    return x >= 1.f ? 2.f : x / (1.f + std::sqrt(1.f - x));
+  }
+  // The density in solid angle of aimed directions w from p: the sum over every target whose
+  // sphere the ray meets (the chosen one counts whatever rounding says).
+  ENVGI_HD float aimedConeDensity(Vec3f p, Vec3f w, int chosen) const {
+    float sum = 0.f;
+    for (int j = 0; j < targetCount; ++j) {
+      Vec3f v = targets[j].center - p;
+      float along = dot(v, w), r2 = targets[j].radius * targets[j].radius;
+      bool meets = lengthSq(v) <= r2 || (along > 0.f && lengthSq(v - w * along) <= r2);
+      if (j == chosen || meets) sum += targets[j].pick / (2.f * kPi * aimedConeOneMinusCos(p, j));
+    }
+    return sum;
+  }
   ENVGI_HD int pickTarget(float u) const {
     int k = 0;
     while (k + 1 < targetCount && !(u < targets[k].cdf)) ++k;
@@ -75,9 +95,10 @@ struct PhotonEmitter {
     if (uSel < envProb && sc.hasEnvironment) sc.env.prefetchEmission(u1);
   }
 
-  // Origin, direction and flux (times the photon count) of one emitted photon. Aimed, the map's
-  // and the suns' photons leave only along lines through the targets, with the flux their
-  // density gives (lines that miss every target carry no caustic); other lights' are as unaimed.
+  // Origin, direction and flux (times the photon count) of one emitted photon. Aimed, the map's,
+  // the suns', the point lights' and the spots' photons leave only along rays that meet a
+  // target, with the flux their density gives (rays that miss every target carry no caustic);
+  // the area lights' are as unaimed.
   ENVGI_HD bool emit(const SceneView& sc, Sampler& smp, Ray* ray, Color* power, bool aimed = false) const {
     float uSel = smp.get1D();
     Vec2f u1 = smp.get2D(), u2 = smp.get2D();
@@ -110,7 +131,17 @@ struct PhotonEmitter {
       const DeltaLight& l = sc.deltaLights[uniformLightIndex((uSel - envProb - areaProb) / deltaProb, m)];
       float pick = deltaProb / float(m);
       ray->tMax = INFINITY;
-      if (isSpot(l)) {
+      if (l.point && aimed) {
+        // Uniform within the cone towards the target's sphere; a spot's falloff weighs it (and
+        // ends it outside the spot's own cone).
+        Vec3f toTarget = targets[target].center - l.v;
+        float oneMinusCos = aimedConeOneMinusCos(l.v, target);
+        Frame f = Frame::fromNormal(lengthSq(toTarget) > 0.f ? normalize(toTarget) : Vec3f(0.f, 1.f, 0.f));
+        ray->o = l.v;
+        ray->d = normalize(f.toWorld(sampleUniformCone(u1, 1.f - oneMinusCos)));
+        float falloff = isSpot(l) ? spotFalloff(l, ray->d) : 1.f;
+        *power = l.value * (falloff / (pick * aimedConeDensity(l.v, ray->d, target)));
+      } else if (isSpot(l)) {
         // A spot: uniform over its cone, each photon carrying the falloff along its direction.
         ray->o = l.v;
         ray->d = Frame::fromNormal(l.axis).toWorld(sampleUniformCone(u1, l.cosCutoff));

@@ -110,25 +110,23 @@ PhotonEmitter makePhotonEmitter(const Scene& scene) {
   // A delta light's power: a sun's irradiance over the bounding sphere's cross-section, a point
   // light's intensity over the whole sphere of directions, a spot's over its cone (the falloff
   // taken as full: a bound, which only shifts how photons are shared among the lights).
-  double deltaPower = 0.0, sunPower = 0.0;
+  double deltaPower = 0.0;
   for (int i = 0; i < sc.deltaLightCount; ++i) {
     const DeltaLight& l = sc.deltaLights[i];
     double solidAngle = isSpot(l) ? 2.0 * kPi * (1.0 - l.cosCutoff) : 4.0 * kPi;
-    double p = luminance(l.value) * (l.point ? solidAngle : double(kPi) * e.radius * e.radius);
-    deltaPower += p;
-    if (!l.point) sunPower += p;
+    deltaPower += luminance(l.value) * (l.point ? solidAngle : double(kPi) * e.radius * e.radius);
   }
   double total = envPower + areaPower + deltaPower;
   e.envProb = total > 0.0 ? float(envPower / total) : 0.f;
   e.deltaProb = total > 0.0 ? float(deltaPower / total) : 0.f;
   // Aiming pays where the targets' disks are small beside the scene's (each aimed photon is
   // R^2 / sum r^2 times as likely to meet glass or a mirror first) and where most of the power
-  // comes from the map and the suns, whose photons can be aimed (an area light's, a point's or a
-  // spot's are not: there a caustic stream of their own would only cost photons).
+  // comes from the map and the delta lights, whose photons can be aimed (an area light's are
+  // not: there a caustic stream of their own would only cost photons).
   std::vector<BoundingSphere> targets = causticTargets(scene);
   double area = 0.0;
   for (const BoundingSphere& b : targets) area += double(b.radius) * b.radius;
-  bool aimable = total > 0.0 && envPower + sunPower >= 0.5 * total;
+  bool aimable = total > 0.0 && envPower + deltaPower >= 0.5 * total;
   if (aimable && !targets.empty() && area > 0.0 && area <= 0.5 * double(e.radius) * e.radius) {
     double cdf = 0.0;
     for (const BoundingSphere& b : targets) {
@@ -137,6 +135,7 @@ PhotonEmitter makePhotonEmitter(const Scene& scene) {
       cdf += pick;
       t.center = b.center;
       t.radius = b.radius;
+      t.pick = float(pick);
       t.cdf = float(cdf);
       t.density = float(pick / (kPi * double(b.radius) * b.radius));
     }

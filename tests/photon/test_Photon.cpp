@@ -514,8 +514,9 @@ TEST(PhotonEmission, ConstantSkyDeliversPiLAToAPlane) {
 }
 
 // Caustic photons aimed at two glass balls whose disks overlap from many directions: through
-// each ball pass, from a constant sky of radiance L, the lines of every unaimed photon, with
-// flux L 4 pi pi r^2; from a sun of irradiance E, E pi r^2. Each aimed photon leaves beyond the
+// each ball pass, from a constant sky of radiance L, the rays of every unaimed photon, with
+// flux L 4 pi pi r^2; from a sun of irradiance E, E pi r^2; from a point light of intensity I,
+// I times the solid angle the ball subtends. Each aimed map or sun photon leaves beyond the
 // scene's bounding sphere, so nothing on its line is skipped.
 TEST(PhotonEmission, AimedPhotonsCarryTheFluxThroughEachBall) {
   Bsdf floor, glass;
@@ -528,17 +529,25 @@ TEST(PhotonEmission, AimedPhotonsCarryTheFluxThroughEachBall) {
   s->shapes.push_back({true, 1, 1, false, Color(0.f)});
   s->finalize();
   const Sphere balls[2] = {s->spheres[0], s->spheres[1]};
-  for (bool sun : {false, true}) {
-    if (sun) {
+  const Vec3f bulb(-1.2f, 3.5f, 0.6f);
+  for (const char* light : {"sky", "sun", "point"}) {
+    const std::string kind = light;
+    if (kind != "sky") {
       s->env.reset();
       DeltaLight l;
-      l.v = normalize(Vec3f(0.6f, -1.f, 0.1f));  // along the line of centres, partly: overlaps
-      l.value = Color(3.f);
+      if (kind == "sun") {
+        l.v = normalize(Vec3f(0.6f, -1.f, 0.1f));  // along the line of centres, partly: overlaps
+        l.value = Color(3.f);
+      } else {
+        l.v = bulb;  // up and to the side: the balls' cones overlap
+        l.value = Color(4.f);
+        l.point = true;
+      }
       s->deltaLights = {l};
       s->finalize();
     }
     PhotonEmitter em = makePhotonEmitter(*s);
-    ASSERT_EQ(em.targetCount, 2);
+    ASSERT_EQ(em.targetCount, 2) << kind;
     const SceneView& sc = s->view();
     const int n = 400000;
     double flux[2] = {0.0, 0.0}, both = 0.0;
@@ -554,18 +563,21 @@ TEST(PhotonEmission, AimedPhotonsCarryTheFluxThroughEachBall) {
       bool through[2];
       for (int k = 0; k < 2; ++k) {
         Vec3f v = balls[k].center - r.o;
-        through[k] = lengthSq(v - r.d * dot(v, r.d)) < balls[k].radius * balls[k].radius;
+        through[k] = dot(v, r.d) > 0.f && lengthSq(v - r.d * dot(v, r.d)) < balls[k].radius * balls[k].radius;
         if (through[k]) flux[k] += pw.y / n;
       }
       if (through[0] && through[1]) both += pw.y / n;
     }
-    EXPECT_EQ(upstream, emitted);
-    EXPECT_GT(both, 0.02 * flux[1]) << "the balls' disks should overlap from some directions";
+    if (kind != "point") EXPECT_EQ(upstream, emitted) << kind;
+    EXPECT_GT(both, 0.02 * flux[1]) << kind << ": the balls should overlap from some directions";
     for (int k = 0; k < 2; ++k) {
       double r2 = double(balls[k].radius) * balls[k].radius;
-      double expected = sun ? 3.0 * kPi * r2 : 2.0 * 4.0 * kPi * kPi * r2;
-      std::printf("%s: ball %d receives %.4f (expected %.4f)\n", sun ? "sun" : "sky", k, flux[k], expected);
-      EXPECT_NEAR(flux[k], expected, 0.01 * expected) << (sun ? "sun" : "sky") << ", ball " << k;
+      double d2 = double(lengthSq(balls[k].center - bulb));
+      double expected = kind == "sky"   ? 2.0 * 4.0 * kPi * kPi * r2
+                        : kind == "sun" ? 3.0 * kPi * r2
+                                        : 4.0 * 2.0 * kPi * (1.0 - std::sqrt(1.0 - r2 / d2));
+      std::printf("%s: ball %d receives %.4f (expected %.4f)\n", light, k, flux[k], expected);
+      EXPECT_NEAR(flux[k], expected, 0.01 * expected) << kind << ", ball " << k;
     }
   }
 }

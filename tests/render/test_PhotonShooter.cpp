@@ -177,7 +177,7 @@ TEST(PhotonShooter, AimedCausticMapHoldsTheUnaimedFlux) {
 }
 
 // Caustic photons are aimed only where it pays: at the teapot scene's two glass balls (lit by a
-// map), not in the Cornell box (lit by an area light, whose photons are never aimed), nor at a
+// map) or a mirror ball under a point light, not in the Cornell box (lit by an area light, whose photons are never aimed), nor at a
 // mirror floor as wide as the scene.
 TEST(PhotonShooter, AimsOnlyWhereTheMapOrASunLightsSmallTargets) {
   Scene teapot, cornell;
@@ -199,5 +199,10 @@ TEST(PhotonShooter, AimsOnlyWhereTheMapOrASunLightsSmallTargets) {
   EXPECT_EQ(makePhotonEmitter(*wide).targetCount, 0);
   // The same mirror as a ball on a wide diffuse floor is aimed at.
   auto small = test::sphereOnFloor(ball, mirror, 8.f, std::move(sky), Vec3f(0, 2, 5), Vec3f(0, 0, 0), 8, 40.f);
+  EXPECT_EQ(makePhotonEmitter(*small).targetCount, 1);
+  // Lit by a point light alone, it is aimed at too.
+  small->env.reset();
+  small->deltaLights = {DeltaLight{Vec3f(0.f, 4.f, 0.f), Color(1.f), true}};
+  small->finalize();
   EXPECT_EQ(makePhotonEmitter(*small).targetCount, 1);
 }
