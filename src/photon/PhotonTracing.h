@@ -19,8 +19,8 @@ struct Photon {
 };
 
 // A shape that can start a caustic (a material with a delta lobe), bounded by a sphere: caustic
-// photons from the map and the suns are aimed at these (Jensen's projection maps, with spheres
-// for the map's cells), so that most of them meet glass or a mirror first.
+// photons from the map and the delta lights are aimed at these (Jensen's projection maps, with
+// spheres for the map's cells), so that most of them meet glass or a mirror first.
 constexpr int kMaxPhotonTargets = 16;
 struct PhotonTarget {
   Vec3f center;
