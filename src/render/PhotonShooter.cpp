@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <stdexcept>
 
 namespace envgi {
@@ -27,8 +28,9 @@ struct BoundingSphere {
   float radius;
 };
 
-// About the centre of the points' box, out to the farthest point.
+// About the centre of the points' box, out to the farthest point (none: radius 0).
 BoundingSphere boundPoints(const std::vector<Vec3f>& pts) {
+  if (pts.empty()) return {Vec3f(0.f), 0.f};
   Vec3f lo(INFINITY), hi(-INFINITY);
   for (Vec3f p : pts) {
     lo = vmin(lo, p);
@@ -93,8 +95,13 @@ std::vector<BoundingSphere> causticTargets(const Scene& scene) {
     }
     out = std::move(groups);
   }
-  for (BoundingSphere& b : out) b.radius = b.radius * 1.001f + 1e-6f * (length(b.center) + b.radius);
-  return out;
+  // A shape with no extent (or none that is finite) can start no caustic anyone sees.
+  std::vector<BoundingSphere> kept;
+  for (BoundingSphere b : out) {
+    b.radius = b.radius * 1.001f + 1e-6f * (length(b.center) + b.radius);
+    if (b.radius > 0.f && std::isfinite(b.radius) && std::isfinite(length(b.center))) kept.push_back(b);
+  }
+  return kept;
 }
 
 }  // namespace
