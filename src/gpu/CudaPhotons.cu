@@ -35,7 +35,7 @@ __global__ void photonMapKernel(const SceneView* sc, BvhTracer tracer, PhotonEmi
 class CudaPhotonTracer final : public PhotonBatchTracer {
  public:
   CudaPhotonTracer(const Scene& scene, const Bvh& bvh, int gpu, int maxDepth)
-      : gpu_(gpu), scene_(scene, bvh), emitter_(makePhotonEmitter(scene)), maxDepth_(std::max(1, maxDepth)) {
+      : gpu_(gpu), scene_(scene, bvh), emitter_(makePhotonEmitter(scene, true)), maxDepth_(std::max(1, maxDepth)) {
     // As many sub-batches a launch as fit ~256 MB of slots (8 at the default depth 16).
     size_t perSub = size_t(kPhotonSubBatch) * size_t(maxDepth_) * sizeof(Photon);
     subs_ = int(std::max<size_t>(1, std::min<size_t>(8, (size_t(256) << 20) / perSub)));

@@ -139,13 +139,13 @@ ENVGI_HD uint64_t sppmCameraStep(const SceneView& sc, const Tracer& tracer, cons
   return rays;
 }
 
-// Photon j of pass `pass`: traced from the lights, splatted into every visible point within
-// its radius (atomics: photons from many threads meet at one pixel). Returns the splats made.
 // Photon j of pass `pass` draws from this sampler (shootPhoton's, on SPPM's stream).
 ENVGI_INLINE Sampler sppmPhotonSampler(const SppmParams& s, uint64_t j, int pass) {
   return photonSampler(s.seed ^ kSppmPhotonStream, uint64_t(pass) * s.photonsPerPass + j, 1);
 }
 
+// Photon j of pass `pass`: traced from the lights, splatted into every visible point within
+// its radius (atomics: photons from many threads meet at one pixel). Returns the splats made.
 template <class Tracer>
 ENVGI_HD uint32_t sppmPhotonStep(const SceneView& sc, const Tracer& tracer, const PhotonEmitter& emitter,
                                  const SppmParams& s, SppmPixels px, const HashGridView& grid, uint64_t j, int pass) {

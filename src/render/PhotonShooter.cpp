@@ -106,7 +106,7 @@ std::vector<BoundingSphere> causticTargets(const Scene& scene) {
 
 }  // namespace
 
-PhotonEmitter makePhotonEmitter(const Scene& scene) {
+PhotonEmitter makePhotonEmitter(const Scene& scene, bool aim) {
   const SceneView& sc = scene.view();
   PhotonEmitter e;
   e.center = (sc.boundsMin + sc.boundsMax) * 0.5f;
@@ -126,6 +126,7 @@ PhotonEmitter makePhotonEmitter(const Scene& scene) {
   double total = envPower + areaPower + deltaPower;
   e.envProb = total > 0.0 ? float(envPower / total) : 0.f;
   e.deltaProb = total > 0.0 ? float(deltaPower / total) : 0.f;
+  if (!aim) return e;
   // Aiming pays where the targets' disks are small beside the scene's (each aimed photon is
   // R^2 / sum r^2 times as likely to meet glass or a mirror first) and where most of the power
   // comes from the map and the delta lights, whose photons can be aimed (an area light's are
@@ -157,7 +158,7 @@ template <class Tracer>
 class CpuPhotonTracer final : public PhotonBatchTracer {
  public:
   CpuPhotonTracer(const Scene& scene, Tracer tracer, std::string name)
-      : scene_(scene), tracer_(tracer), emitter_(makePhotonEmitter(scene)), name_(std::move(name)) {}
+      : scene_(scene), tracer_(tracer), emitter_(makePhotonEmitter(scene, true)), name_(std::move(name)) {}
   std::string deviceName() const override { return name_; }
   void trace(const PhotonTraceRequest& r, std::vector<PhotonBatch>* out) override {
     const int chunk = 1024, chunks = kPhotonSubBatch / chunk;
@@ -234,7 +235,7 @@ void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* g
   const SceneView& sc = scene.view();
   if (!s.tracer) throw std::logic_error("shootPhotons: no photon tracer");
   PhotonBatchTracer* tracer = s.tracer.get();
-  PhotonEmitter emitter = makePhotonEmitter(scene);
+  PhotonEmitter emitter = makePhotonEmitter(scene, s.aimCaustics);
   bool anyLight = emitter.emitsLight(sc);
   std::vector<Photon> g, c;
   bool gDone = s.globalPhotons == 0, cDone = s.causticPhotons == 0;
@@ -248,7 +249,7 @@ void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* g
   }
   // One stream fills both maps; or, with targets to aim at, the global map's stream keeps only
   // its global photons and a second, aimed stream fills the caustic map.
-  bool aim = s.aimCaustics && emitter.targetCount > 0 && !cDone;
+  bool aim = emitter.targetCount > 0 && !cDone;  // targets only where s.aimCaustics
   std::vector<PhotonBatch> batches;
   // Shoots one stream into the maps whose done flag is given (null: that map's photons are not
   // this stream's) until each is full, given up or the cap is reached.

@@ -77,7 +77,9 @@ struct PhotonShootStats {
 };
 
 // The emitter for a scene: bounding sphere, and the environment's share of the emitted power.
-PhotonEmitter makePhotonEmitter(const Scene& scene);
+// With aim, also the targets caustic photons may be aimed at (which walks the specular shapes'
+// points: only the photon-map pass reads them, not SPPM nor a scene radius).
+PhotonEmitter makePhotonEmitter(const Scene& scene, bool aim = false);
 
 // With s.tracer null the photons are traced on the CPU with accel.
 void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShootSettings& s, PhotonMap* global,

@@ -546,7 +546,7 @@ TEST(PhotonEmission, AimedPhotonsCarryTheFluxThroughEachBall) {
       s->deltaLights = {l};
       s->finalize();
     }
-    PhotonEmitter em = makePhotonEmitter(*s);
+    PhotonEmitter em = makePhotonEmitter(*s, true);
     ASSERT_EQ(em.targetCount, 2) << kind;
     const SceneView& sc = s->view();
     const int n = 400000;

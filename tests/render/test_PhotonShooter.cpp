@@ -185,24 +185,25 @@ TEST(PhotonShooter, AimsOnlyWhereTheMapOrASunLightsSmallTargets) {
   loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml", {}, cornell);
   teapot.finalize();
   cornell.finalize();
-  PhotonEmitter e = makePhotonEmitter(teapot);
+  PhotonEmitter e = makePhotonEmitter(teapot, true);
   ASSERT_EQ(e.targetCount, 2);
   EXPECT_FLOAT_EQ(e.targets[1].cdf, 1.f);
   EXPECT_NEAR(e.targets[0].radius, 1.2f, 0.01f);  // the larger ball, first in the file
-  EXPECT_EQ(makePhotonEmitter(cornell).targetCount, 0);
+  EXPECT_EQ(makePhotonEmitter(cornell, true).targetCount, 0);
+  EXPECT_EQ(makePhotonEmitter(teapot).targetCount, 0);  // not asked to aim: SPPM's, a radius
   Bsdf ball, mirror;
   mirror.type = BsdfType::Conductor;
   mirror.perfectMirror = true;
   Image sky(8, 4);
   for (float& v : sky.rgb) v = 1.f;
   auto wide = test::sphereOnFloor(mirror, ball, 8.f, sky, Vec3f(0, 2, 5), Vec3f(0, 0, 0), 8, 40.f);
-  EXPECT_EQ(makePhotonEmitter(*wide).targetCount, 0);
+  EXPECT_EQ(makePhotonEmitter(*wide, true).targetCount, 0);
   // The same mirror as a ball on a wide diffuse floor is aimed at.
   auto small = test::sphereOnFloor(ball, mirror, 8.f, std::move(sky), Vec3f(0, 2, 5), Vec3f(0, 0, 0), 8, 40.f);
-  EXPECT_EQ(makePhotonEmitter(*small).targetCount, 1);
+  EXPECT_EQ(makePhotonEmitter(*small, true).targetCount, 1);
   // Lit by a point light alone, it is aimed at too.
   small->env.reset();
   small->deltaLights = {DeltaLight{Vec3f(0.f, 4.f, 0.f), Color(1.f), true}};
   small->finalize();
-  EXPECT_EQ(makePhotonEmitter(*small).targetCount, 1);
+  EXPECT_EQ(makePhotonEmitter(*small, true).targetCount, 1);
 }
