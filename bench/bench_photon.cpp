@@ -52,6 +52,19 @@ static void BM_PhotonPass(benchmark::State& state) {
 }
 BENCHMARK(BM_PhotonPass)->Arg(100000)->Arg(1000000)->Arg(10000000)->Unit(benchmark::kMillisecond)->Iterations(1)->UseRealTime();
 
+// The benchmark's iterations, each a whole photon pass on one thread; the last pass's stats.
+static PhotonShootStats photonPassesOnOneThread(benchmark::State& state, const Scene& scene, const EmbreeAccel& accel,
+                                                const PhotonShootSettings& ps) {
+  PhotonShootStats st;
+  tbb::task_arena one(1);
+  for (auto _ : state) {
+    PhotonMap g, c;
+    one.execute([&] { shootPhotons(scene, accel, ps, &g, &c, &st); });
+    benchmark::DoNotOptimize(g.size());
+  }
+  return st;
+}
+
 // The photon pass on the bundled glass teapot, one thread: photons from Grace Cathedral's
 // 1024 x 512 map (an emission table of 6 MB), the caustic map's aimed at the two glass balls.
 // Arg: photons asked of each map. The time is the whole pass (tracing, kd-trees, irradiance).
@@ -66,19 +79,33 @@ static void BM_PhotonPassTeapot(benchmark::State& state) {
   ps.globalPhotons = ps.causticPhotons = size_t(state.range(0));
   ps.irradianceStride = 4;
   ps.progress = false;
-  PhotonShootStats st;
-  tbb::task_arena one(1);
-  for (auto _ : state) {
-    PhotonMap g, c;
-    one.execute([&] { shootPhotons(scene, *accel, ps, &g, &c, &st); });
-    benchmark::DoNotOptimize(g.size());
-  }
+  PhotonShootStats st = photonPassesOnOneThread(state, scene, *accel, ps);
   state.counters["emitted_global"] = double(st.emittedGlobal);
   state.counters["emitted_caustic"] = double(st.emittedCaustic);
   state.counters["stored_caustic"] = double(st.storedCaustic);
   state.counters["emitted/s"] = double(st.emittedGlobal + st.emittedCaustic) / st.traceSeconds;
 }
 BENCHMARK(BM_PhotonPassTeapot)->Arg(20000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The photon pass in the bundled Cornell box, one thread, 250,000 photons a map (the default),
+// lit by its ceiling's area light. Arg: 1 aims the caustic photons at the two balls, 0 shoots
+// them unaimed from the global map's stream.
+static void BM_PhotonPassCornell(benchmark::State& state) {
+  static Scene scene;
+  static std::unique_ptr<EmbreeAccel> accel;
+  if (!accel) {
+    loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml", {{"res", "160"}}, scene);
+    accel = std::make_unique<EmbreeAccel>(scene);
+  }
+  PhotonShootSettings ps;
+  ps.aimCaustics = state.range(0) != 0;
+  ps.progress = false;
+  PhotonShootStats st = photonPassesOnOneThread(state, scene, *accel, ps);
+  state.counters["emitted_caustic"] = double(st.emittedCaustic);
+  state.counters["stored_caustic"] = double(st.storedCaustic);
+  state.counters["trace_s"] = st.traceSeconds;
+}
+BENCHMARK(BM_PhotonPassCornell)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 static void BM_RadianceLookup(benchmark::State& state) {
   Fixture& f = fixture();

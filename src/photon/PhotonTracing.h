@@ -19,8 +19,8 @@ struct Photon {
 };
 
 // A shape that can start a caustic (a material with a delta lobe), bounded by a sphere: caustic
-// photons from the map and the delta lights are aimed at these (Jensen's projection maps, with
-// spheres for the map's cells), so that most of them meet glass or a mirror first.
+// photons from every light are aimed at these (Jensen's projection maps, with spheres for the
+// map's cells), so that most of them meet glass or a mirror first.
 constexpr int kMaxPhotonTargets = 16;
 struct PhotonTarget {
   Vec3f center;
@@ -77,6 +77,13 @@ struct PhotonEmitter {
     }
     return sum;
   }
+  // A direction from p uniform within the cone towards target k's sphere (a point or spot light,
+  // or a point on an area light, aimed).
+  ENVGI_HD Vec3f aimedConeDirection(Vec3f p, int k, Vec2f u) const {
+    Vec3f toTarget = targets[k].center - p;
+    Frame f = Frame::fromNormal(lengthSq(toTarget) > 0.f ? normalize(toTarget) : Vec3f(0.f, 1.f, 0.f));
+    return normalize(f.toWorld(sampleUniformCone(u, 1.f - aimedConeOneMinusCos(p, k))));
+  }
   ENVGI_HD int pickTarget(float u) const {
     int k = 0;
     while (k + 1 < targetCount && !(u < targets[k].cdf)) ++k;
@@ -95,10 +102,10 @@ struct PhotonEmitter {
     if (uSel < envProb && sc.hasEnvironment) sc.env.prefetchEmission(u1);
   }
 
-  // Origin, direction and flux (times the photon count) of one emitted photon. Aimed, the map's,
-  // the suns', the point lights' and the spots' photons leave only along rays that meet a
-  // target, with the flux their density gives (rays that miss every target carry no caustic);
-  // the area lights' are as unaimed.
+  // Origin, direction and flux (times the photon count) of one emitted photon. Aimed, every
+  // light's photons (the map's, the suns', the point lights', the spots' and the area lights')
+  // leave only along rays that meet a target, with the flux their density gives (rays that miss
+  // every target carry no caustic).
   ENVGI_HD bool emit(const SceneView& sc, Sampler& smp, Ray* ray, Color* power, bool aimed = false) const {
     float uSel = smp.get1D();
     Vec2f u1 = smp.get2D(), u2 = smp.get2D();
@@ -134,11 +141,8 @@ struct PhotonEmitter {
       if (l.point && aimed) {
         // Uniform within the cone towards the target's sphere; a spot's falloff weighs it (and
         // ends it outside the spot's own cone).
-        Vec3f toTarget = targets[target].center - l.v;
-        float oneMinusCos = aimedConeOneMinusCos(l.v, target);
-        Frame f = Frame::fromNormal(lengthSq(toTarget) > 0.f ? normalize(toTarget) : Vec3f(0.f, 1.f, 0.f));
         ray->o = l.v;
-        ray->d = normalize(f.toWorld(sampleUniformCone(u1, 1.f - oneMinusCos)));
+        ray->d = aimedConeDirection(l.v, target, u1);
         float falloff = isSpot(l) ? spotFalloff(l, ray->d) : 1.f;
         *power = l.value * (falloff / (pick * aimedConeDensity(l.v, ray->d, target)));
       } else if (isSpot(l)) {
@@ -169,6 +173,19 @@ struct PhotonEmitter {
     Color Le;
     sampleAreaLight(sc, u2, u1, &pmf, &p, &n, &Le, &areaPdf);
     Vec2f u3 = smp.get2D();
+    if (aimed) {
+      // From the light's point, uniform within the cone towards the target's sphere: Le cos /
+      // (pdf_area pdf_dir), with the cones' summed density; a direction behind the light (the
+      // target below its horizon) carries nothing.
+      Vec3f d = aimedConeDirection(p, target, u3);
+      float cosL = dot(n, d);
+      if (!(cosL > 0.f)) return false;
+      ray->o = offsetRayOrigin(p, n, d, 0.f);
+      ray->d = d;
+      ray->tMax = INFINITY;
+      *power = Le * (cosL / (pmf * areaPdf * areaProb * aimedConeDensity(p, d, target)));
+      return !isBlack(*power);
+    }
     Vec3f dir = Frame::fromNormal(n).toWorld(sampleCosineHemisphere(u3));
     ray->o = offsetRayOrigin(p, n, dir, 0.f);
     ray->d = normalize(dir);

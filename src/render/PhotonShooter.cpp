@@ -127,15 +127,13 @@ PhotonEmitter makePhotonEmitter(const Scene& scene, bool aim) {
   e.envProb = total > 0.0 ? float(envPower / total) : 0.f;
   e.deltaProb = total > 0.0 ? float(deltaPower / total) : 0.f;
   if (!aim) return e;
-  // Aiming pays where the targets' disks are small beside the scene's (each aimed photon is
-  // R^2 / sum r^2 times as likely to meet glass or a mirror first) and where most of the power
-  // comes from the map and the delta lights, whose photons can be aimed (an area light's are
-  // not: there a caustic stream of their own would only cost photons).
+  // Aiming pays where the targets' disks are small beside the scene's: each aimed photon is
+  // R^2 / sum r^2 times as likely to meet glass or a mirror first (from the map or a sun; from a
+  // point or area light inside the scene, about as much).
   std::vector<BoundingSphere> targets = causticTargets(scene);
   double area = 0.0;
   for (const BoundingSphere& b : targets) area += double(b.radius) * b.radius;
-  bool aimable = total > 0.0 && envPower + deltaPower >= 0.5 * total;
-  if (aimable && !targets.empty() && area > 0.0 && area <= 0.5 * double(e.radius) * e.radius) {
+  if (total > 0.0 && !targets.empty() && area > 0.0 && area <= 0.5 * double(e.radius) * e.radius) {
     double cdf = 0.0;
     for (const BoundingSphere& b : targets) {
       PhotonTarget& t = e.targets[e.targetCount++];

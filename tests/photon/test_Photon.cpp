@@ -516,7 +516,9 @@ TEST(PhotonEmission, ConstantSkyDeliversPiLAToAPlane) {
 // Caustic photons aimed at two glass balls whose disks overlap from many directions: through
 // each ball pass, from a constant sky of radiance L, the rays of every unaimed photon, with
 // flux L 4 pi pi r^2; from a sun of irradiance E, E pi r^2; from a point light of intensity I,
-// I times the solid angle the ball subtends. Each aimed map or sun photon leaves beyond the
+// I times the solid angle the ball subtends; from an area light of radiance L facing down, L
+// times the cone's projected solid angle summed over the light, pi r^2 / d^2 cos(axis, n) dA
+// (every cone lies in front of the light). Each aimed map or sun photon leaves beyond the
 // scene's bounding sphere, so nothing on its line is skipped.
 TEST(PhotonEmission, AimedPhotonsCarryTheFluxThroughEachBall) {
   Bsdf floor, glass;
@@ -530,9 +532,21 @@ TEST(PhotonEmission, AimedPhotonsCarryTheFluxThroughEachBall) {
   s->finalize();
   const Sphere balls[2] = {s->spheres[0], s->spheres[1]};
   const Vec3f bulb(-1.2f, 3.5f, 0.6f);
-  for (const char* light : {"sky", "sun", "point"}) {
+  // The area light: a 1 x 0.6 rectangle at y = 3.5 about (-1, 0.4), facing down.
+  const Vec3f panel(-1.f, 3.5f, 0.4f);
+  const float halfX = 0.5f, halfZ = 0.3f, panelL = 2.5f;
+  for (const char* light : {"sky", "sun", "point", "area"}) {
     const std::string kind = light;
-    if (kind != "sky") {
+    if (kind == "area") {
+      s->deltaLights.clear();
+      TriangleMesh m = makeRectangle();  // [-1, 1]^2 at z = 0 facing +z: (x, y) to (x, z) faces -y
+      for (Vec3f& p : m.positions) p = panel + Vec3f(p.x * halfX, 0.f, p.y * halfZ);
+      m.normals.clear();
+      s->meshes.push_back(m);
+      s->bsdfs.push_back(Bsdf{});
+      s->shapes.push_back({false, s->meshes.size() - 1, int(s->bsdfs.size()) - 1, true, Color(panelL)});
+      s->finalize();
+    } else if (kind != "sky") {
       s->env.reset();
       DeltaLight l;
       if (kind == "sun") {
@@ -568,7 +582,7 @@ TEST(PhotonEmission, AimedPhotonsCarryTheFluxThroughEachBall) {
       }
       if (through[0] && through[1]) both += pw.y / n;
     }
-    if (kind != "point") {
+    if (kind == "sky" || kind == "sun") {
       EXPECT_EQ(upstream, emitted) << kind;
     }
     EXPECT_GT(both, 0.02 * flux[1]) << kind << ": the balls should overlap from some directions";
@@ -578,6 +592,20 @@ TEST(PhotonEmission, AimedPhotonsCarryTheFluxThroughEachBall) {
       double expected = kind == "sky"   ? 2.0 * 4.0 * kPi * kPi * r2
                         : kind == "sun" ? 3.0 * kPi * r2
                                         : 4.0 * 2.0 * kPi * (1.0 - std::sqrt(1.0 - r2 / d2));
+      if (kind == "area") {
+        // Midpoint rule over the panel, 200 x 120 cells.
+        const int nx = 200, nz = 120;
+        const double dA = (2.0 * halfX / nx) * (2.0 * halfZ / nz);
+        expected = 0.0;
+        for (int i = 0; i < nx; ++i)
+          for (int j = 0; j < nz; ++j) {
+            Vec3f p = panel + Vec3f((2.f * (float(i) + 0.5f) / nx - 1.f) * halfX, 0.f,
+                                    (2.f * (float(j) + 0.5f) / nz - 1.f) * halfZ);
+            Vec3f v = balls[k].center - p;
+            double dist2 = double(lengthSq(v)), cosAxis = -double(v.y) / std::sqrt(dist2);
+            expected += panelL * kPi * r2 / dist2 * cosAxis * dA;
+          }
+      }
       std::printf("%s: ball %d receives %.4f (expected %.4f)\n", light, k, flux[k], expected);
       EXPECT_NEAR(flux[k], expected, 0.01 * expected) << kind << ", ball " << k;
     }
