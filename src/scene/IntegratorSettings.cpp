@@ -28,6 +28,10 @@ static int readMaxDepth(Properties& p, int def) {
   return d;
 }
 
+// The photon integrators' loops run to a depth: -1 reads as kUnboundedChainDepth (it had
+// stopped every photon and camera chain before its first bounce: a black image).
+static int chainDepth(int maxDepth) { return maxDepth < 0 ? kUnboundedChainDepth : maxDepth; }
+
 // The path-length and emitter properties that path and photon share (Mitsuba's names); the
 // pointers hold the defaults on entry.
 static void readPathProperties(Properties& p, int* maxDepth, int* rrDepth, bool* hideEmitters) {
@@ -56,6 +60,7 @@ DirectSettings DirectSettings::fromProperties(Properties& p) {
 PhotonSettings PhotonSettings::fromProperties(Properties& p) {
   PhotonSettings s;
   readPathProperties(p, &s.maxDepth, &s.rrDepth, &s.hideEmitters);
+  s.maxDepth = chainDepth(s.maxDepth);
   int g = p.getInt("global_photons", int(s.globalPhotons)), c = p.getInt("caustic_photons", int(s.causticPhotons));
   if (g < 0 || c < 0) p.fail("photon counts must not be negative");
   s.globalPhotons = size_t(g);
@@ -72,7 +77,7 @@ PhotonSettings PhotonSettings::fromProperties(Properties& p) {
 
 SppmSettings SppmSettings::fromProperties(Properties& p) {
   SppmSettings s;
-  s.maxDepth = readMaxDepth(p, s.maxDepth);
+  s.maxDepth = chainDepth(readMaxDepth(p, s.maxDepth));
   s.passes = p.getInt("passes", s.passes);
   int pc = p.getInt("photon_count", int(s.photonCount));
   s.initialRadius = p.getFloat("initial_radius", s.initialRadius);
@@ -87,6 +92,7 @@ SppmSettings SppmSettings::fromProperties(Properties& p) {
 GridSettings GridSettings::fromProperties(Properties& p) {
   GridSettings s;
   readPathProperties(p, &s.maxDepth, &s.rrDepth, &s.hideEmitters);
+  s.maxDepth = chainDepth(s.maxDepth);
   s.resolution = p.getInt("resolution", s.resolution);
   s.gatherRays = p.getInt("gather_rays", s.gatherRays);
   s.refineRays = p.getInt("refine_rays", s.refineRays);

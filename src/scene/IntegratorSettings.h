@@ -16,6 +16,10 @@ enum class IntegratorType : int { Path = 0, Direct = 1, Photon = 2, Sppm = 3, Gr
 // Chains of mirror and glass bounces (from the camera in photon and sppm, and from a light)
 // end here.
 inline constexpr int kSpecularChainDepth = 16;
+// max_depth -1 (Mitsuba's "unbounded") in the photon integrators: Russian roulette ends almost
+// every path long before, but a chain between perfect mirrors would not end, and the GPU's
+// photon tracer holds a slot a bounce.
+inline constexpr int kUnboundedChainDepth = 64;
 // Russian roulette starts at this path depth (Mitsuba's rr_depth).
 inline constexpr int kRouletteDepth = 5;
 // The most photons one kd-tree lookup gathers (its buffers live on the stack).

@@ -306,6 +306,36 @@ TEST(CliRender, PhotonSppmAndGridIntegrators) {
   EXPECT_NE(bad.output.find("alpha must be in (0, 1)"), std::string::npos) << bad.output;
 }
 
+// max_depth -1 in a photon integrator's own element (Mitsuba's "unbounded") lights the Cornell
+// box as the default depth does; it had ended every photon and camera chain at once (black).
+TEST(CliRender, PhotonIntegratorsReadMaxDepthMinusOneAsUnbounded) {
+  TempDir d;
+  std::ifstream in(std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml");
+  std::stringstream xml;
+  xml << in.rdbuf();
+  const std::string text = xml.str();
+  size_t from = text.find("<integrator"), to = text.find("</integrator>");
+  ASSERT_TRUE(from != std::string::npos && to != std::string::npos);
+  double mean[2] = {0.0, 0.0};
+  for (int k = 0; k < 2; ++k) {
+    std::string t = text;
+    t.replace(from, to + 13 - from,
+              std::string(R"(<integrator type="photon"><integer name="global_photons" value="20000"/>)") +
+                  R"(<integer name="caustic_photons" value="5000"/><integer name="gather_samples" value="2"/>)" +
+                  (k == 0 ? R"(<integer name="max_depth" value="-1"/>)" : "") + "</integrator>");
+    std::string scene = d.file("cornell-" + std::to_string(k) + ".xml");
+    std::ofstream(scene) << t;
+    CliResult r = runCli("render " + scene + " -o " + d.file("c.pfm") + " --spp 2 -D res=24 --no-progress --seed 3");
+    ASSERT_EQ(r.code, 0) << r.output;
+    envgi::Image img = envgi::loadImage(d.file("c.pfm"));
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) mean[k] += img.at(x, y).y / double(img.width * img.height);
+  }
+  std::printf("image mean: max_depth -1 %.4f, default %.4f\n", mean[0], mean[1]);
+  EXPECT_NEAR(mean[0], mean[1], 0.05 * mean[1]);
+  EXPECT_GT(mean[1], 0.1);
+}
+
 // A textured diffuse square filling the view under a constant sky of radiance 1 reflects its
 // albedo, so each quarter of the image shows its texel. The rectangle's
 // v runs up the square and texture rows down the image (as in Mitsuba): texel row 0 is the

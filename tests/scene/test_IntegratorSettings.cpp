@@ -100,6 +100,18 @@ TEST(IntegratorSettings, ReadsEachIntegratorsOwnProperties) {
   EXPECT_EQ(s.direct.bsdfSamples, 0);
 }
 
+// max_depth -1 is Mitsuba's "unbounded": path keeps it; the photon integrators, whose loops run
+// to a depth, read it as kUnboundedChainDepth (it had ended every chain at once).
+TEST(IntegratorSettings, MaxDepthMinusOneIsUnboundedForEveryIntegrator) {
+  Properties p("s.xml:1");
+  p.set("max_depth", "integer", "-1");
+  EXPECT_EQ(IntegratorSettings::fromProperties(IntegratorType::Path, p).path.maxDepth, -1);
+  EXPECT_EQ(IntegratorSettings::fromProperties(IntegratorType::Photon, p).photon.maxDepth, kUnboundedChainDepth);
+  EXPECT_EQ(IntegratorSettings::fromProperties(IntegratorType::Sppm, p).sppm.maxDepth, kUnboundedChainDepth);
+  EXPECT_EQ(IntegratorSettings::fromProperties(IntegratorType::Grid, p).grid.maxDepth, kUnboundedChainDepth);
+  EXPECT_GT(kUnboundedChainDepth, kSpecularChainDepth);
+}
+
 TEST(IntegratorSettings, RefusesBadValuesAtThePluginsLine) {
   auto with = [](const char* name, const char* tag, const char* value) {
     Properties p("s.xml:2");
