@@ -258,6 +258,20 @@ ENVGI_INLINE Sampler photonSampler(uint32_t streamSeed, uint64_t index, uint32_t
   return smp;
 }
 
+// Photons [begin, end) on the CPU, a block of 64 at a time: every photon of a block has its
+// emission bin asked for (prefetch(j), PhotonEmitter::prefetch) before the first is shot
+// (shoot(j)). A large map's table misses the cache on almost every photon, and these misses
+// overlap where the photons' own would not (BM_PhotonPassTeapot 0.82x the time).
+template <class Prefetch, class Shoot>
+inline void shootInPrefetchedBlocks(uint64_t begin, uint64_t end, Prefetch&& prefetch, Shoot&& shoot) {
+  constexpr uint64_t kBlock = 64;
+  for (uint64_t j0 = begin; j0 < end; j0 += kBlock) {
+    const uint64_t j1 = end - j0 < kBlock ? end : j0 + kBlock;
+    for (uint64_t j = j0; j < j1; ++j) prefetch(j);
+    for (uint64_t j = j0; j < j1; ++j) shoot(j);
+  }
+}
+
 template <class Tracer, class Store>
 ENVGI_HD void shootPhoton(const SceneView& sc, const Tracer& tracer, const PhotonEmitter& emitter, Sampler smp,
                           int maxDepth, bool aimed, Store&& store) {

@@ -166,22 +166,19 @@ class CpuPhotonTracer final : public PhotonBatchTracer {
       PhotonBatch& b = local[size_t(ci)];
       const uint32_t stream = r.seed ^ r.stream;
       const uint64_t first = r.first + uint64_t(ci) * chunk;
-      // A block's emission bins asked for before its photons are shot: a large map's table
-      // misses the cache on almost every photon, and these misses overlap where the photons'
-      // own would not (BM_PhotonPassTeapot 0.82x the time).
-      const int block = 64;
-      for (int j0 = 0; j0 < chunk; j0 += block) {
-        for (int j = j0; j < j0 + block; ++j) {
-          Sampler smp = photonSampler(stream, first + j, 0);
-          emitter_.prefetch(sc, smp);
-        }
-        for (int j = j0; j < j0 + block; ++j)
-          shootPhoton(sc, tracer_, emitter_, stream, first + j, 0, r.maxDepth, r.aimed,
-                      [&](const SurfaceInteraction& si, Vec3f wi, Color pw, bool isCaustic, int) {
-                        if (isCaustic ? r.caustic : r.global)
-                          (isCaustic ? b.caustic : b.global).push_back(makePhoton(si, wi, pw));
-                      });
-      }
+      shootInPrefetchedBlocks(
+          first, first + chunk,
+          [&](uint64_t j) {
+            Sampler smp = photonSampler(stream, j, 0);
+            emitter_.prefetch(sc, smp);
+          },
+          [&](uint64_t j) {
+            shootPhoton(sc, tracer_, emitter_, stream, j, 0, r.maxDepth, r.aimed,
+                        [&](const SurfaceInteraction& si, Vec3f wi, Color pw, bool isCaustic, int) {
+                          if (isCaustic ? r.caustic : r.global)
+                            (isCaustic ? b.caustic : b.global).push_back(makePhoton(si, wi, pw));
+                        });
+          });
     });
     // Chunks are appended in order, so the maps do not depend on the thread count.
     PhotonBatch all;

@@ -79,15 +79,13 @@ void SppmExecutor<Tracer>::iteration(int pass, PassCounters* counters) {
       tbb::parallel_for(size_t(0), chunks, [&](size_t ci) {
         uint64_t local = 0;
         size_t end = std::min(p_.photonsPerPass, (ci + 1) * chunk);
-        // A block's emission bins asked for first, as the photon map's pass does.
-        for (size_t j0 = ci * chunk; j0 < end; j0 += 64) {
-          for (size_t j = j0; j < std::min(end, j0 + 64); ++j) {
-            Sampler smp = sppmPhotonSampler(p_, j, pass);
-            emitter_.prefetch(sc, smp);
-          }
-          for (size_t j = j0; j < std::min(end, j0 + 64); ++j)
-            local += sppmPhotonStep(sc, tracer_, emitter_, p_, px, gv, j, pass);
-        }
+        shootInPrefetchedBlocks(
+            ci * chunk, end,
+            [&](uint64_t j) {
+              Sampler smp = sppmPhotonSampler(p_, j, pass);
+              emitter_.prefetch(sc, smp);
+            },
+            [&](uint64_t j) { local += sppmPhotonStep(sc, tracer_, emitter_, p_, px, gv, j, pass); });
         hits += local;
       });
     });
