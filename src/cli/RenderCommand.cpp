@@ -9,6 +9,8 @@
 #include <memory>
 #include <stdexcept>
 
+#include <unistd.h>
+
 #include "accel/Bvh.h"
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
@@ -24,7 +26,18 @@ namespace envgi::cli {
 namespace {
 
 std::atomic<bool> g_cancel{false};
-extern "C" void onInterrupt(int) { g_cancel.store(true); }
+// The first SIGINT or SIGTERM asks the render to stop after the pass in flight (and write what
+// is finished); a second one ends the process at once, as the signal's default would.
+extern "C" void onInterrupt(int sig) {
+  if (g_cancel.exchange(true)) {
+    std::signal(sig, SIG_DFL);
+    std::raise(sig);
+    return;
+  }
+  static const char msg[] = "\nenvgi: stopping after the pass in flight (again to stop now)\n";
+  ssize_t ignored = write(2, msg, sizeof(msg) - 1);  // async-signal-safe, unlike the logger
+  (void)ignored;
+}
 
 struct RenderArgs {
   std::string scene, output;

@@ -44,7 +44,7 @@ void IlluminationGrid::finish() {
 }
 
 size_t IlluminationGrid::bytes() const {
-  return sum_.size() * (2 * sizeof(ShL1) + 2 * sizeof(int) + sizeof(float));
+  return sum_.size() * kBytesPerPoint;
 }
 
 }  // namespace envgi

@@ -93,6 +93,9 @@ class IlluminationGrid {
   const IlluminationGridView& view() const { return view_; }
   int raysPerPoint() const { return count_.empty() ? 0 : count_[0]; }
   size_t bytes() const;
+  // What each point holds: two sets of coefficients (sums and averages), its ray and back-face
+  // counts, its weight.
+  static constexpr size_t kBytesPerPoint = 2 * sizeof(ShL1) + 2 * sizeof(int) + sizeof(float);
 
  private:
   std::vector<ShL1> sum_, sh_;

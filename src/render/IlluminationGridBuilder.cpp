@@ -8,6 +8,8 @@
 #include <chrono>
 
 #include "accel/BvhView.h"
+#include "core/PhysicalMemory.h"
+#include "render/Cancellation.h"
 
 
 namespace envgi {
@@ -19,8 +21,17 @@ IlluminationGrid makeIlluminationGrid(const Scene& scene, int resolution) {
   auto count = [&](float e) { return std::max(2, int(std::ceil(float(resolution - 1) * e / longest)) + 1); };
   // Half a cell of margin, so surfaces on the bounds still have points on both sides.
   Vec3f pad = Vec3f(0.5f * longest / float(resolution - 1));
-  return IlluminationGrid(sc.boundsMin - pad, sc.boundsMax + pad, count(ext.x + 2 * pad.x), count(ext.y + 2 * pad.y),
-                          count(ext.z + 2 * pad.z));
+  const int nx = count(ext.x + 2 * pad.x), ny = count(ext.y + 2 * pad.y), nz = count(ext.z + 2 * pad.z);
+  requireGridFits(nx, ny, nz, physicalMemoryBytes(), resolution);
+  return IlluminationGrid(sc.boundsMin - pad, sc.boundsMax + pad, nx, ny, nz);
+}
+
+void requireGridFits(int nx, int ny, int nz, double memoryBytes, int resolution) {
+  const double bytes = double(nx) * ny * nz * double(IlluminationGrid::kBytesPerPoint);
+  if (memoryBytes > 0.0 && bytes > 0.5 * memoryBytes)
+    throw std::runtime_error(fmt::format(
+        "grid: {}x{}x{} points would take {:.1f} GB, more than half of this machine's {:.1f} GB: lower `resolution` ({})",
+        nx, ny, nz, bytes / 1e9, memoryBytes / 1e9, resolution));
 }
 
 template <class Tracer>
@@ -31,7 +42,11 @@ void gatherIntoGrid(IlluminationGrid& grid, const Scene& scene, const Tracer& tr
   const SceneView& sc = scene.view();
   std::atomic<uint64_t> rayCount{0};
   const IrradianceCacheView &g = global.irradianceCache().view(), &c = caustic.irradianceCache().view();
+  // Only the first fill stops early (then there is no pass to keep): a refinement runs to the
+  // end, since every point must keep the same count of rays.
+  const std::atomic<bool>* cancel = first == 0 ? s.cancel : nullptr;
   tbb::parallel_for(size_t(0), grid.pointCount(), [&](size_t i) {
+    if (cancelRequested(cancel)) return;
     ShL1 sum;
     int back = 0;
     uint64_t r = 0;
@@ -40,6 +55,7 @@ void gatherIntoGrid(IlluminationGrid& grid, const Scene& scene, const Tracer& tr
     grid.accumulate(i, sum, rays, back);
     rayCount += r;
   });
+  throwIfCancelled(cancel);
   finishGather(grid, rayCount.load(), std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
                stats);
 }

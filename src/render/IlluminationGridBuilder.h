@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <atomic>
 
 #include "accel/EmbreeAccel.h"
 #include "integrators/GridIntegrator.h"
@@ -28,6 +29,8 @@ struct GridExecutorSettings {
   int refineRays = 0;      // added before every camera pass after the first
   int maxGatherRays = 128;
   uint32_t seed = 0;
+  // Set (Ctrl-C): the gather stops within a point and throws RenderCancelled.
+  const std::atomic<bool>* cancel = nullptr;
   // The length of each point's ray sequence: the most rays it will get.
   int sequenceLength() const { return refineRays > 0 ? std::max(maxGatherRays, gatherRays) : gatherRays; }
   // Rays to add before a camera pass, when the grid already has `done` a point.
@@ -42,8 +45,14 @@ struct GridBuild {
   GridBuildStats gridStats;
 };
 
-// A grid over the scene's bounds with `resolution` points along its longest side.
+// A grid over the scene's bounds with `resolution` points along its longest side; refused
+// (requireGridFits) where it would not fit in half the machine's memory.
 IlluminationGrid makeIlluminationGrid(const Scene& scene, int resolution);
+
+// Throws, naming the size and the memory, where nx x ny x nz points would take more than half
+// of memoryBytes (0: unknown, never refused): 512 a side over a cube is 134 M points, 14.6 GB
+// and hours of gathering, which should end with an error rather than swap or be killed.
+void requireGridFits(int nx, int ny, int nz, double memoryBytes, int resolution);
 
 // Adds `rays` gather rays to every point (rays [first, first + rays) of each point's sequence
 // of s.sequenceLength(), so calls refine a grid progressively) and re-averages it.

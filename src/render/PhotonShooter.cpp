@@ -1,4 +1,5 @@
 #include "render/PhotonShooter.h"
+#include "render/Cancellation.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -268,6 +269,7 @@ void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* g
       req.maxDepth = s.maxDepth;
       req.global = !gd;
       req.caustic = !cd;
+      throwIfCancelled(s.cancel);
       tracer->trace(req, &batches);
       // Sub-batches are taken in order and the maps checked after each, whatever the device
       // traced at once: the same seed fills the same maps.

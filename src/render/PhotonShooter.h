@@ -4,6 +4,8 @@
 // same seed stores the same photons in the same order.
 #pragma once
 
+#include <atomic>
+
 #include <memory>
 #include <string>
 #include <vector>
@@ -65,6 +67,8 @@ struct PhotonShootSettings {
   float causticIrradianceRadius = 0.025f;
   // Where photons are traced; null: the CPU with Embree.
   std::shared_ptr<PhotonBatchTracer> tracer;
+  // Set (Ctrl-C): the pass stops after the batch in flight and throws RenderCancelled.
+  const std::atomic<bool>* cancel = nullptr;
 };
 
 struct PhotonShootStats {

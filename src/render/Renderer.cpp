@@ -38,6 +38,7 @@ PhotonShootSettings photonShootSettings(const Scene& scene, const RenderOptions&
   shoot.seed = scene.sampler.seed;
   shoot.progress = opts.progress;
   shoot.tracer = opts.photonTracer;
+  shoot.cancel = opts.cancel;
   return shoot;
 }
 
@@ -105,6 +106,7 @@ GridExecutorSettings gridExecutorSettings(const Scene& scene, const RenderOption
   ge.refineRays = gs.refineRays;
   ge.maxGatherRays = gs.maxGatherRays;
   ge.seed = scene.sampler.seed;
+  ge.cancel = opts.cancel;
   return ge;
 }
 

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "accel/Bvh.h"
+#include "render/Cancellation.h"
 #include "render/PhotonShooter.h"
 #include "scene/SceneLoader.h"
 #include "support/CausticScene.h"
@@ -246,4 +247,17 @@ TEST(PhotonShooter, AreaLightsAimedCausticMapHoldsTheUnaimedFlux) {
     std::printf("bin %d: aimed %.4f, unaimed %.4f (sigma %.4f)\n", k, aimed.sum[k], unaimed.sum[k], sigma);
     EXPECT_NEAR(aimed.sum[k], unaimed.sum[k], 4.0 * sigma + 1e-9) << "bin " << k;
   }
+}
+
+// Ctrl-C during the photon pass (the flag set) ends it with RenderCancelled, maps unfilled.
+TEST(PhotonShooter, CancelEndsThePass) {
+  test::CausticSetup cs = test::causticScene(8);
+  EmbreeAccel accel(*cs.scene);
+  std::atomic<bool> cancel{true};
+  PhotonShootSettings ps;
+  ps.progress = false;
+  ps.cancel = &cancel;
+  PhotonMap g, c;
+  EXPECT_THROW(shootPhotons(*cs.scene, accel, ps, &g, &c, nullptr), RenderCancelled);
+  EXPECT_EQ(g.size() + c.size(), 0u);
 }
