@@ -1,5 +1,4 @@
 #include "render/PhotonShooter.h"
-#include "render/Cancellation.h"
 
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
@@ -10,6 +9,9 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+
+#include "core/PhysicalMemory.h"
+#include "render/Cancellation.h"
 
 namespace envgi {
 
@@ -215,6 +217,15 @@ void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShoo
   shootPhotons(scene, cpu, global, caustic, stats);
 }
 
+void requirePhotonMapsFit(size_t photons, double memoryBytes) {
+  const double bytes = double(photons) * double(kPhotonPeakBytes);
+  if (memoryBytes > 0.0 && bytes > 0.5 * memoryBytes)
+    throw std::runtime_error(fmt::format(
+        "photon maps of {} photons would take about {:.1f} GB, more than half of this machine's {:.1f} GB: ask for "
+        "fewer global_photons or caustic_photons",
+        photons, bytes / 1e9, memoryBytes / 1e9));
+}
+
 void logPhotonStats(const PhotonShootStats& st) {
   std::string aimed = st.causticTargets > 0 ? fmt::format(", aimed at {} specular shapes", st.causticTargets) : "";
   spdlog::info("photon pass: {} global photons stored ({} emitted), {} caustic ({} emitted{}), {:.2f} s tracing on {}, "
@@ -230,6 +241,7 @@ void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* g
   auto t0 = Clock::now();
   const SceneView& sc = scene.view();
   if (!s.tracer) throw std::logic_error("shootPhotons: no photon tracer");
+  requirePhotonMapsFit(s.globalPhotons + s.causticPhotons, physicalMemoryBytes());
   PhotonBatchTracer* tracer = s.tracer.get();
   PhotonEmitter emitter = makePhotonEmitter(scene, s.aimCaustics);
   bool anyLight = emitter.emitsLight(sc);

@@ -5,7 +5,6 @@
 #pragma once
 
 #include <atomic>
-
 #include <memory>
 #include <string>
 #include <vector>
@@ -94,5 +93,11 @@ void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* g
 
 // One log line: photons stored and emitted, times, memory.
 void logPhotonStats(const PhotonShootStats& st);
+
+// Throws, naming the count and the memory, where maps holding `photons` would take more than
+// half of memoryBytes (0: unknown, never refused), at kPhotonPeakBytes each: shootPhotons asks
+// this first, so that global_photons 2000000000 is an error line, not a killed process.
+constexpr size_t kPhotonPeakBytes = 2 * sizeof(Photon) + 85;  // the vector grown while shooting, the map built
+void requirePhotonMapsFit(size_t photons, double memoryBytes);
 
 }  // namespace envgi

@@ -348,6 +348,14 @@ TEST(CliRender, PhotonSppmAndGridIntegrators) {
   CliResult badGrid = runCli("render " + d.file("grid.xml") + " -o " + d.file("x.exr"));
   EXPECT_NE(badGrid.code, 0);
   EXPECT_NE(badGrid.output.find("resolution must be between 2 and 512"), std::string::npos) << badGrid.output;
+  // Two billion photons (over 300 GB of maps) are one error line, not a process the kernel kills.
+  std::ofstream(d.file("huge.xml")) << text.substr(0, text.find("<integrator")) +
+                                           R"(<integrator type="photon"><integer name="global_photons" value="2000000000"/></integrator>)" +
+                                           text.substr(text.find("</integrator>") + 13);
+  CliResult huge = runCli("render " + d.file("huge.xml") + " -o " + d.file("huge.exr") + " --spp 1 -D res=8 --no-progress");
+  EXPECT_EQ(huge.code, 1) << huge.output;
+  EXPECT_NE(huge.output.find("photon maps of 2000250000 photons would take about"), std::string::npos) << huge.output;
+  EXPECT_FALSE(fs::exists(d.file("huge.exr")));
   std::ofstream(d.file("bad.xml")) << R"(<scene version="3.0.0"><integrator type="sppm"><float name="alpha" value="1.5"/></integrator></scene>)";
   CliResult bad = runCli("render " + d.file("bad.xml") + " -o " + d.file("x.exr"));
   EXPECT_NE(bad.code, 0);

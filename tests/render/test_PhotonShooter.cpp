@@ -261,3 +261,17 @@ TEST(PhotonShooter, CancelEndsThePass) {
   EXPECT_THROW(shootPhotons(*cs.scene, accel, ps, &g, &c, nullptr), RenderCancelled);
   EXPECT_EQ(g.size() + c.size(), 0u);
 }
+
+// Maps that could never fit are refused before a photon is shot, naming the count and memory.
+TEST(PhotonShooter, MapsThatCannotFitAreRefused) {
+  try {
+    requirePhotonMapsFit(2000000000, 25.3e9);
+    FAIL() << "two billion photons were accepted on a 25.3 GB machine";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("photon maps of 2000000000 photons would take about"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("more than half of this machine's 25.3 GB"), std::string::npos) << e.what();
+  }
+  EXPECT_NO_THROW(requirePhotonMapsFit(500000, 25.3e9));
+  EXPECT_NO_THROW(requirePhotonMapsFit(2000000000, 0.0));  // memory unknown
+}
