@@ -77,7 +77,7 @@ void PhotonMap::build(std::vector<Photon> photons) {
 size_t PhotonMap::bytes() const {
   // The kd-tree holds a position and two indices per point plus nodes of about 16 points each.
   size_t n = photons_.size();
-  return n * (sizeof(Photon) + sizeof(Vec3f) + 2 * sizeof(uint32_t)) + n / 16 * 48 + cache_.bytes();
+  return n * kBytesPerPhoton + n / 16 * 48 + cache_.bytes();
 }
 
 size_t PhotonMap::beginIrradiance(int stride) {

@@ -29,6 +29,9 @@ class PhotonMap {
   size_t size() const { return photons_.size(); }
   const std::vector<Photon>& photons() const { return photons_; }
   size_t bytes() const;
+  // The kd-tree's arrays per photon: the photon, its position and two indices (its nodes, about
+  // one per 16 photons, and the irradiance cache come on top).
+  static constexpr size_t kBytesPerPhoton = sizeof(Photon) + sizeof(Vec3f) + 2 * sizeof(uint32_t);
 
   // L_r(x, wo) = 1/(pi r^2) sum f_r(x, wp, wo) dPhi_p (Eq. 12), r the distance to the k-th
   // photon (Eq. 11), or maxRadius when fewer are within it. Photons arriving from behind the

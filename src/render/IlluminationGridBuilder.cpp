@@ -28,7 +28,7 @@ IlluminationGrid makeIlluminationGrid(const Scene& scene, int resolution) {
 
 void requireGridFits(int nx, int ny, int nz, double memoryBytes, int resolution) {
   const double bytes = double(nx) * ny * nz * double(IlluminationGrid::kBytesPerPoint);
-  if (memoryBytes > 0.0 && bytes > 0.5 * memoryBytes)
+  if (!fitsInHalfOfMemory(bytes, memoryBytes))
     throw std::runtime_error(fmt::format(
         "grid: {}x{}x{} points would take {:.1f} GB, more than half of this machine's {:.1f} GB: lower `resolution` ({})",
         nx, ny, nz, bytes / 1e9, memoryBytes / 1e9, resolution));

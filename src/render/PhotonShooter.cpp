@@ -219,7 +219,7 @@ void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShoo
 
 void requirePhotonMapsFit(size_t photons, double memoryBytes) {
   const double bytes = double(photons) * double(kPhotonPeakBytes);
-  if (memoryBytes > 0.0 && bytes > 0.5 * memoryBytes)
+  if (!fitsInHalfOfMemory(bytes, memoryBytes))
     throw std::runtime_error(fmt::format(
         "photon maps of {} photons would take about {:.1f} GB, more than half of this machine's {:.1f} GB: ask for "
         "fewer global_photons or caustic_photons",

@@ -97,7 +97,9 @@ void logPhotonStats(const PhotonShootStats& st);
 // Throws, naming the count and the memory, where maps holding `photons` would take more than
 // half of memoryBytes (0: unknown, never refused), at kPhotonPeakBytes each: shootPhotons asks
 // this first, so that global_photons 2000000000 is an error line, not a killed process.
-constexpr size_t kPhotonPeakBytes = 2 * sizeof(Photon) + 85;  // the vector grown while shooting, the map built
+// The vector grown while shooting (up to twice its photons), then the map built from it: its
+// arrays, plus 17 bytes a photon for its nodes and irradiance cache (85 a photon in all, logged).
+constexpr size_t kPhotonPeakBytes = 2 * sizeof(Photon) + PhotonMap::kBytesPerPhoton + 17;
 void requirePhotonMapsFit(size_t photons, double memoryBytes);
 
 }  // namespace envgi
