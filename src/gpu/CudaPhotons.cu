@@ -35,7 +35,7 @@ __global__ void photonMapKernel(const SceneView* sc, BvhTracer tracer, PhotonEmi
 class CudaPhotonTracer final : public PhotonBatchTracer {
  public:
   CudaPhotonTracer(const Scene& scene, const Bvh& bvh, int gpu, int maxDepth)
-      : gpu_(gpu), scene_(scene, bvh), emitter_(makePhotonEmitter(scene, true)), maxDepth_(std::max(1, maxDepth)) {
+      : gpu_(gpu), scene_(scene, bvh), maxDepth_(std::max(1, maxDepth)) {
     // As many sub-batches a launch as fit ~256 MB of slots (8 at the default depth 16).
     size_t perSub = size_t(kPhotonSubBatch) * size_t(maxDepth_) * sizeof(Photon);
     subs_ = int(std::max<size_t>(1, std::min<size_t>(8, (size_t(256) << 20) / perSub)));
@@ -59,7 +59,7 @@ class CudaPhotonTracer final : public PhotonBatchTracer {
     if (r.maxDepth > maxDepth_) throw std::runtime_error("photon tracer: made for a smaller max_depth");
     int count = subs_ * kPhotonSubBatch;
     photonMapKernel<<<(count + kThreads - 1) / kThreads, kThreads>>>(
-        scene_.deviceView, BvhTracer{scene_.bvh}, emitter_, r.seed ^ r.stream, r.aimed, r.first, count, r.maxDepth,
+        scene_.deviceView, BvhTracer{scene_.bvh}, r.emitter, r.seed ^ r.stream, r.aimed, r.first, count, r.maxDepth,
         maxDepth_, r.global, r.caustic, slots_, isGlobal_, isCaustic_);
     check(cudaGetLastError(), "launching the photon kernel");
     out->assign(size_t(subs_), PhotonBatch{});
@@ -87,7 +87,6 @@ class CudaPhotonTracer final : public PhotonBatchTracer {
 
   int gpu_;
   DeviceScene scene_;
-  PhotonEmitter emitter_;
   int maxDepth_;
   int subs_ = 1;
   Photon* slots_ = nullptr;

@@ -159,7 +159,7 @@ template <class Tracer>
 class CpuPhotonTracer final : public PhotonBatchTracer {
  public:
   CpuPhotonTracer(const Scene& scene, Tracer tracer, std::string name)
-      : scene_(scene), tracer_(tracer), emitter_(makePhotonEmitter(scene, true)), name_(std::move(name)) {}
+      : scene_(scene), tracer_(tracer), name_(std::move(name)) {}
   std::string deviceName() const override { return name_; }
   void trace(const PhotonTraceRequest& r, std::vector<PhotonBatch>* out) override {
     const int chunk = 1024, chunks = kPhotonSubBatch / chunk;
@@ -173,10 +173,10 @@ class CpuPhotonTracer final : public PhotonBatchTracer {
           first, first + chunk,
           [&](uint64_t j) {
             Sampler smp = photonSampler(stream, j, 0);
-            emitter_.prefetch(sc, smp);
+            r.emitter.prefetch(sc, smp);
           },
           [&](uint64_t j) {
-            shootPhoton(sc, tracer_, emitter_, stream, j, 0, r.maxDepth, r.aimed,
+            shootPhoton(sc, tracer_, r.emitter, stream, j, 0, r.maxDepth, r.aimed,
                         [&](const SurfaceInteraction& si, Vec3f wi, Color pw, bool isCaustic, int) {
                           if (isCaustic ? r.caustic : r.global)
                             (isCaustic ? b.caustic : b.global).push_back(makePhoton(si, wi, pw));
@@ -195,7 +195,6 @@ class CpuPhotonTracer final : public PhotonBatchTracer {
  private:
   const Scene& scene_;
   Tracer tracer_;
-  PhotonEmitter emitter_;
   std::string name_;
 };
 
@@ -281,6 +280,7 @@ void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* g
       req.maxDepth = s.maxDepth;
       req.global = !gd;
       req.caustic = !cd;
+      req.emitter = emitter;
       throwIfCancelled(s.cancel);
       tracer->trace(req, &batches);
       // Sub-batches are taken in order and the maps checked after each, whatever the device

@@ -31,6 +31,9 @@ struct PhotonTraceRequest {
   bool aimed = false;                  // aimed at the emitter's targets (the caustic stream)
   int maxDepth = kSpecularChainDepth;
   bool global = true, caustic = true;  // which maps still want photons
+  // The lights and the targets to aim at, made once a pass (makePhotonEmitter walks the
+  // specular shapes); a device tracer copies it to its kernels as it is.
+  PhotonEmitter emitter;
 };
 
 // Traces sub-batches of a photon-map pass on some device.
