@@ -79,6 +79,7 @@ class CudaGridExecutor final : public PassExecutor {
   bool restart(const Camera& cam) override { return camera_->restart(cam); }
   bool setActivePixels(const std::vector<unsigned char>& mask) override { return camera_->setActivePixels(mask); }
   bool keepsVariance() const override { return camera_->keepsVariance(); }
+  double maxPassPixelSamples() const override { return camera_->maxPassPixelSamples(); }
   size_t deviceBytes() const { return camera_->deviceBytes(); }
 
  private:

@@ -2,6 +2,7 @@
 
 #include <stdexcept>
 
+#include "core/PhysicalMemory.h"
 #include "gpu/CudaExecutor.h"
 #include "render/Renderer.h"
 
@@ -9,6 +10,7 @@ namespace envgi::gpu {
 
 PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const EmbreeAccel* accel, RenderOptions opts,
                                  int gpu, size_t* deviceBytes) {
+  requireFilmFits(scene.view().camera, opts, physicalMemoryBytes());  // its host copy, before the device's
   size_t bytes = 0;
   PreparedRender pr;
   switch (scene.integrator.type) {

@@ -35,6 +35,9 @@ class PassExecutor {
   virtual void readFilm(FilmSums* out) = 0;
   // The most samples one pass may take: passes are where checkpoints and Ctrl-C happen.
   virtual int maxPassSize() const { return 64; }
+  // The most pixel-samples (pixels x samples) one pass may take: about 5 s of path tracing the
+  // bundled Buddha on two cores.
+  virtual double maxPassPixelSamples() const { return double(1 << 24); }
   // Starts over with a new camera and an empty film, keeping what does not depend on the
   // camera (photon maps, a grid). False: this executor cannot, make a new one.
   virtual bool restart(const Camera&) { return false; }

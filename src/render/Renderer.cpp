@@ -1,5 +1,6 @@
 #include "render/Renderer.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -9,6 +10,7 @@
 #include <stdexcept>
 
 #include "accel/Bvh.h"
+#include "core/PhysicalMemory.h"
 #include "render/ActivePixels.h"
 #include "render/CpuExecutor.h"
 #include "integrators/PhotonIntegrator.h"
@@ -139,6 +141,7 @@ std::shared_ptr<PhotonBatchTracer> cpuPhotonTracer(const Scene& scene, const Bvh
 // the CPU: with Embree, or with the GPU's BVH to check the GPU's bodies without a GPU.
 template <class Tracer>
 PreparedRender prepareOnTracer(const Scene& scene, const Tracer& tracer, const RenderOptions& opts, const char* name) {
+  requireFilmFits(scene.view().camera, opts, physicalMemoryBytes());
   switch (scene.integrator.type) {
     case IntegratorType::Sppm:
       return {std::make_unique<SppmExecutor<Tracer>>(scene, tracer, sppmParams(scene), opts.threads),
@@ -166,6 +169,7 @@ PreparedRender prepareOnTracer(const Scene& scene, const Tracer& tracer, const R
 }
 
 PreparedRender preparePhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
+  requireFilmFits(scene.view().camera, opts, physicalMemoryBytes());  // before the photon pass
   const PhotonSettings& ps = scene.integrator.photon;
   int spp = samplesOf(scene, opts);
   auto globalMap = std::make_shared<PhotonMap>(), causticMap = std::make_shared<PhotonMap>();
@@ -268,13 +272,34 @@ Image filmMean(const FilmSums& film, int width, int height, const std::vector<in
                     [&samples](size_t i) { return samples[i]; });
 }
 
+size_t filmBytesPerPixel(const Camera& cam, const RenderOptions& opts) {
+  const bool adaptive = opts.noiseThreshold > 0.f;
+  size_t sums = sizeof(Color) + (opts.keepsVariance() ? sizeof(double) : 0) +
+                (cam.filter.hasNegativeLobes() ? sizeof(float) : 0) + (adaptive ? 1 : 0);
+  return 2 * sums + sizeof(int) + 1 + sizeof(Color);
+}
+
+void requireFilmFits(const Camera& cam, const RenderOptions& opts, double memoryBytes) {
+  const double bytes = double(cam.width) * double(cam.height) * double(filmBytesPerPixel(cam, opts));
+  if (!fitsInHalfOfMemory(bytes, memoryBytes))
+    throw std::runtime_error(fmt::format(
+        "a {}x{} film would take about {:.1f} GB, more than half of this machine's {:.1f} GB: render fewer pixels "
+        "(the film's width and height)",
+        cam.width, cam.height, bytes / 1e9, memoryBytes / 1e9));
+}
+
 Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts, RenderStats* stats) {
   // Passes double the samples done (1, 1, 2, 4, ...) up to the executor's limit (64 samples on
   // the CPU), so a checkpoint comes early, and each pass ends at a power of two or a multiple of
   // the limit: there a pixel's Sobol samples so far are a net (Sampler::shuffledIndex), so a
   // checkpoint or a time-limited render is as even as a render of that many samples.
+  // A pass also takes at most the executor's maxPassPixelSamples() (halving the limit, so it
+  // stays a power of two): on a large image a checkpoint, the time limit and Ctrl-C then come
+  // every few seconds, not after passes of 64 samples of every pixel (at 4096^2, minutes each).
+  // The passes depend on the image's size alone, so the same render sums the same film.
   std::vector<std::pair<int, int>> passes;
-  const int maxPass = std::max(1, ex.maxPassSize());
+  int maxPass = std::max(1, ex.maxPassSize());
+  while (maxPass > 1 && double(maxPass) * double(W) * double(H) > double(ex.maxPassPixelSamples())) maxPass /= 2;
   for (int s = 0; s < spp;) {
     int n = std::clamp(s, 1, maxPass);
     passes.push_back({s, std::min(spp, s + n)});

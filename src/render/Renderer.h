@@ -102,6 +102,14 @@ Image filmMean(const FilmSums& film, int width, int height, int samples);
 // The same with each pixel's own count (adaptive sampling); a pixel with none is black.
 Image filmMean(const FilmSums& film, int width, int height, const std::vector<int>& samples);
 
+// The host's film at its peak, in bytes a pixel: the executor's sums (squared luminance where
+// opts keeps variance, filter weights for a filter with negative lobes, adaptive sampling's
+// mask), renderPasses' copy of them, each pixel's sample count and mask, and the mean image.
+size_t filmBytesPerPixel(const Camera& cam, const RenderOptions& opts);
+// Throws where that film would take more than half of memoryBytes (physicalMemoryBytes()), before
+// any of it is allocated: a 32768^2 film (44 GB) otherwise thrashed a 25 GB machine for minutes.
+void requireFilmFits(const Camera& cam, const RenderOptions& opts, double memoryBytes);
+
 // The loop itself, over an executor that already holds the scene (e.g. a GPU's).
 Image renderPasses(PassExecutor& executor, int width, int height, int spp, const RenderOptions& opts,
                    RenderStats* stats);

@@ -1,0 +1,102 @@
+// The render loop's own rules: how renderPasses cuts a render into passes, and the film's
+// memory bound.
+#include <gtest/gtest.h>
+
+#include "render/Renderer.h"
+
+using namespace envgi;
+
+namespace {
+
+// Records the passes it is asked for; its film stays black.
+class RecordingExecutor final : public PassExecutor {
+ public:
+  RecordingExecutor(int w, int h, double budget) : px_(size_t(w) * size_t(h)), budget_(budget) {}
+  std::string deviceName() const override { return "recording"; }
+  void runPass(int s0, int s1, Progress&, PassCounters*) override { passes.push_back({s0, s1}); }
+  void readFilm(FilmSums* out) override { out->sum.assign(px_, Color(0.f)); }
+  double maxPassPixelSamples() const override { return budget_; }
+  std::vector<std::pair<int, int>> passes;
+
+ private:
+  size_t px_;
+  double budget_;
+};
+
+std::vector<std::pair<int, int>> passesOf(int w, int h, int spp, double budget) {
+  RecordingExecutor ex(w, h, budget);
+  RenderOptions o;
+  o.progress = false;
+  RenderStats st;
+  renderPasses(ex, w, h, spp, o, &st);
+  EXPECT_EQ(st.sppDone, spp);
+  return ex.passes;
+}
+
+using Passes = std::vector<std::pair<int, int>>;
+
+}  // namespace
+
+// Passes double up to 64 samples where the image is small beside the budget; on a larger one
+// they stop doubling at the largest power of two whose pass fits in it, and at one sample a
+// pass where even that does not. Each pass starts at a multiple of its size, so a checkpoint
+// holds whole power-of-two blocks of every pixel's Sobol samples.
+TEST(RenderPasses, ALargeImageTakesSmallerPasses) {
+  EXPECT_EQ(passesOf(16, 16, 200, 256.0 * 64),
+            (Passes{{0, 1}, {1, 2}, {2, 4}, {4, 8}, {8, 16}, {16, 32}, {32, 64}, {64, 128}, {128, 192}, {192, 200}}));
+  // 256 pixels, a budget of 256 x 20: at most 16 samples a pass.
+  EXPECT_EQ(passesOf(16, 16, 64, 256.0 * 20),
+            (Passes{{0, 1}, {1, 2}, {2, 4}, {4, 8}, {8, 16}, {16, 32}, {32, 48}, {48, 64}}));
+  Passes ones = passesOf(16, 16, 5, 100.0);
+  EXPECT_EQ(ones, (Passes{{0, 1}, {1, 2}, {2, 3}, {3, 4}, {4, 5}}));
+  for (double budget : {1.0, 300.0, 256.0 * 7, 256.0 * 64, 1e12}) {
+    Passes p = passesOf(16, 16, 100, budget);
+    ASSERT_FALSE(p.empty());
+    EXPECT_EQ(p.front().first, 0);
+    EXPECT_EQ(p.back().second, 100);
+    for (size_t i = 0; i < p.size(); ++i) {
+      int n = p[i].second - p[i].first;
+      if (i + 1 < p.size()) {
+        EXPECT_EQ(p[i].second, p[i + 1].first);
+        EXPECT_EQ(n & (n - 1), 0) << "pass " << i << " of " << n << " samples";
+        EXPECT_EQ(p[i].first % n, 0) << "pass " << i;
+      }
+      EXPECT_LE(double(n) * 256.0, std::max(budget, 256.0)) << "pass " << i;
+    }
+  }
+}
+
+// The default budget leaves the bundled scenes' passes as they were (320 x 320: up to 64
+// samples) and cuts a 4096 x 4096 image's to one sample.
+TEST(RenderPasses, TheDefaultBudgetCutsOnlyLargeImages) {
+  RecordingExecutor ex(1, 1, 0.0);
+  const double budget = ex.PassExecutor::maxPassPixelSamples();
+  EXPECT_GE(budget, 320.0 * 320.0 * 64.0);
+  EXPECT_LT(budget, 4096.0 * 4096.0 * 2.0);
+}
+
+// A film too large for the machine is refused with its size, before any of it is allocated;
+// where the system does not say how much memory it has, any film goes.
+TEST(Film, AFilmThatCannotFitIsRefused) {
+  Camera cam;
+  cam.width = cam.height = 32768;
+  RenderOptions o;
+  EXPECT_EQ(filmBytesPerPixel(cam, o), 41u);  // two 12-byte sums, the mean image, 4 + 1 a pixel
+  std::vector<float> var;
+  o.varianceOut = &var;
+  EXPECT_EQ(filmBytesPerPixel(cam, o), 57u);  // with each pixel's squared luminance, twice
+  o.varianceOut = nullptr;
+  try {
+    requireFilmFits(cam, o, 25.3e9);
+    ADD_FAILURE() << "a 44 GB film was let through on a 25.3 GB machine";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("a 32768x32768 film would take about 44.0 GB, more than half of this "
+                                         "machine's 25.3 GB"),
+              std::string::npos)
+        << e.what();
+  }
+  EXPECT_NO_THROW(requireFilmFits(cam, o, 0.0));
+  EXPECT_NO_THROW(requireFilmFits(cam, o, 100e9));
+  cam.width = cam.height = 8192;  // 2.75 GB
+  EXPECT_NO_THROW(requireFilmFits(cam, o, 25.3e9));
+}
