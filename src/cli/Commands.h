@@ -25,6 +25,8 @@ bool parseFiniteNumber(const std::string& s, double& v);
 CLI::Validator atLeast(double lo);
 // Any finite number:
 CLI::Validator finiteNumber();
+// --threads N on a command that renders: 0 (every core) to kMaxWorkerThreads.
+void addThreadsOption(CLI::App* c, int* threads);
 
 // -D name=value pairs into a map; throws on a pair without '='.
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds);

@@ -15,6 +15,7 @@
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
 #include "core/Files.h"
+#include "envmap/CollapsedMap.h"
 #include "gpu/CudaExecutor.h"
 #include "render/AovRenderer.h"
 #include "render/Renderer.h"
@@ -254,10 +255,10 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("--spp", a->spp, "Samples per pixel, or passes for sppm (default: the scene's)")->check(atLeast(1));
   c->add_option("--integrator", a->integrator, "Integrator: " + nameList(kIntegratorNames) + " (overrides the scene)");
   c->add_option("--strategy", a->strategy, "Environment strategy: " + strategyNameList());
-  c->add_option("--points", a->points, "points: directional lights in the collapsed map (default 64)")->check(atLeast(1));
+  c->add_option("--points", a->points, "points: directional lights in the collapsed map (default 64)")->check(CLI::Range(1, kMaxCollapsedPoints));
   c->add_option("--point-method", a->pointMethod, "points: sample (Algorithm 1 draws, power L/pdf/N) | mediancut");
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
-  c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(atLeast(0));
+  addThreadsOption(c, &a->threads);
   c->add_option("--seed", a->seed, "Sampler seed (overrides the scene)")->check(atLeast(0));
   c->add_flag("--png", a->png, "Also write a tonemapped PNG beside the output");
   c->add_option("--exposure", a->exposure, "Exposure in stops for 8-bit output")->check(finiteNumber());

@@ -345,7 +345,7 @@ void addStudyCommand(CLI::App& app) {
   c->add_option("--reference-spp", a->referenceSpp, "Samples for the rendered reference (default 4096)")->check(atLeast(1));
   c->add_option("--integrator", a->integrator, "direct (default) or path");
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
-  c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(atLeast(0));
+  addThreadsOption(c, &a->threads);
   c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
   c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(atLeast(0));
   c->add_option("--noise-threshold", a->noiseThreshold,

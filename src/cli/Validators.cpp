@@ -5,6 +5,7 @@
 #include <cstdlib>
 
 #include "cli/Commands.h"
+#include "render/WorkerThreads.h"
 
 namespace envgi::cli {
 
@@ -33,6 +34,19 @@ CLI::Validator finiteNumber() {
         return "";
       },
       "NUMBER");
+}
+
+void addThreadsOption(CLI::App* c, int* threads) {
+  c->add_option("--threads", *threads, "Worker threads (default: all cores)")
+      ->check(CLI::Validator(
+          [](std::string& s) -> std::string {
+            double v = 0;
+            if (!parseFiniteNumber(s, v) || v != std::floor(v)) return fmt::format("'{}' is not a whole number", s);
+            if (v < 0 || v > kMaxWorkerThreads)
+              return fmt::format("must be between 0 (every core) and {}, not {}", kMaxWorkerThreads, s);
+            return "";
+          },
+          fmt::format("0..{}", kMaxWorkerThreads)));
 }
 
 }  // namespace envgi::cli

@@ -66,7 +66,7 @@ void addViewCommand(CLI::App& app) {
   c->add_option("--host", a->host, "Address to bind (default 127.0.0.1; anything wider requires the printed token)");
   c->add_option("--integrator", a->integrator, "Integrator: " + nameList(kIntegratorNames));
   c->add_option("--strategy", a->strategy, "Environment strategy: " + strategyNameList());
-  c->add_option("--threads", a->threads, "Worker threads (default: all cores)")->check(atLeast(0));
+  addThreadsOption(c, &a->threads);
   c->add_option("--max-spp", a->maxSpp, "Stop refining at this many samples per pixel")->check(atLeast(1));
   c->add_option("--noise-threshold", a->noiseThreshold,
                 "Adaptive sampling, as in render: a pixel stops refining once it and its neighbours are below this "

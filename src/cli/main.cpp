@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <new>
 
 #include "cli/Commands.h"
 
@@ -39,6 +40,11 @@ int main(int argc, char** argv) {
     // One line, like every other error; --help has the details.
     std::fprintf(stderr, "envgi: error: %s (see envgi --help)\n", e.what());
     return 2;
+  } catch (const std::bad_alloc&) {
+    // An allocation the system refused (past a ulimit, or far larger than its memory) is one
+    // line too; the bounds envgi checks itself (film, photon maps, grid) say what to lower.
+    std::fprintf(stderr, "envgi: error: out of memory: the system refused an allocation (std::bad_alloc)\n");
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "envgi: error: %s\n", e.what());
     return 1;

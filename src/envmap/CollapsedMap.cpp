@@ -3,13 +3,24 @@
 #include <algorithm>
 #include <queue>
 #include <stdexcept>
+#include <string>
 
 #include "sampling/Sampler.h"
 
 namespace envgi {
 
+namespace {
+
+void requirePointCount(int n) {
+  if (n < 1 || n > kMaxCollapsedPoints)
+    throw std::runtime_error("point_count must be between 1 and " + std::to_string(kMaxCollapsedPoints) + ", not " +
+                             std::to_string(n));
+}
+
+}  // namespace
+
 std::vector<DirectionalLight> collapseByWeightedSampling(const EnvironmentMap& map, int n, uint32_t seed) {
-  if (n < 1) throw std::runtime_error("point_count must be at least 1");
+  requirePointCount(n);
   EnvironmentMapView v = map.view();
   std::vector<DirectionalLight> out;
   out.reserve(size_t(n));
@@ -36,7 +47,7 @@ struct Region {
 }  // namespace
 
 std::vector<DirectionalLight> collapseByMedianCut(const EnvironmentMap& map, int n) {
-  if (n < 1) throw std::runtime_error("point_count must be at least 1");
+  requirePointCount(n);
   const Image& img = map.image();
   const int W = img.width, H = img.height;
   EnvironmentMapView v = map.view();

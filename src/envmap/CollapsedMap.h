@@ -11,6 +11,11 @@ namespace envgi {
 
 enum class CollapseMethod { WeightedSampling, MedianCut };
 
+// The most lights a collapsed map may have (600 MB of them): far past any count that still
+// makes it fast, and a bound that turns a slip (point_count 2000000000) into an error line
+// rather than an allocation the machine refuses.
+inline constexpr int kMaxCollapsedPoints = 1 << 24;
+
 // N directions drawn by Algorithm 1 (stratified, Owen-scrambled Sobol' points for `seed`), each
 // with irradiance L / (pdf N): their sum estimates the map's integral.
 std::vector<DirectionalLight> collapseByWeightedSampling(const EnvironmentMap& map, int n, uint32_t seed);

@@ -8,6 +8,7 @@
 
 #include "materials/Bsdf.h"
 #include "render/PixelKernel.h"
+#include "render/WorkerThreads.h"
 
 namespace envgi {
 
@@ -103,7 +104,7 @@ std::vector<ImageChannel> renderAovs(const Scene& scene, const EmbreeAccel& acce
         for (size_t c = 0; c < nc; ++c) out[c].values[pixel] = wsum != 0.f ? acc[c] / wsum : 0.f;
       }
   };
-  tbb::task_arena arena(threads > 0 ? threads : tbb::this_task_arena::max_concurrency());
+  tbb::task_arena arena(arenaConcurrency(threads));
   arena.execute([&] { tbb::parallel_for(tbb::blocked_range<int>(0, cam.height, 4), body); });
   return out;
 }

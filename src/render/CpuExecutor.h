@@ -17,6 +17,7 @@
 
 #include "render/PassExecutor.h"
 #include "render/PixelKernel.h"
+#include "render/WorkerThreads.h"
 
 namespace envgi {
 
@@ -26,7 +27,7 @@ class CpuExecutor final : public PassExecutor {
   CpuExecutor(const Camera& cam, SampleSequence seq, Integrator integrate, int threads, bool keepVariance,
               std::string name, int tileSize = 16)
       : cam_(cam), seq_(seq), integrate_(std::move(integrate)),
-        arena_(threads > 0 ? threads : tbb::this_task_arena::max_concurrency()), name_(std::move(name)),
+        arena_(arenaConcurrency(threads)), name_(std::move(name)),
         tile_(tileSize) {
     film_.sum.assign(size_t(cam.width) * cam.height, Color(0.f));
     if (keepVariance) film_.sumSqLum.assign(film_.sum.size(), 0.0);

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "accel/BvhView.h"
+#include "render/WorkerThreads.h"
 
 namespace envgi {
 
@@ -23,7 +24,7 @@ void checkSppmParams(const SppmParams& p) {
 template <class Tracer>
 SppmExecutor<Tracer>::SppmExecutor(const Scene& scene, Tracer tracer, const SppmParams& params, int threads)
     : scene_(scene), tracer_(tracer), p_(params),
-      arena_(threads > 0 ? threads : tbb::this_task_arena::max_concurrency()), emitter_(makePhotonEmitter(scene)),
+      arena_(arenaConcurrency(threads)), emitter_(makePhotonEmitter(scene)),
       anyLight_(emitter_.emitsLight(scene.view())), W_(scene.view().camera.width), H_(scene.view().camera.height) {
   checkSppmParams(p_);
   size_t np = size_t(W_) * H_;

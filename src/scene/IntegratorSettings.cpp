@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "envmap/CollapsedMap.h"
 #include "scene/NameTables.h"
 
 namespace envgi {
@@ -16,7 +17,8 @@ EnvSamplingSettings EnvSamplingSettings::fromProperties(Properties& p) {
   } catch (const std::runtime_error& e) {
     p.fail(e.what());
   }
-  if (s.pointCount < 1) p.fail("point_count must be at least 1");
+  if (s.pointCount < 1 || s.pointCount > kMaxCollapsedPoints)
+    p.fail("point_count must be between 1 and " + std::to_string(kMaxCollapsedPoints));
   if (s.pointMethod != "sample" && s.pointMethod != "mediancut")
     p.fail("unknown point_method '" + s.pointMethod + "' (sample, mediancut)");
   return s;

@@ -17,8 +17,9 @@ struct CliResult {
   std::string output;
 };
 
-inline CliResult runCli(const std::string& args) {
-  std::string cmd = std::string(ENVGI_CLI_PATH) + " " + args + " 2>&1";
+// shell: commands run before envgi in the same shell (e.g. "ulimit -v 600000; ").
+inline CliResult runCli(const std::string& args, const std::string& shell = "") {
+  std::string cmd = shell + std::string(ENVGI_CLI_PATH) + " " + args + " 2>&1";
   CliResult r;
   FILE* p = popen(cmd.c_str(), "r");
   if (!p) return r;

@@ -215,6 +215,26 @@ TEST(CliRender, AFilmTooLargeForTheMachineIsRefused) {
   }
 }
 
+// An allocation the system refuses (here the 8192^2 film's sums, 805 MB, past a 600 MB
+// address-space limit) ends with one line naming it, exit 1 and no image, where it used to
+// print "std::bad_alloc". Not under AddressSanitizer, whose shadow memory alone passes the
+// limit, nor on a machine under 6 GB, where envgi's own film bound refuses it first.
+TEST(CliRender, AnAllocationTheSystemRefusesIsOneErrorLine) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer reserves more address space than the limit this test sets";
+#endif
+  if (envgi::physicalMemoryBytes() < 6e9) GTEST_SKIP() << "an 8192^2 film is refused by envgi's own bound here";
+  TempDir d;
+  std::string out = d.file("big.exr");
+  CliResult r = runCli("render " + std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml -D res=8192 --spp 1 " +
+                           "--integrator path --no-progress -o " + out,
+                       "ulimit -v 600000; ");
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("envgi: error: out of memory: the system refused an allocation"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 // A time limit ends a render of far more samples than fit at a pass boundary, with the image
 // of the samples done and a log line saying how many.
 TEST(CliRender, TimeLimitStopsAtAPassWithTheSamplesDone) {
@@ -620,7 +640,7 @@ TEST(CliRender, RaysOutsideEmbreesRangeMissInsteadOfAborting) {
 
 // Numeric options out of range, or NaN, are one sentence naming the option and the value, exit
 // 2, and no file; they used to pass (NaN time limit and exposure, negative photon counts and
-// checkpoint periods) or quote a range up to 1.8e308.
+// checkpoint periods, ten million threads) or quote a range up to 1.8e308.
 TEST(RenderCli, NumericOptionsOutOfRangeAreOneClearError) {
   TempDir d;
   std::string scene = tinyScene(d, 8, 2);
@@ -633,10 +653,16 @@ TEST(RenderCli, NumericOptionsOutOfRangeAreOneClearError) {
       {render + "--time-limit nan", "--time-limit: 'nan' is not a number"},
       {render + "--checkpoint -1", "--checkpoint: must be at least 0, not -1"},
       {render + "--exposure inf", "--exposure: 'inf' is not a finite number"},
-      {render + "--threads -2", "--threads: must be at least 0, not -2"},
+      {render + "--threads -2", "--threads: must be between 0 (every core) and 1024, not -2"},
+      // oneTBB's arena crashed (SIGSEGV) when asked for ten million threads.
+      {render + "--threads 10000000", "--threads: must be between 0 (every core) and 1024, not 10000000"},
+      {render + "--threads 2.5", "--threads: '2.5' is not a whole number"},
+      {render + "--points 2000000000", "--points: Value 2000000000 not in range 1 to 16777216"},
+      {"view " + scene + " --threads 1025", "--threads: must be between 0 (every core) and 1024, not 1025"},
       {"photons " + scene + " -o " + d.file("bad.png") + " --global -5", "--global: must be at least 0, not -5"},
       {"study " + scene + " -o " + d.file("study") + " --reference-spp 0", "--reference-spp: must be at least 1, not 0"},
-      {"study " + scene + " -o " + d.file("study") + " --threads -1", "--threads: must be at least 0, not -1"},
+      {"study " + scene + " -o " + d.file("study") + " --threads -1",
+       "--threads: must be between 0 (every core) and 1024, not -1"},
   };
   for (const Case& c : cases) {
     CliResult r = runCli(c.args);

@@ -49,6 +49,9 @@ TEST(CollapsedMap, LightsCarryTheMapsPower) {
   for (int i = 0; i < 16; ++i) diff += length(a[i].dir - c[i].dir);
   EXPECT_GT(diff, 0.0);
   EXPECT_THROW(collapseByMedianCut(map, 0), std::runtime_error);
+  // Past the bound, refused before anything is allocated for the lights.
+  EXPECT_THROW(collapseByMedianCut(map, kMaxCollapsedPoints + 1), std::runtime_error);
+  EXPECT_THROW(collapseByWeightedSampling(map, 2000000000, 3), std::runtime_error);
 }
 
 // A diffuse ball on a diffuse floor: `direct` with the collapsed map against `direct` with

@@ -134,6 +134,9 @@ TEST(IntegratorSettings, RefusesBadValuesAtThePluginsLine) {
             "s.xml:2: max_gather_rays must be at least gather_rays");
   EXPECT_EQ(errorOf(IntegratorType::Path, with("point_method", "string", "kmeans")),
             "s.xml:2: unknown point_method 'kmeans' (sample, mediancut)");
+  // Two billion lights had reached the collapse, whose allocation the system refused.
+  EXPECT_EQ(errorOf(IntegratorType::Direct, with("point_count", "integer", "2000000000")),
+            "s.xml:2: point_count must be between 1 and 16777216");
 }
 
 TEST(IntegratorSettings, SetStrategyResetsDirectsCountsToTheStrategys) {
