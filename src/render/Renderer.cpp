@@ -297,14 +297,11 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   // stays a power of two): on a large image a checkpoint, the time limit and Ctrl-C then come
   // every few seconds, not after passes of 64 samples of every pixel (at 4096^2, minutes each).
   // The passes depend on the image's size alone, so the same render sums the same film.
-  std::vector<std::pair<int, int>> passes;
   int maxPass = std::max(1, ex.maxPassSize());
   while (maxPass > 1 && double(maxPass) * double(W) * double(H) > double(ex.maxPassPixelSamples())) maxPass /= 2;
-  for (int s = 0; s < spp;) {
-    int n = std::clamp(s, 1, maxPass);
-    passes.push_back({s, std::min(spp, s + n)});
-    s += n;
-  }
+  // Where the pass that starts at s0 ends, one pass at a time: a list of them all (33 million
+  // for --spp 2147483647 and a time limit) and s0 + n in int had overflowed into a hang.
+  auto passEnd = [&](int s0) { return int(std::min<int64_t>(spp, int64_t(s0) + std::clamp(s0, 1, maxPass))); };
   Progress progress(size_t(W) * H * spp, opts.progress, opts.timeLimitSeconds);
   PassCounters counters;
   FilmSums film;
@@ -323,7 +320,8 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     ex.readFilm(&film);
     return filmMean(film, W, H, pixels.samples());
   };
-  for (auto [s0, s1] : passes) {
+  for (int s0 = 0, s1 = 0; s0 < spp; s0 = s1) {
+    s1 = passEnd(s0);
     if (opts.cancel && opts.cancel->load()) {
       cancelled = true;
       break;

@@ -2,6 +2,9 @@
 // memory bound.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <climits>
+
 #include "render/Renderer.h"
 
 using namespace envgi;
@@ -13,10 +16,15 @@ class RecordingExecutor final : public PassExecutor {
  public:
   RecordingExecutor(int w, int h, double budget) : px_(size_t(w) * size_t(h)), budget_(budget) {}
   std::string deviceName() const override { return "recording"; }
-  void runPass(int s0, int s1, Progress&, PassCounters*) override { passes.push_back({s0, s1}); }
+  void runPass(int s0, int s1, Progress&, PassCounters*) override {
+    passes.push_back({s0, s1});
+    if (cancelAfter && passes.size() == cancelAfterPasses) cancelAfter->store(true);
+  }
   void readFilm(FilmSums* out) override { out->sum.assign(px_, Color(0.f)); }
   double maxPassPixelSamples() const override { return budget_; }
   std::vector<std::pair<int, int>> passes;
+  std::atomic<bool>* cancelAfter = nullptr;  // set (Ctrl-C) once cancelAfterPasses have run
+  size_t cancelAfterPasses = 0;
 
  private:
   size_t px_;
@@ -64,6 +72,23 @@ TEST(RenderPasses, ALargeImageTakesSmallerPasses) {
       EXPECT_LE(double(n) * 256.0, std::max(budget, 256.0)) << "pass " << i;
     }
   }
+}
+
+// --spp 2147483647 (with a time limit, or until Ctrl-C) starts at once: the passes are made
+// one at a time, where a list of all of them had overflowed int into a hang at 4 GB.
+TEST(RenderPasses, TheLargestSampleCountStartsAtOnce) {
+  RecordingExecutor ex(4, 4, 1e9);
+  std::atomic<bool> cancel{false};
+  ex.cancelAfter = &cancel;
+  ex.cancelAfterPasses = 9;
+  RenderOptions o;
+  o.progress = false;
+  o.cancel = &cancel;
+  RenderStats st;
+  renderPasses(ex, 4, 4, INT_MAX, o, &st);
+  EXPECT_TRUE(st.cancelled);
+  EXPECT_EQ(st.sppDone, 192);
+  EXPECT_EQ(ex.passes, (Passes{{0, 1}, {1, 2}, {2, 4}, {4, 8}, {8, 16}, {16, 32}, {32, 64}, {64, 128}, {128, 192}}));
 }
 
 // The default budget leaves the bundled scenes' passes as they were (320 x 320: up to 64
