@@ -25,6 +25,8 @@ bool parseFiniteNumber(const std::string& s, double& v);
 CLI::Validator atLeast(double lo);
 // Any finite number:
 CLI::Validator finiteNumber();
+// A whole number from lo to hi:
+CLI::Validator wholeNumberFrom(long long lo, long long hi);
 // --threads N on a command that renders: 0 (every core) to kMaxWorkerThreads.
 void addThreadsOption(CLI::App* c, int* threads);
 

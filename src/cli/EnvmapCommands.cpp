@@ -58,7 +58,7 @@ void addSampleOptions(CLI::App* c, SampleArgs& a) {
   addLayoutOption(c, a.layout);
   // The samples are held (and `samples` writes its CSV, ~80 bytes a sample) in memory: 2^24 of
   // them is a 1.3 GB file, and two billion had ended in std::bad_alloc.
-  c->add_option("--count,-n", a.count, "Number of samples (at most 16777216)")->check(CLI::Range(1, 1 << 24));
+  c->add_option("--count,-n", a.count, "Number of samples")->check(wholeNumberFrom(1, 1 << 24));
   c->add_option("--strategy,-s", a.strategy, strategyNameList(true) + " (cosine and product about --normal)");
   c->add_option("--normal", a.normal, "x,y,z: the surface normal, in the map's frame, for cosine and product (default 0,1,0)")
       ->expected(3)

@@ -255,7 +255,8 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("--spp", a->spp, "Samples per pixel, or passes for sppm (default: the scene's)")->check(atLeast(1));
   c->add_option("--integrator", a->integrator, "Integrator: " + nameList(kIntegratorNames) + " (overrides the scene)");
   c->add_option("--strategy", a->strategy, "Environment strategy: " + strategyNameList());
-  c->add_option("--points", a->points, "points: directional lights in the collapsed map (default 64)")->check(CLI::Range(1, kMaxCollapsedPoints));
+  c->add_option("--points", a->points, "points: directional lights in the collapsed map (default 64)")
+      ->check(wholeNumberFrom(1, kMaxCollapsedPoints));
   c->add_option("--point-method", a->pointMethod, "points: sample (Algorithm 1 draws, power L/pdf/N) | mediancut");
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
   addThreadsOption(c, &a->threads);

@@ -36,17 +36,21 @@ CLI::Validator finiteNumber() {
       "NUMBER");
 }
 
+CLI::Validator wholeNumberFrom(long long lo, long long hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& s) -> std::string {
+        double v = 0;
+        if (!parseFiniteNumber(s, v) || v != std::floor(v)) return fmt::format("'{}' is not a whole number", s);
+        if (v < double(lo) || v > double(hi)) return fmt::format("must be from {} to {}, not {}", lo, hi, s);
+        return "";
+      },
+      fmt::format("{}..{}", lo, hi));
+}
+
 void addThreadsOption(CLI::App* c, int* threads) {
-  c->add_option("--threads", *threads, "Worker threads (default: all cores)")
-      ->check(CLI::Validator(
-          [](std::string& s) -> std::string {
-            double v = 0;
-            if (!parseFiniteNumber(s, v) || v != std::floor(v)) return fmt::format("'{}' is not a whole number", s);
-            if (v < 0 || v > kMaxWorkerThreads)
-              return fmt::format("must be between 0 (every core) and {}, not {}", kMaxWorkerThreads, s);
-            return "";
-          },
-          fmt::format("0..{}", kMaxWorkerThreads)));
+  c->add_option("--threads", *threads, fmt::format("Worker threads, 0 for every core (the default), at most {}",
+                                                   kMaxWorkerThreads))
+      ->check(wholeNumberFrom(0, kMaxWorkerThreads));
 }
 
 }  // namespace envgi::cli

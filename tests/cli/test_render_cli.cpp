@@ -653,20 +653,20 @@ TEST(RenderCli, NumericOptionsOutOfRangeAreOneClearError) {
       {render + "--time-limit nan", "--time-limit: 'nan' is not a number"},
       {render + "--checkpoint -1", "--checkpoint: must be at least 0, not -1"},
       {render + "--exposure inf", "--exposure: 'inf' is not a finite number"},
-      {render + "--threads -2", "--threads: must be between 0 (every core) and 1024, not -2"},
+      {render + "--threads -2", "--threads: must be from 0 to 1024, not -2"},
       // oneTBB's arena crashed (SIGSEGV) when asked for ten million threads.
-      {render + "--threads 10000000", "--threads: must be between 0 (every core) and 1024, not 10000000"},
+      {render + "--threads 10000000", "--threads: must be from 0 to 1024, not 10000000"},
       {render + "--threads 2.5", "--threads: '2.5' is not a whole number"},
-      {render + "--points 2000000000", "--points: Value 2000000000 not in range 1 to 16777216"},
-      {"view " + scene + " --threads 1025", "--threads: must be between 0 (every core) and 1024, not 1025"},
+      {render + "--points 2000000000", "--points: must be from 1 to 16777216, not 2000000000"},
+      {"view " + scene + " --threads 1025", "--threads: must be from 0 to 1024, not 1025"},
       // Two billion map samples had ended in std::bad_alloc.
       {"envmap samples " + std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/studio.hdr -n 2000000000 -o " +
            d.file("bad.png"),
-       "--count: Value 2000000000 not in range 1 to 16777216"},
+       "--count: must be from 1 to 16777216, not 2000000000"},
       {"photons " + scene + " -o " + d.file("bad.png") + " --global -5", "--global: must be at least 0, not -5"},
       {"study " + scene + " -o " + d.file("study") + " --reference-spp 0", "--reference-spp: must be at least 1, not 0"},
       {"study " + scene + " -o " + d.file("study") + " --threads -1",
-       "--threads: must be between 0 (every core) and 1024, not -1"},
+       "--threads: must be from 0 to 1024, not -1"},
   };
   for (const Case& c : cases) {
     CliResult r = runCli(c.args);
