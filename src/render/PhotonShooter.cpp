@@ -221,7 +221,8 @@ void requirePhotonMapsFit(size_t photons, double memoryBytes) {
   if (!fitsInHalfOfMemory(bytes, memoryBytes))
     throw std::runtime_error(fmt::format(
         "photon maps of {} photons would take about {:.1f} GB, more than half of this machine's {:.1f} GB: ask for "
-        "fewer global_photons or caustic_photons",
+        "fewer photons (the integrator's global_photons and caustic_photons, or --global and --caustic on "
+        "envgi photons)",
         photons, bytes / 1e9, memoryBytes / 1e9));
 }
 

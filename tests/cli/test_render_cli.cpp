@@ -399,6 +399,9 @@ TEST(CliRender, PhotonSppmAndGridIntegrators) {
   CliResult huge = runCli("render " + d.file("huge.xml") + " -o " + d.file("huge.exr") + " --spp 1 -D res=8 --no-progress");
   EXPECT_EQ(huge.code, 1) << huge.output;
   EXPECT_NE(huge.output.find("photon maps of 2000250000 photons would take about"), std::string::npos) << huge.output;
+  // It names the settings of both commands that set the counts.
+  EXPECT_NE(huge.output.find("global_photons and caustic_photons, or --global and --caustic"), std::string::npos)
+      << huge.output;
   EXPECT_FALSE(fs::exists(d.file("huge.exr")));
   std::ofstream(d.file("bad.xml")) << R"(<scene version="3.0.0"><integrator type="sppm"><float name="alpha" value="1.5"/></integrator></scene>)";
   CliResult bad = runCli("render " + d.file("bad.xml") + " -o " + d.file("x.exr"));
