@@ -28,10 +28,8 @@ IlluminationGrid makeIlluminationGrid(const Scene& scene, int resolution) {
 
 void requireGridFits(int nx, int ny, int nz, double memoryBytes, int resolution) {
   const double bytes = double(nx) * ny * nz * double(IlluminationGrid::kBytesPerPoint);
-  if (!fitsInHalfOfMemory(bytes, memoryBytes))
-    throw std::runtime_error(fmt::format(
-        "grid: {}x{}x{} points would take {:.1f} GB, more than half of this machine's {:.1f} GB: lower `resolution` ({})",
-        nx, ny, nz, bytes / 1e9, memoryBytes / 1e9, resolution));
+  requireFitsInHalfOfMemory(bytes, memoryBytes, fmt::format("grid: {}x{}x{} points would take", nx, ny, nz),
+                            fmt::format("lower `resolution` ({})", resolution));
 }
 
 template <class Tracer>

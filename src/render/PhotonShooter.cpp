@@ -218,12 +218,9 @@ void shootPhotons(const Scene& scene, const EmbreeAccel& accel, const PhotonShoo
 
 void requirePhotonMapsFit(size_t photons, double memoryBytes) {
   const double bytes = double(photons) * double(kPhotonPeakBytes);
-  if (!fitsInHalfOfMemory(bytes, memoryBytes))
-    throw std::runtime_error(fmt::format(
-        "photon maps of {} photons would take about {:.1f} GB, more than half of this machine's {:.1f} GB: ask for "
-        "fewer photons (the integrator's global_photons and caustic_photons, or --global and --caustic on "
-        "envgi photons)",
-        photons, bytes / 1e9, memoryBytes / 1e9));
+  requireFitsInHalfOfMemory(bytes, memoryBytes, fmt::format("photon maps of {} photons would take about", photons),
+                            "ask for fewer photons (the integrator's global_photons and caustic_photons, or --global "
+                            "and --caustic on envgi photons)");
 }
 
 void logPhotonStats(const PhotonShootStats& st) {

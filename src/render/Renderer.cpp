@@ -281,11 +281,8 @@ size_t filmBytesPerPixel(const Camera& cam, const RenderOptions& opts) {
 
 void requireFilmFits(const Camera& cam, const RenderOptions& opts, double memoryBytes) {
   const double bytes = double(cam.width) * double(cam.height) * double(filmBytesPerPixel(cam, opts));
-  if (!fitsInHalfOfMemory(bytes, memoryBytes))
-    throw std::runtime_error(fmt::format(
-        "a {}x{} film would take about {:.1f} GB, more than half of this machine's {:.1f} GB: render fewer pixels "
-        "(the film's width and height)",
-        cam.width, cam.height, bytes / 1e9, memoryBytes / 1e9));
+  requireFitsInHalfOfMemory(bytes, memoryBytes, fmt::format("a {}x{} film would take about", cam.width, cam.height),
+                            "render fewer pixels (the film's width and height)");
 }
 
 Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts, RenderStats* stats) {
