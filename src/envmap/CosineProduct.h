@@ -123,11 +123,25 @@ struct CosineProductView {
     return *pdfOut > 0.f;
   }
 
-  ENVGI_HD float pdf(Vec2f uv, Vec3f nLocal) const {
+  // Where pdf() reads for (uv, nLocal): the bucket, the cell and the pixel inside the cell.
+  struct Step {
+    int k, c, j;
+  };
+  ENVGI_HD Step stepAt(Vec2f uv, Vec3f nLocal) const {
     int px = clampi(int(uv.x * float(width)), 0, width - 1), py = clampi(int(uv.y * float(height)), 0, height - 1);
     int cx = columnCell[px], cy = rowCell[py];
     int x0 = cellStartX[cx], cw = cellStartX[cx + 1] - x0;
-    return pdfUV(bucket(nLocal), cy * cellsX + cx, (py - cellStartY[cy]) * cw + (px - x0));
+    return {bucket(nLocal), cy * cellsX + cx, (py - cellStartY[cy]) * cw + (px - x0)};
+  }
+  ENVGI_HD float pdf(Vec2f uv, Vec3f nLocal) const {
+    const Step s = stepAt(uv, nLocal);
+    return pdfUV(s.k, s.c, s.j);
+  }
+  // The two cdf entries pdf(uv, nLocal) reads first, asked for ahead (CPU only).
+  void prefetchPdf(Vec2f uv, Vec3f nLocal) const {
+    const Step s = stepAt(uv, nLocal);
+    prefetchLine(bucketCdf + size_t(s.k) * (cells() + 1) + s.c);
+    prefetchLine(cellCdf + cellCdfStart[s.c] + s.j);
   }
 };
 

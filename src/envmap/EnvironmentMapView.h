@@ -108,19 +108,23 @@ struct EnvironmentMapView {
     return c * scale;
   }
 
-  // The bilinear lookup's luminance over pixel (px, py) is four bilinear patches meeting on a
-  // 3 x 3 lattice: v[j][i] at x = i / 2, y = j / 2 across the pixel (its corners, the midpoints
-  // of its edges, its centre), each the mean of the pixels around that point, wrapping in u and
-  // clamping at the poles as lookupUV does.
-  // The luminance of pixel (px, py) and its eight neighbours, l[j][i] for x = px - 1 + i and
-  // y = py - 1 + j, wrapping in u and clamping at the poles as lookupUV does.
+  // The columns xs and rows ys of pixel (px, py) and its eight neighbours, wrapping in u and
+  // clamping at the poles as lookupUV does; and their luminance, l[j][i] at (xs[i], ys[j]).
+  ENVGI_HD void neighbourhood(int px, int py, int xs[3], int ys[3]) const {
+    xs[0] = px > 0 ? px - 1 : width - 1, xs[1] = px, xs[2] = px + 1 < width ? px + 1 : 0;
+    ys[0] = py > 0 ? py - 1 : 0, ys[1] = py, ys[2] = py + 1 < height ? py + 1 : height - 1;
+  }
   ENVGI_HD void neighbourhoodLuminance(int px, int py, float l[3][3]) const {
-    int xs[3] = {px > 0 ? px - 1 : width - 1, px, px + 1 < width ? px + 1 : 0};
-    int ys[3] = {py > 0 ? py - 1 : 0, py, py + 1 < height ? py + 1 : height - 1};
+    int xs[3], ys[3];
+    neighbourhood(px, py, xs, ys);
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i)
         l[j][i] = texels[(size_t(ys[j]) * width + xs[i]) * 4 + 3];
   }
+  // The bilinear lookup's luminance over pixel (px, py) is four bilinear patches meeting on a
+  // 3 x 3 lattice: v[j][i] at x = i / 2, y = j / 2 across the pixel (its corners, the midpoints
+  // of its edges, its centre), each the mean of the pixels around that point, wrapping in u and
+  // clamping at the poles as lookupUV does.
   ENVGI_HD void pixelLattice(int px, int py, float v[3][3]) const {
     float l[3][3];
     neighbourhoodLuminance(px, py, l);
@@ -250,6 +254,21 @@ struct EnvironmentMapView {
   // pass prefetches a block of photons' bins, so that their misses overlap). Its texels were
   // tried too and cost more than they saved.
   void prefetchEmission(Vec2f u) const { prefetchLine(emission.bins + emission.column(u)); }
+
+  // Asks for what evalWithPdf(s, worldDir, normal) reads from the map (CPU only: a round of
+  // escaped rays prefetches them all before shading, so that their misses overlap): the texel
+  // rows the lookup and the in-pixel density read and, for product, its two cdf steps.
+  void prefetchEvalWithPdf(EnvStrategy s, Vec3f worldDir, Vec3f normal) const {
+    const Vec2f uv = dirToUV(toLocalUnnormalized(worldDir));
+    const PixelPoint p = pixelPoint(uv);
+    int xs[3], ys[3];
+    neighbourhood(p.x, p.y, xs, ys);
+    for (int j = 0; j < 3; ++j) {  // 16-byte texels: the middle one shares a line with one of these but at the seam
+      prefetchLine(texels + (size_t(ys[j]) * width + xs[0]) * 4);
+      prefetchLine(texels + (size_t(ys[j]) * width + xs[2]) * 4);
+    }
+    if (strategyFor(s, normal) == EnvStrategy::Product) product.prefetchPdf(uv, toLocalUnnormalized(normal));
+  }
 
   ENVGI_HD float importancePdfUV(Vec2f uv) const { return solidAnglePdf(dist.pdf(uv), uv.y); }
 

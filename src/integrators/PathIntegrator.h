@@ -103,6 +103,13 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   return depth < pp.rrDepth || russianRoulette(&st->beta, smp.get1D(), kRouletteMaxSurvival, st->etaScale);
 }
 
+// What pathShade will read from the map for a path whose ray escaped, asked for ahead (CPU
+// only: renderTileByBounce prefetches a round's escapes before shading it).
+inline void pathPrefetchEscape(const SceneView& sc, const PathState& st, const PathParams& pp) {
+  if (sc.hasEnvironment && !st.prevDelta && envSeenByBsdfSampling(pp.envStrategy, false))
+    sc.env.prefetchEvalWithPdf(pp.envStrategy, st.ray.d, st.prevAxis);
+}
+
 // One bounce of the path: trace st->ray, then pathShade.
 template <class Tracer>
 ENVGI_HD bool pathStep(const SceneView& sc, const Tracer& tracer, PathState* st, Sampler& smp, const PathParams& pp,

@@ -50,6 +50,8 @@ struct SampleIntegrator {
   ENVGI_HD bool shade(PathState* st, bool found, const Hit& h, Sampler& smp, const Shadow& shadow) const {
     return pathShade(*scene, st, found, h, smp, path, shadow);
   }
+  // What shade() will read for a path whose ray escaped, asked for ahead (CPU only).
+  void prefetchEscape(const PathState& st) const { pathPrefetchEscape(*scene, st, path); }
 };
 
 // Integrators that run one bounce a call, so regeneratePaths and renderTileByBounce can drive
@@ -265,13 +267,17 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       }
       counters->rays += uint64_t(live);
       // Ask for the hit triangles' indices, then their vertices, for the whole round before
-      // shading it, so that interaction()'s misses overlap instead of following one another.
+      // shading it, so that interaction()'s misses overlap instead of following one another;
+      // likewise the map's texels and cdf steps that the escaped rays' MIS weights read.
       // Then shade, then trace the round's shadow rays back to back, each adding what got
       // through before anything later in its path, as pathStep adds it.
       for (int i = 0; i < live; ++i)
         if (b->found[b->active[i]]) integ.scene->prefetchTriangle(b->hit[b->active[i]]);
       for (int i = 0; i < live; ++i)
         if (b->found[b->active[i]]) integ.scene->prefetchVertices(b->hit[b->active[i]]);
+      if (!cameraRays)
+        for (int i = 0; i < live; ++i)
+          if (!b->found[b->active[i]]) integ.prefetchEscape(b->state[b->active[i]]);
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];
         b->ld[k].needsRay = false;
