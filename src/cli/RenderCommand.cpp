@@ -145,7 +145,7 @@ void runRender(const RenderArgs& a) {
   RenderOptions ro;
   ro.spp = a.spp;
   ro.threads = a.threads;
-  ro.progress = !a.noProgress;
+  ro.progress = !a.noProgress && spdlog::should_log(spdlog::level::info);  // -q: errors and warnings only, as pbrt's --quiet
   ro.checkpointSeconds = a.checkpoint;
   ro.checkpoint = [&](const Image& img, int done) {
     write(img);

@@ -17,7 +17,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("envgi ") + ENVGI_VERSION);
   bool verbose = false, quiet = false;
   app.add_flag("-v,--verbose", verbose, "Debug logging");
-  app.add_flag("-q,--quiet", quiet, "Warnings and errors only");
+  app.add_flag("-q,--quiet", quiet, "Warnings and errors only (no progress bar)");
   app.parse_complete_callback([&] {
     spdlog::set_pattern("[%^%l%$] %v");
     spdlog::set_level(verbose ? spdlog::level::debug : (quiet ? spdlog::level::warn : spdlog::level::info));

@@ -563,8 +563,8 @@ TEST(RenderCli, DeviceChoice) {
   }
 }
 
-// The log flags work before or after the subcommand: -q leaves warnings and errors only, -v is
-// accepted there too.
+// The log flags work before or after the subcommand: -q leaves warnings and errors only (no
+// progress bar either), -v is accepted there too.
 TEST(RenderCli, LogFlagsBeforeOrAfterTheSubcommand) {
   TempDir d;
   std::string scene = tinyScene(d, 8, 1);
@@ -574,6 +574,10 @@ TEST(RenderCli, LogFlagsBeforeOrAfterTheSubcommand) {
     EXPECT_EQ(r.code, 0) << args << ": " << r.output;
     EXPECT_EQ(r.output.find("[info]"), std::string::npos) << args << ": " << r.output;
   }
+  // -q without --no-progress: nothing at all on a clean render, the progress bar included.
+  CliResult quiet = runCli("-q render " + scene + " -o " + d.file("q.exr"));
+  EXPECT_EQ(quiet.code, 0) << quiet.output;
+  EXPECT_EQ(quiet.output, "");
   CliResult loud = runCli("render " + scene + " -o " + d.file("c.exr") + " --no-progress --verbose");
   EXPECT_EQ(loud.code, 0) << loud.output;
   EXPECT_NE(loud.output.find("[info]"), std::string::npos) << loud.output;
