@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <memory>
 #include <stdexcept>
 
@@ -90,6 +91,13 @@ void runInfo(const std::string& path, const std::string& layout) {
 }
 
 void runSamples(const SampleArgs& a) {
+  // A CSV in a file named as an image is a slip (any other name is the user's choice).
+  const std::string ext = std::filesystem::path(a.out).extension().string();
+  for (const char* image : {".png", ".jpg", ".jpeg", ".exr", ".hdr", ".pfm", ".tif", ".tiff", ".bmp"})
+    if (ext == image)
+      throw std::runtime_error(fmt::format("output '{}' names an image, but samples writes CSV (u,v,x,y,z,pdf): name it .csv",
+                                           a.out));
+  requireWritableDirectoryOf(a.out);
   EnvironmentMap env = EnvironmentMap::loadLayout(a.map, a.layout, mapOptions(a));
   std::vector<EnvSample> samples = drawSamples(env, a);
   std::string csv = "u,v,x,y,z,pdf\n";
@@ -104,6 +112,7 @@ void runSamples(const SampleArgs& a) {
 }
 
 void runPlot(const SampleArgs& a, float exposure) {
+  requireOutputExtension(a.out, {".png", ".jpg", ".exr", ".hdr", ".pfm"}, "output");
   EnvironmentMap env = EnvironmentMap::loadLayout(a.map, a.layout, mapOptions(a));
   std::vector<EnvSample> samples = drawSamples(env, a);
   Image img = env.image();
@@ -145,6 +154,8 @@ struct ConvertArgs {
 
 void runConvert(const ConvertArgs& a) {
   ProbeLayout layout = parseProbeLayout(a.layout);
+  // A map to light scenes with keeps its HDR values: not tone-mapped into a .png or .jpg.
+  requireOutputExtension(a.out, {".exr", ".hdr", ".pfm"}, "output");
   Image probe = loadImage(a.probe);
   ProbeConversion c;
   c.width = a.width;
@@ -172,14 +183,14 @@ void addEnvmapCommands(CLI::App& app) {
   auto sa = std::make_shared<SampleArgs>();
   CLI::App* samples = env->add_subcommand("samples", "Write samples as CSV: u,v,x,y,z,pdf (map frame, solid angle)");
   addSampleOptions(samples, *sa);
-  samples->add_option("-o,--output", sa->out, "CSV file")->required();
+  samples->add_option("-o,--output", sa->out, "CSV file (any name but an image's)")->required();
   samples->callback([sa] { runSamples(*sa); });
 
   auto pa = std::make_shared<SampleArgs>();
   auto exposure = std::make_shared<float>(NAN);
   CLI::App* plot = env->add_subcommand("plot", "The paper's Figure 2: the map with its samples drawn on it");
   addSampleOptions(plot, *pa);
-  plot->add_option("-o,--output", pa->out, "Image (.png)")->required();
+  plot->add_option("-o,--output", pa->out, "Image (.png, .jpg, .exr, .hdr, .pfm)")->required();
   plot->add_option("--exposure", *exposure, "Exposure in stops (default: automatic)")->check(finiteNumber());
   plot->callback([pa, exposure] { runPlot(*pa, *exposure); });
 

@@ -25,9 +25,7 @@ struct PhotonsArgs {
 
 void runPhotons(const PhotonsArgs& a) {
   std::map<std::string, std::string> defs = parseDefines(a.defines);
-  std::string ext = std::filesystem::path(a.output).extension().string();
-  if (ext != ".png" && ext != ".exr") throw std::runtime_error("output '" + a.output + "' must end in .png or .exr");
-  requireWritableDirectoryOf(a.output);  // before the photons are shot
+  const std::string ext = requireOutputExtension(a.output, {".png", ".exr"}, "output");  // before the photons are shot
   Scene scene;
   loadScene(a.scene, defs, scene);
   scene.integrator = IntegratorSettings{};

@@ -70,11 +70,7 @@ void runRender(const RenderArgs& a) {
   namespace fs = std::filesystem;
   // Both images are checked before the render, so a bad name or folder cannot cost its samples.
   auto requireImageName = [](const std::string& path, const std::string& what) {
-    std::string e = fs::path(path).extension().string();
-    if (e != ".exr" && e != ".pfm" && e != ".hdr" && e != ".png")
-      throw std::runtime_error(what + " '" + path + "' must end in .exr, .pfm, .hdr or .png");
-    requireWritableDirectoryOf(path);
-    return e;
+    return requireOutputExtension(path, {".exr", ".pfm", ".hdr", ".png"}, what);
   };
   std::string ext = requireImageName(a.output, "output");
   if (!a.sampleMap.empty()) requireImageName(a.sampleMap, "--sample-map");

@@ -1,10 +1,15 @@
 // Option checks for the command line (cli/Commands.h).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
+#include <filesystem>
+#include <stdexcept>
+
 #include "cli/Commands.h"
+#include "core/Files.h"
 #include "render/WorkerThreads.h"
 
 namespace envgi::cli {
@@ -51,6 +56,19 @@ void addThreadsOption(CLI::App* c, int* threads) {
   c->add_option("--threads", *threads, fmt::format("Worker threads, 0 for every core (the default), at most {}",
                                                    kMaxWorkerThreads))
       ->check(wholeNumberFrom(0, kMaxWorkerThreads));
+}
+
+std::string requireOutputExtension(const std::string& path, const std::vector<std::string>& allowed,
+                                   const std::string& what) {
+  const std::string e = std::filesystem::path(path).extension().string();
+  if (std::find(allowed.begin(), allowed.end(), e) == allowed.end()) {
+    std::string list;
+    for (size_t i = 0; i < allowed.size(); ++i)
+      list += (i == 0 ? "" : i + 1 == allowed.size() ? " or " : ", ") + allowed[i];
+    throw std::runtime_error(fmt::format("{} '{}' must end in {}", what, path, list));
+  }
+  requireWritableDirectoryOf(path);
+  return e;
 }
 
 }  // namespace envgi::cli

@@ -1,4 +1,5 @@
 // End-to-end tests of the envgi command line: outputs, exit codes and error lines.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <array>
@@ -261,4 +262,35 @@ TEST(CliEnvmap, ErrorsAreOneLineAndLeaveNoFile) {
   CliResult count = runCli("envmap samples " + bundledMap() + " --count -4 -o " + out);
   EXPECT_NE(count.code, 0);
   EXPECT_FALSE(fs::exists(out));
+}
+
+// An output whose name says another kind of file is refused before any work: samples' CSV in a
+// file named as an image, a plot in a format envgi does not write, and a converted map in a
+// tone-mapped .png or .jpg, which would lose the HDR values that light a scene (it was written).
+TEST(CliEnvmap, AnOutputNamedAsTheWrongKindOfFileIsRefused) {
+  TempDir d;
+  const std::string probe = std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/uffizi_probe_128.exr";
+  struct Case {
+    std::string args, file, message;
+  };
+  const Case cases[] = {
+      {"envmap samples " + bundledMap() + " --count 5", "s.png", "names an image, but samples writes CSV"},
+      {"envmap plot " + bundledMap() + " --count 5", "p.tif", "must end in .png, .jpg, .exr, .hdr or .pfm"},
+      {"envmap convert " + probe + " --width 64", "c.jpg", "must end in .exr, .hdr or .pfm"},
+      {"envmap convert " + probe + " --width 64", "c.png", "must end in .exr, .hdr or .pfm"},
+  };
+  for (const Case& c : cases) {
+    CliResult r = runCli(c.args + " -o " + d.file(c.file));
+    EXPECT_EQ(r.code, 1) << c.args << ": " << r.output;
+    const std::string expected = fmt::format("envgi: error: output '{}' {}", d.file(c.file), c.message);
+    EXPECT_NE(r.output.find(expected), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(d.file(c.file))) << c.file;
+  }
+  // What they do write: a CSV under a name without .csv, a plot as .exr, a map as .hdr.
+  for (const std::string& ok : {"envmap samples " + bundledMap() + " --count 5 -o " + d.file("s"),
+                                "envmap plot " + bundledMap() + " --count 5 -o " + d.file("p.exr"),
+                                "envmap convert " + probe + " --width 64 -o " + d.file("c.hdr")}) {
+    CliResult r = runCli(ok);
+    EXPECT_EQ(r.code, 0) << ok << ": " << r.output;
+  }
 }
