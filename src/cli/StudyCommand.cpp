@@ -18,6 +18,7 @@
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
 #include "core/Files.h"
+#include "envmap/CollapsedMap.h"
 #include "gpu/CudaExecutor.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
@@ -61,18 +62,25 @@ std::vector<double> positiveNumbers(const std::string& list, const std::string& 
   return out;
 }
 
+// A run's largest sample count: a render's pass arithmetic is in int.
+constexpr long long kMaxStudySpp = 2147483647;
+
 // A strategy name of the study: a render strategy, or points-N (the collapsed map with N
 // lights), each with its own sample counts (setStrategy) whatever the scene file asked for.
 void applyStrategy(const std::string& name, Scene& scene) {
   if (name.rfind("points-", 0) == 0) {
-    int n = 0;
+    long long n = 0;
     try {
-      n = std::stoi(name.substr(7));
+      size_t used = 0;
+      n = std::stoll(name.substr(7), &used);
+      if (used != name.size() - 7) n = 0;
     } catch (...) {
     }
-    if (n < 1) throw std::runtime_error("strategy '" + name + "': points-N needs a positive N");
+    if (n < 1 || n > kMaxCollapsedPoints)
+      throw std::runtime_error(
+          fmt::format("strategy '{}': points-N needs a whole N from 1 to {}", name, kMaxCollapsedPoints));
     scene.integrator.setStrategy("points");
-    scene.integrator.env.pointCount = n;
+    scene.integrator.env.pointCount = int(n);
     return;
   }
   if (findStrategy(name).env == EnvStrategy::Points)
@@ -197,6 +205,14 @@ nlohmann::json checkStudyFolder(const StudyArgs& a) {
   return now;
 }
 
+// A reference the runs can be measured against: finite, and the size the scene renders.
+void checkReference(const Image& ref, const std::string& path, const Scene& scene) {
+  if (nonFiniteValues(ref) > 0) throw std::runtime_error("reference '" + path + "' has NaN or infinite pixels");
+  if (scene.camera.width != ref.width || scene.camera.height != ref.height)
+    throw std::runtime_error(fmt::format("reference '{}' is {}x{}, the scene renders {}x{}", path, ref.width,
+                                         ref.height, scene.camera.width, scene.camera.height));
+}
+
 void runStudy(const StudyArgs& a) {
   auto t0 = std::chrono::steady_clock::now();
   std::vector<std::string> strategies = splitList(a.strategies);
@@ -204,12 +220,13 @@ void runStudy(const StudyArgs& a) {
   std::vector<int> sppList;
   for (double v : sppValues) {
     if (v != std::floor(v)) throw std::runtime_error("--spp: '" + fmt::format("{}", v) + "' is not a positive sample count");
+    if (v > double(kMaxStudySpp))  // it wrapped round to a negative count, and the runs went ahead
+      throw std::runtime_error(fmt::format("--spp: {:.0f} is more than {} samples a pixel", v, kMaxStudySpp));
     sppList.push_back(int(v));
   }
   std::vector<double> times = positiveNumbers(a.times, "--time", "a positive number of seconds");
   if (strategies.empty()) throw std::runtime_error("--strategies is empty");
   if (sppList.empty()) throw std::runtime_error("--spp is empty");
-  if (a.seeds < 1) throw std::runtime_error("--seeds must be at least 1");
   if (a.noiseThreshold > 0.f) {
     spdlog::info("study: adaptive sampling in every run, noise threshold {:g} from {} spp", a.noiseThreshold, a.minSpp);
     if (a.minSpp >= sppList.back())
@@ -230,16 +247,28 @@ void runStudy(const StudyArgs& a) {
     prepare = gpu::cudaPreparer(a.gpu);
     spdlog::info("study: rendering on cuda:{} ({})", a.gpu, gpu::deviceName(a.gpu));
   }
-  fs::create_directories(a.out + "/runs");
+  // A given reference is read and checked before the folder is made, so that a wrong one leaves
+  // nothing behind.
+  Image ref;
+  if (!a.reference.empty()) {
+    ref = loadImage(a.reference);
+    checkReference(ref, a.reference, scene);
+  }
+  std::error_code made;
+  fs::create_directories(a.out + "/runs", made);
+  if (made)
+    throw std::runtime_error(fmt::format("cannot make the study's folder '{}/runs': {}", a.out,
+                                         fs::exists(a.out) && !fs::is_directory(a.out) ? "'" + a.out + "' is a file" : made.message()));
   std::string probe = a.out + "/.write_test";
   writeFileAtomically(probe, "ok");  // an unwritable folder fails here, before any rendering
   fs::remove(probe);
   nlohmann::json settings = checkStudyFolder(a);
 
   // The reference: given, or rendered once (and reused by a re-run).
-  Image ref;
   std::string refPath = a.reference.empty() ? a.out + "/reference.exr" : a.reference;
-  if (!a.reference.empty() || fs::exists(refPath)) {
+  if (!a.reference.empty()) {
+    spdlog::info("study: reference {}", refPath);
+  } else if (fs::exists(refPath)) {
     ref = loadImage(refPath);
     spdlog::info("study: reference {}", refPath);
   } else {
@@ -249,10 +278,7 @@ void runStudy(const StudyArgs& a) {
     saveImage(ref, refPath);
     spdlog::info("study: reference done in {:.1f} s", r.seconds);
   }
-  if (nonFiniteValues(ref) > 0) throw std::runtime_error("reference '" + refPath + "' has NaN or infinite pixels");
-  if (scene.camera.width != ref.width || scene.camera.height != ref.height)
-    throw std::runtime_error(fmt::format("reference '{}' is {}x{}, the scene renders {}x{}", refPath, ref.width,
-                                         ref.height, scene.camera.width, scene.camera.height));
+  checkReference(ref, refPath, scene);
   writeFileAtomically(a.out + "/study.json", settings.dump(2));
 
   std::vector<StudyRun> plan;
@@ -340,7 +366,8 @@ void addStudyCommand(CLI::App& app) {
   c->add_option("--strategies", a->strategies, "Comma-separated: uniform,cosine,bsdf,importance,alias,adaptive,mis,product,points-N");
   c->add_option("--spp", a->spp, "Comma-separated sample counts (default 1,4,16,64,256)");
   c->add_option("--time", a->times, "Comma-separated time budgets in seconds for equal-time runs");
-  c->add_option("--seeds", a->seeds, "Seeds per configuration (default 2)");
+  // Each seed is one more run of every configuration; 10^8 of them had ended in std::bad_alloc.
+  c->add_option("--seeds", a->seeds, "Seeds per configuration (default 2), at most 1000")->check(wholeNumberFrom(1, 1000));
   c->add_option("--reference", a->reference, "Reference image (.exr); default: rendered with mis");
   c->add_option("--reference-spp", a->referenceSpp, "Samples for the rendered reference (default 4096)")->check(atLeast(1));
   c->add_option("--integrator", a->integrator, "direct (default) or path");

@@ -160,10 +160,19 @@ TEST(StudyCli, BadInputIsOneErrorLine) {
   expectError("--time 0", "not a positive number of seconds");
   expectError("--time 1,inf", "--time: 'inf' is not a positive number of seconds");  // was taken, then cast to int
   expectError("--spp 4,1e999", "--spp: '1e999' is not a positive sample count");
-  expectError("--seeds 0", "--seeds must be at least 1");
+  expectError("--spp 4,99999999999", "--spp: 99999999999 is more than 2147483647 samples a pixel");  // ran at -2^31
+  EXPECT_FALSE(fs::exists(d.file("s")));
   expectError("--integrator photon", "--integrator must be direct or path");
   expectError("--strategies points", "name its size, points-N");
-  expectError("--strategies points-0", "points-N needs a positive N");
+  expectError("--strategies points-0", "points-N needs a whole N from 1 to 16777216");
+  expectError("--strategies points-99999999999", "points-N needs a whole N from 1 to 16777216");
+  expectError("--strategies points-12x", "points-N needs a whole N from 1 to 16777216");
+  // --seeds is an option's range: exit 2 (10^8 seeds had ended in std::bad_alloc).
+  for (const char* seeds : {"0", "100000000"}) {
+    CliResult r = runCli("study " + buddha() + " -o " + d.file("s") + " -D res=16 --seeds " + seeds);
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(r.output.find(std::string("--seeds: must be from 1 to 1000, not ") + seeds), std::string::npos) << r.output;
+  }
   // A reference of the wrong size.
   CliResult ok = runCli("render " + buddha() + " -o " + d.file("ref.exr") + " -D res=8 --spp 1 --no-progress");
   ASSERT_EQ(ok.code, 0) << ok.output;
@@ -172,8 +181,16 @@ TEST(StudyCli, BadInputIsOneErrorLine) {
   nan.rgb[5] = NAN;
   envgi::saveImage(nan, d.file("nan.pfm"));
   expectError("--reference " + d.file("nan.pfm"), "has NaN or infinite pixels");
+  expectError("--reference " + d.file("missing.exr"), "cannot open image");
+  // A given reference is checked before the study's folder is made: a wrong one leaves none.
+  EXPECT_FALSE(fs::exists(d.file("s"))) << "the folder of a study that never started";
   CliResult unwritable = runCli("study " + buddha() + " -o /proc/envgi_study -D res=16");
   EXPECT_EQ(unwritable.code, 1) << unwritable.output;
+  EXPECT_NE(unwritable.output.find("cannot make the study's folder '/proc/envgi_study/runs'"), std::string::npos)
+      << unwritable.output;
+  CliResult file = runCli("study " + buddha() + " -o " + d.file("ref.exr") + " -D res=16 --reference-spp 4");
+  EXPECT_EQ(file.code, 1) << file.output;
+  EXPECT_NE(file.output.find("'" + d.file("ref.exr") + "' is a file"), std::string::npos) << file.output;
 }
 
 // --device as `render` takes it: auto falls back to the CPU where there is no GPU; cuda there is
