@@ -129,6 +129,31 @@ TEST(MeshIO, ObjAndErrors) {
   EXPECT_THROW(loadObj(d.file("missing.obj")), std::runtime_error);
 }
 
+// tinyobjloader reads a number it cannot parse, and a coordinate that is missing, as 0: such a
+// line moved its vertex to the origin without a word. Now it is an error naming the line.
+TEST(MeshIO, ObjNumbersThatAreNotNumbersAreErrors) {
+  test::TempDir d;
+  const std::string face = "f 1 2 3\n";
+  const std::pair<std::string, std::string> bad[] = {
+      {"v 0 0 0\nv 1 0 abc\nv 0 1 0\n", "line 2: 'abc' is not a finite number"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 nan\n", "line 3: 'nan' is not a finite number"},
+      {"v 0 0 1e999\nv 1 0 0\nv 0 1 0\n", "line 1: '1e999' is not a finite number"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1\n", "line 3: v needs 3 coordinates, it has 2"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 1\n", "line 4: vn needs 3 coordinates, it has 2"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt\n", "line 4: vt needs 1 coordinate, it has 0"},
+      {"v 0 0 0\nv 1 0 0\nv 0 1 +-1\n", "line 3: '+-1' is not a finite number"},
+  };
+  for (const auto& [text, message] : bad) {
+    write(d.file("bad.obj"), text + face);
+    expectError([&] { loadObj(d.file("bad.obj")); }, message);
+  }
+  // What OBJ writers do write: a '+', a w, a comment after the numbers, CRLF, a "vp" line.
+  write(d.file("ok.obj"), "v +0 0 0 # origin\r\nv 1 0 0 1.0\r\nv 0 1 -0.0\r\nvt 0.5\r\nvp 0.1 0.2\r\n" + face);
+  TriangleMesh m = loadObj(d.file("ok.obj"));
+  EXPECT_EQ(m.triangleCount(), 1u);
+  EXPECT_EQ(m.positions[1].x, 1.f);
+}
+
 TEST(MeshIO, SharedAssetsLoad) {
   std::string buddha = std::string(ENVGI_ASSETS_DIR) + "/meshes/happy_buddha/happy_buddha_100k.ply";
   std::string dragon = std::string(ENVGI_ASSETS_DIR) + "/meshes/dragon/dragon_vrip.ply";
