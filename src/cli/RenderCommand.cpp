@@ -73,7 +73,13 @@ void runRender(const RenderArgs& a) {
     return requireOutputExtension(path, {".exr", ".pfm", ".hdr", ".png"}, what);
   };
   std::string ext = requireImageName(a.output, "output");
-  if (!a.sampleMap.empty()) requireImageName(a.sampleMap, "--sample-map");
+  if (!a.sampleMap.empty()) {
+    requireImageName(a.sampleMap, "--sample-map");
+    // Written after the image, it would replace it (or the PNG beside it) without a word.
+    const fs::path map = fs::weakly_canonical(a.sampleMap), out = fs::weakly_canonical(a.output);
+    if (map == out || (a.png && map == fs::path(out).replace_extension(".png")))
+      throw std::runtime_error("--sample-map '" + a.sampleMap + "' would overwrite the rendered image: give it a name of its own");
+  }
   auto t0 = std::chrono::steady_clock::now();
   Scene scene;
   loadScene(a.scene, parseDefines(a.defines), scene);
@@ -253,10 +259,12 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("--strategy", a->strategy, "Environment strategy: " + strategyNameList());
   c->add_option("--points", a->points, "points: directional lights in the collapsed map (default 64)")
       ->check(wholeNumberFrom(1, kMaxCollapsedPoints));
-  c->add_option("--point-method", a->pointMethod, "points: sample (Algorithm 1 draws, power L/pdf/N) | mediancut");
+  c->add_option("--point-method", a->pointMethod, "points: sample (Algorithm 1 draws, power L/pdf/N) | mediancut")
+      ->check(CLI::IsMember({"sample", "mediancut"}));  // Scene::finalize checks it only where a map is collapsed
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");
   addThreadsOption(c, &a->threads);
-  c->add_option("--seed", a->seed, "Sampler seed (overrides the scene)")->check(atLeast(0));
+  // The sampler's seed is 32 bits: a larger one had been cut to its low bits without a word.
+  c->add_option("--seed", a->seed, "Sampler seed (overrides the scene)")->check(wholeNumberFrom(0, 4294967295LL));
   c->add_flag("--png", a->png, "Also write a tonemapped PNG beside the output");
   c->add_option("--exposure", a->exposure, "Exposure in stops for 8-bit output")->check(finiteNumber());
   c->add_flag("--aces", a->aces, "ACES-style tone curve for 8-bit output");

@@ -665,6 +665,9 @@ TEST(RenderCli, NumericOptionsOutOfRangeAreOneClearError) {
       {render + "--threads 10000000", "--threads: must be from 0 to 1024, not 10000000"},
       {render + "--threads 2.5", "--threads: '2.5' is not a whole number"},
       {render + "--points 2000000000", "--points: must be from 1 to 16777216, not 2000000000"},
+      // The seed is 32 bits (a larger one was cut short); a misspelt point method was ignored.
+      {render + "--seed 99999999999", "--seed: must be from 0 to 4294967295, not 99999999999"},
+      {render + "--strategy points --point-method median", "--point-method: median not in {sample,mediancut}"},
       {"view " + scene + " --threads 1025", "--threads: must be from 0 to 1024, not 1025"},
       // Two billion map samples had ended in std::bad_alloc.
       {"envmap samples " + std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/studio.hdr -n 2000000000 -o " +
@@ -682,6 +685,25 @@ TEST(RenderCli, NumericOptionsOutOfRangeAreOneClearError) {
   }
   EXPECT_FALSE(fs::exists(d.file("bad.png")));
   EXPECT_FALSE(fs::exists(d.file("study")));
+}
+
+// --sample-map is written after the image: named as the image, or as the PNG beside it, it
+// would have replaced it. Refused before the render.
+TEST(RenderCli, ASampleMapCannotOverwriteTheImage) {
+  TempDir d;
+  std::string scene = tinyScene(d, 8, 2);
+  for (const std::string& extra : {" -o " + d.file("a.exr") + " --sample-map " + d.file("a.exr"),
+                                   " -o " + d.file("b.exr") + " --png --sample-map " + d.file("b.png")}) {
+    CliResult r = runCli("render " + scene + extra + " --no-progress");
+    EXPECT_EQ(r.code, 1) << extra << ": " << r.output;
+    EXPECT_NE(r.output.find("would overwrite the rendered image"), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(fs::exists(d.file("a.exr")));
+  EXPECT_FALSE(fs::exists(d.file("b.exr")));
+  CliResult ok = runCli("render " + scene + " -o " + d.file("c.exr") + " --png --sample-map " + d.file("c-samples.png") +
+                        " --no-progress");
+  EXPECT_EQ(ok.code, 0) << ok.output;
+  EXPECT_TRUE(fs::exists(d.file("c.png")) && fs::exists(d.file("c-samples.png")));
 }
 
 // compare: an image against itself has no error, a noisier one has some, a wrong size is one
