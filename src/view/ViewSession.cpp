@@ -10,6 +10,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "core/PhysicalMemory.h"
 #include "render/ActivePixels.h"
 #include "scene/NameTables.h"
 
@@ -314,12 +315,14 @@ void ViewSession::run() {
         if (pr.executor && s.noiseThreshold > 0.f && scene_->integrator.type != IntegratorType::Sppm &&
             !pr.executor->keepsVariance())
           pr = PreparedRender{};
+        RenderOptions ro;
+        ro.progress = false;
+        ro.threads = opts_.threads;
+        ro.spp = opts_.maxSpp;
+        ro.noiseThreshold = s.noiseThreshold;
+        // Twice a large scene's resolution had resized the film past the machine's memory.
+        requireFilmFits(scene_->view().camera, ro, opts_.memoryBytes > 0.0 ? opts_.memoryBytes : physicalMemoryBytes());
         if (!pr.executor || !pr.executor->restart(scene_->view().camera)) {
-          RenderOptions ro;
-          ro.progress = false;
-          ro.threads = opts_.threads;
-          ro.spp = opts_.maxSpp;
-          ro.noiseThreshold = s.noiseThreshold;
           auto tp = Clock::now();
           pr = PreparedRender{};  // free the old executor's maps first
           pr = opts_.prepare ? opts_.prepare(*scene_, *accel_, ro) : prepareRender(*scene_, *accel_, ro);

@@ -35,6 +35,9 @@ struct ViewOptions {
   float noiseThreshold = 0.f;
   int adaptiveMinSpp = 16;
   int jpegQuality = 85;
+  // The memory a film must fit in half of (requireFilmFits); 0: this machine's. A restart at
+  // another resolution resizes the film without prepareRender, so the session checks it itself.
+  double memoryBytes = 0.0;
 };
 
 class ViewSession {

@@ -394,3 +394,32 @@ TEST(ViewSession, ACropWindowKeepsItsPartOfTheViewAtAnyResolution) {
   EXPECT_NEAR(meanOfImage(half), expected, 0.02);
   session->stop();
 }
+
+// The page's resolution control restarts the executor at up to twice the scene's size, which
+// resized the film without prepareRender's memory check. A film that would not fit is now an
+// error frame that leaves the viewer running, and the scale the film fits at renders again.
+TEST(ViewSession, AResolutionWhoseFilmCannotFitIsAnError) {
+  test::TempDir d;
+  Sink sink;
+  ViewOptions vo;
+  // The ball scene is 24 x 16: its film (41 bytes a pixel) fits in half of 64 kB at scale 1,
+  // not at scale 2 (4 times the pixels).
+  vo.memoryBytes = 64.0 * 1024.0;
+  auto session = makeSession(d.path.string(), sink, vo, 4);
+  ASSERT_FALSE(frameWhere(*session, sink, [](const json& m) { return m["type"] == "frame" && m["spp"] == 4; }).is_null());
+  size_t n;
+  {
+    std::lock_guard<std::mutex> l(sink.m);
+    n = sink.frames.size();
+  }
+  EXPECT_EQ(session->handle(R"({"type":"resolution","scale":2})"), "");
+  json err = sink.waitFor(n);
+  ASSERT_FALSE(err.is_null());
+  EXPECT_EQ(err["type"], "error") << err.dump();
+  EXPECT_NE(err["message"].get<std::string>().find("a 48x32 film would take about"), std::string::npos) << err.dump();
+  EXPECT_EQ(session->handle(R"({"type":"resolution","scale":1})"), "");
+  json f = frameWhere(*session, sink, [](const json& m) { return m["type"] == "frame" && m["spp"] == 4; });
+  ASSERT_FALSE(f.is_null());
+  EXPECT_EQ(f["width"], 24);
+  session->stop();
+}
