@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -253,6 +254,7 @@ void runStudy(const StudyArgs& a) {
   if (!a.reference.empty()) {
     ref = loadImage(a.reference);
     checkReference(ref, a.reference, scene);
+    spdlog::info("study: reference {}", a.reference);
   }
   std::error_code made;
   fs::create_directories(a.out + "/runs", made);
@@ -266,19 +268,18 @@ void runStudy(const StudyArgs& a) {
 
   // The reference: given, or rendered once (and reused by a re-run).
   std::string refPath = a.reference.empty() ? a.out + "/reference.exr" : a.reference;
-  if (!a.reference.empty()) {
-    spdlog::info("study: reference {}", refPath);
-  } else if (fs::exists(refPath)) {
+  if (a.reference.empty() && fs::exists(refPath)) {
     ref = loadImage(refPath);
+    checkReference(ref, refPath, scene);
     spdlog::info("study: reference {}", refPath);
-  } else {
+  } else if (a.reference.empty()) {
     spdlog::info("study: rendering the reference, mis at {} spp", a.referenceSpp);
     Rendered r = renderOnce(a, scene, accel, prepare, "mis", a.referenceSpp, 1000003u, true);
     ref = r.image;
     saveImage(ref, refPath);
     spdlog::info("study: reference done in {:.1f} s", r.seconds);
+    checkReference(ref, refPath, scene);
   }
-  checkReference(ref, refPath, scene);
   writeFileAtomically(a.out + "/study.json", settings.dump(2));
 
   std::vector<StudyRun> plan;
@@ -315,7 +316,8 @@ void runStudy(const StudyArgs& a) {
     if (!reuse) {
       if (r.timeBudget > 0) {
         double sps = secondsPerSpp.count(r.strategy) ? secondsPerSpp[r.strategy] : 0.0;
-        r.spp = sps > 0 ? std::max(1, int(r.timeBudget / sps)) : 1;
+        // Clamped before the cast: a budget of 1e12 s made a count past int's range (undefined).
+        r.spp = sps > 0 ? int(std::clamp(r.timeBudget / sps, 1.0, double(kMaxStudySpp))) : 1;
       }
       spdlog::info("study: [{}/{}] {} {} seed {}", done, plan.size(), r.strategy,
                    r.timeBudget > 0 ? fmt::format("{} s ({} spp)", r.timeBudget, r.spp) : fmt::format("{} spp", r.spp),
