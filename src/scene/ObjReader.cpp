@@ -1,6 +1,7 @@
 #include <fmt/format.h>
 #include <tiny_obj_loader.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -14,40 +15,41 @@ namespace envgi {
 
 namespace {
 
-// tinyobjloader reads a number it cannot parse ("abc", "nan", "1e999") as 0 and a missing
-// coordinate as 0, so a garbled vertex line moved the vertex to the origin without a word.
-// Its v, vn and vt lines are checked here first: each coordinate a finite number, at least
-// three for v and vn, one for vt.
-void checkObjNumbers(const std::string& path) {
+// tinyobjloader reads a number it cannot parse ("abc", "nan", "1e999") and a missing coordinate
+// as 0, so a garbled vertex line moved the vertex to the origin without a word; and it drops a
+// face of fewer than three vertices. Those lines are checked here first: v, vn and vt take
+// finite numbers, at least three for v and vn and one for vt, and f at least three vertices.
+void checkObjLines(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
   if (!f) throw std::runtime_error("cannot open OBJ file '" + path + "'");
   std::string line;
   for (size_t lineNo = 1; std::getline(f, line); ++lineNo) {
-    size_t i = line.find_first_not_of(" \t");
-    if (i == std::string::npos || line[i] != 'v') continue;
-    size_t k = i + 1;
-    const bool normal = k < line.size() && line[k] == 'n', uv = k < line.size() && line[k] == 't';
-    if (normal || uv) ++k;
-    if (k < line.size() && line[k] != ' ' && line[k] != '\t' && line[k] != '\r') continue;  // "vp" and the like
+    size_t k = line.find_first_not_of(" \t");
+    if (k == std::string::npos) continue;
+    const size_t tagEnd = std::min(line.find_first_of(" \t\r", k), line.size());
+    const std::string tag = line.substr(k, tagEnd - k);
+    if (tag != "v" && tag != "vn" && tag != "vt" && tag != "f") continue;
+    auto fail = [&](const std::string& what) {
+      throw std::runtime_error(fmt::format("OBJ file '{}': line {}: {}", path, lineNo, what));
+    };
     int count = 0;
-    while (true) {
+    for (k = tagEnd;; ++count) {
       k = line.find_first_not_of(" \t\r", k);
       if (k == std::string::npos || line[k] == '#') break;
-      size_t end = line.find_first_of(" \t\r", k);
-      if (end == std::string::npos) end = line.size();
-      float v = 0.f;
-      const size_t start = line[k] == '+' && k + 1 < end && line[k + 1] != '-' ? k + 1 : k;  // from_chars takes no '+'
-      auto [ptr, ec] = std::from_chars(line.data() + start, line.data() + end, v);
-      if (ec != std::errc() || ptr != line.data() + end || !std::isfinite(v))
-        throw std::runtime_error(fmt::format("OBJ file '{}': line {}: '{}' is not a finite number", path, lineNo,
-                                             line.substr(k, end - k)));
-      ++count;
+      const size_t end = std::min(line.find_first_of(" \t\r", k), line.size());
+      if (tag != "f") {
+        float v = 0.f;
+        const size_t from = line[k] == '+' && k + 1 < end && line[k + 1] != '-' ? k + 1 : k;  // from_chars takes no '+'
+        auto [ptr, ec] = std::from_chars(line.data() + from, line.data() + end, v);
+        if (ec != std::errc() || ptr != line.data() + end || !std::isfinite(v))
+          fail(fmt::format("'{}' is not a finite number", line.substr(k, end - k)));
+      }
       k = end;
     }
-    const int needed = uv ? 1 : 3;
-    if (count < needed)
-      throw std::runtime_error(fmt::format("OBJ file '{}': line {}: {} needs {} coordinate{}, it has {}", path, lineNo,
-                                           normal ? "vn" : uv ? "vt" : "v", needed, needed > 1 ? "s" : "", count));
+    if (tag == "f" && count < 3) fail(fmt::format("a face needs 3 vertices or more, it has {}", count));
+    const int needed = tag == "vt" ? 1 : 3;
+    if (tag != "f" && count < needed)
+      fail(fmt::format("{} needs {} coordinate{}, it has {}", tag, needed, needed > 1 ? "s" : "", count));
   }
 }
 
@@ -55,7 +57,7 @@ void checkObjNumbers(const std::string& path) {
 
 TriangleMesh loadObj(const std::string& path) {
   if (!std::filesystem::exists(path)) throw std::runtime_error("cannot open OBJ file '" + path + "'");
-  checkObjNumbers(path);
+  checkObjLines(path);
   tinyobj::ObjReaderConfig cfg;
   cfg.triangulate = true;
   cfg.vertex_color = false;

@@ -130,7 +130,8 @@ TEST(MeshIO, ObjAndErrors) {
 }
 
 // tinyobjloader reads a number it cannot parse, and a coordinate that is missing, as 0: such a
-// line moved its vertex to the origin without a word. Now it is an error naming the line.
+// line moved its vertex to the origin without a word; and it dropped a face of two vertices.
+// Now each is an error naming the line.
 TEST(MeshIO, ObjNumbersThatAreNotNumbersAreErrors) {
   test::TempDir d;
   const std::string face = "f 1 2 3\n";
@@ -142,6 +143,8 @@ TEST(MeshIO, ObjNumbersThatAreNotNumbersAreErrors) {
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 1\n", "line 4: vn needs 3 coordinates, it has 2"},
       {"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt\n", "line 4: vt needs 1 coordinate, it has 0"},
       {"v 0 0 0\nv 1 0 0\nv 0 1 +-1\n", "line 3: '+-1' is not a finite number"},
+      // tinyobjloader dropped such a face; PLY's reader refuses it too.
+      {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 # edge\n", "line 5: a face needs 3 vertices or more, it has 2"},
   };
   for (const auto& [text, message] : bad) {
     write(d.file("bad.obj"), text + face);
