@@ -275,8 +275,9 @@ Image filmMean(const FilmSums& film, int width, int height, const std::vector<in
 size_t filmBytesPerPixel(const Camera& cam, const RenderOptions& opts) {
   const bool adaptive = opts.noiseThreshold > 0.f;
   size_t sums = sizeof(Color) + (opts.keepsVariance() ? sizeof(double) : 0) +
-                (cam.filter.hasNegativeLobes() ? sizeof(float) : 0) + (adaptive ? 1 : 0);
-  return 2 * sums + sizeof(int) + 1 + sizeof(Color);
+                (cam.filter.hasNegativeLobes() ? sizeof(float) : 0);
+  // The sums twice (renderPasses' FilmSums copies them, not the executor's mask).
+  return 2 * sums + (adaptive ? 1 : 0) + sizeof(int) + 1 + sizeof(Color);
 }
 
 void requireFilmFits(const Camera& cam, const RenderOptions& opts, double memoryBytes) {

@@ -111,6 +111,9 @@ TEST(Film, AFilmThatCannotFitIsRefused) {
   o.varianceOut = &var;
   EXPECT_EQ(filmBytesPerPixel(cam, o), 57u);  // with each pixel's squared luminance, twice
   o.varianceOut = nullptr;
+  o.noiseThreshold = 0.05f;
+  EXPECT_EQ(filmBytesPerPixel(cam, o), 58u);  // adaptive: the variance, and the executor's mask once
+  o.noiseThreshold = 0.f;
   try {
     requireFilmFits(cam, o, 25.3e9);
     ADD_FAILURE() << "a 44 GB film was let through on a 25.3 GB machine";
