@@ -30,8 +30,8 @@ CLI::Validator wholeNumberFrom(long long lo, long long hi);
 // --threads N on a command that renders: 0 (every core) to kMaxWorkerThreads.
 void addThreadsOption(CLI::App* c, int* threads);
 
-// An output file's extension, checked before any work is done: one of `allowed` (".exr", ...),
-// in a folder that exists and takes files; else one error naming what is written there.
+// An output file's extension, lower-cased, checked before any work is done: one of `allowed`
+// (".exr", ...), in a folder that exists and takes files; else one error naming what is written there.
 std::string requireOutputExtension(const std::string& path, const std::vector<std::string>& allowed,
                                    const std::string& what);
 

@@ -3,7 +3,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <filesystem>
 #include <memory>
 #include <stdexcept>
 
@@ -11,6 +10,7 @@
 #include "core/Files.h"
 #include "envmap/EnvironmentMap.h"
 #include "envmap/LightProbe.h"
+#include "image/Image.h"
 #include "sampling/Sampler.h"
 #include "scene/NameTables.h"
 
@@ -92,7 +92,7 @@ void runInfo(const std::string& path, const std::string& layout) {
 
 void runSamples(const SampleArgs& a) {
   // A CSV in a file named as an image is a slip (any other name is the user's choice).
-  const std::string ext = std::filesystem::path(a.out).extension().string();
+  const std::string ext = lowerExtension(a.out);
   for (const char* image : {".png", ".jpg", ".jpeg", ".exr", ".hdr", ".pfm", ".tif", ".tiff", ".bmp"})
     if (ext == image)
       throw std::runtime_error(fmt::format("output '{}' names an image, but samples writes CSV (u,v,x,y,z,pdf): name it .csv",
@@ -112,7 +112,7 @@ void runSamples(const SampleArgs& a) {
 }
 
 void runPlot(const SampleArgs& a, float exposure) {
-  requireOutputExtension(a.out, {".png", ".jpg", ".exr", ".hdr", ".pfm"}, "output");
+  requireOutputExtension(a.out, imageWriterExtensions(), "output");
   EnvironmentMap env = EnvironmentMap::loadLayout(a.map, a.layout, mapOptions(a));
   std::vector<EnvSample> samples = drawSamples(env, a);
   Image img = env.image();

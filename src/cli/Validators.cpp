@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
-
-#include <filesystem>
 #include <stdexcept>
 
 #include "cli/Commands.h"
@@ -60,7 +58,7 @@ void addThreadsOption(CLI::App* c, int* threads) {
 
 std::string requireOutputExtension(const std::string& path, const std::vector<std::string>& allowed,
                                    const std::string& what) {
-  const std::string e = std::filesystem::path(path).extension().string();
+  const std::string e = lowerExtension(path);  // as saveImage chooses its format
   if (std::find(allowed.begin(), allowed.end(), e) == allowed.end()) {
     std::string list;
     for (size_t i = 0; i < allowed.size(); ++i)

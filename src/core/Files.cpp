@@ -1,5 +1,7 @@
 #include "core/Files.h"
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -16,6 +18,12 @@ std::string temporarySibling(const std::string& path, const std::string& suffix)
   std::string name(".");
   name.append(p.filename().string()).append(".tmp").append(std::to_string(::getpid())).append(suffix);
   return (dir / name).string();
+}
+
+std::string lowerExtension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
 }
 
 void requireWritableDirectoryOf(const std::string& path) {

@@ -5,6 +5,9 @@
 
 namespace envgi {
 
+// The extension of `path`, lower-cased (".EXR" -> ".exr"): what formats are chosen by.
+std::string lowerExtension(const std::string& path);
+
 // A hidden temporary name beside `path` ending in `suffix`, unique to this process.
 std::string temporarySibling(const std::string& path, const std::string& suffix);
 

@@ -35,12 +35,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string lowerExtension(const fs::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-  return ext;
-}
-
 struct FileCloser {
   void operator()(FILE* f) const { std::fclose(f); }
 };
@@ -436,12 +430,17 @@ std::vector<unsigned char> toneMapImage(const Image& img, const SaveOptions& opt
   return ldr;
 }
 
+const std::vector<std::string>& imageWriterExtensions() {
+  static const std::vector<std::string> exts = {".exr", ".pfm", ".hdr", ".png", ".jpg", ".jpeg"};
+  return exts;
+}
+
 void saveImage(const Image& img, const std::string& path, const SaveOptions& opts) {
   fs::path p(path);
-  std::string ext = lowerExtension(p);
+  std::string ext = lowerExtension(path);
   if (ext.empty()) throw std::runtime_error("output '" + path + "' has no extension to choose a format by");
-  bool known = ext == ".exr" || ext == ".pfm" || ext == ".hdr" || ext == ".png" || ext == ".jpg" || ext == ".jpeg";
-  if (!known)
+  const std::vector<std::string>& known = imageWriterExtensions();
+  if (std::find(known.begin(), known.end(), ext) == known.end())
     throw std::runtime_error("cannot write '" + path + "': no writer for '" + ext +
                              "' (envgi writes .exr, .pfm, .hdr, .png, .jpg)");
   requireWritableDirectoryOf(path);

@@ -50,6 +50,8 @@ Image loadImage(const std::string& path, bool decodeSrgb = true);
 // Writes by extension: .exr, .pfm and .hdr as linear float, .png/.jpg as 8-bit sRGB after
 // exposure and tone curve. The file appears atomically (a temporary file, then rename).
 void saveImage(const Image& img, const std::string& path, const SaveOptions& opts = {});
+// The extensions saveImage writes by, lower-case.
+const std::vector<std::string>& imageWriterExtensions();
 
 // Exposure, tone curve and sRGB encoding of one linear value, in [0,1].
 float toneMapChannel(float v, const SaveOptions& opts);

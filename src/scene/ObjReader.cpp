@@ -6,7 +6,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 
 #include "scene/TriangleMesh.h"
@@ -19,9 +21,8 @@ namespace {
 // as 0, so a garbled vertex line moved the vertex to the origin without a word; and it drops a
 // face of fewer than three vertices. Those lines are checked here first: v, vn and vt take
 // finite numbers, at least three for v and vn and one for vt, and f at least three vertices.
-void checkObjLines(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw std::runtime_error("cannot open OBJ file '" + path + "'");
+void checkObjLines(const std::string& path, const std::string& text) {
+  std::istringstream f(text);
   std::string line;
   for (size_t lineNo = 1; std::getline(f, line); ++lineNo) {
     size_t k = line.find_first_not_of(" \t");
@@ -56,14 +57,17 @@ void checkObjLines(const std::string& path) {
 }  // namespace
 
 TriangleMesh loadObj(const std::string& path) {
-  if (!std::filesystem::exists(path)) throw std::runtime_error("cannot open OBJ file '" + path + "'");
-  checkObjLines(path);
+  std::ifstream f(path, std::ios::binary);
+  if (!std::filesystem::is_regular_file(path) || !f) throw std::runtime_error("cannot open OBJ file '" + path + "'");
+  // Read once: checked, then parsed from memory (envgi takes its materials from the scene, so
+  // no .mtl file is read).
+  const std::string text((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  checkObjLines(path, text);
   tinyobj::ObjReaderConfig cfg;
   cfg.triangulate = true;
   cfg.vertex_color = false;
-  cfg.mtl_search_path = std::filesystem::path(path).parent_path().string();
   tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(path, cfg)) {
+  if (!reader.ParseFromString(text, "", cfg)) {
     std::string err = reader.Error();
     while (!err.empty() && (err.back() == '\n' || err.back() == '\r')) err.pop_back();
     throw std::runtime_error("OBJ file '" + path + "': " + (err.empty() ? "cannot parse" : err));

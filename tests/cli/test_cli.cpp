@@ -275,7 +275,8 @@ TEST(CliEnvmap, AnOutputNamedAsTheWrongKindOfFileIsRefused) {
   };
   const Case cases[] = {
       {"envmap samples " + bundledMap() + " --count 5", "s.png", "names an image, but samples writes CSV"},
-      {"envmap plot " + bundledMap() + " --count 5", "p.tif", "must end in .png, .jpg, .exr, .hdr or .pfm"},
+      {"envmap plot " + bundledMap() + " --count 5", "p.tif", "must end in .exr, .pfm, .hdr, .png, .jpg or .jpeg"},
+      {"envmap samples " + bundledMap() + " --count 5", "s.PNG", "names an image, but samples writes CSV"},
       {"envmap convert " + probe + " --width 64", "c.jpg", "must end in .exr, .hdr or .pfm"},
       {"envmap convert " + probe + " --width 64", "c.png", "must end in .exr, .hdr or .pfm"},
   };
@@ -286,10 +287,13 @@ TEST(CliEnvmap, AnOutputNamedAsTheWrongKindOfFileIsRefused) {
     EXPECT_NE(r.output.find(expected), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(d.file(c.file))) << c.file;
   }
-  // What they do write: a CSV under a name without .csv, a plot as .exr, a map as .hdr.
+  // What they do write: a CSV under a name without .csv, a plot as .exr or .JPEG, a map as .hdr
+  // or .EXR (extensions in any case, as saveImage reads them).
   for (const std::string& ok : {"envmap samples " + bundledMap() + " --count 5 -o " + d.file("s"),
                                 "envmap plot " + bundledMap() + " --count 5 -o " + d.file("p.exr"),
-                                "envmap convert " + probe + " --width 64 -o " + d.file("c.hdr")}) {
+                                "envmap plot " + bundledMap() + " --count 5 -o " + d.file("p.JPEG"),
+                                "envmap convert " + probe + " --width 64 -o " + d.file("c.hdr"),
+                                "envmap convert " + probe + " --width 64 -o " + d.file("c.EXR")}) {
     CliResult r = runCli(ok);
     EXPECT_EQ(r.code, 0) << ok << ": " << r.output;
   }
