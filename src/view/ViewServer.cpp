@@ -156,6 +156,14 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
   http::request<http::string_body> req_;
 
   void onRead(beast::error_code ec) {
+    // A request Beast could not read gets its status, as any HTTP server gives one; a closed or
+    // timed-out connection gets nothing.
+    if (ec == http::error::header_limit)
+      return reply(http::status::request_header_fields_too_large, "text/plain", "request header too large\n");
+    if (ec == http::error::body_limit) return reply(http::status::payload_too_large, "text/plain", "body too large\n");
+    if (ec && ec.category() == http::make_error_code(http::error::bad_method).category() &&
+        ec != http::error::end_of_stream && ec != http::error::partial_message)
+      return reply(http::status::bad_request, "text/plain", "bad request\n");
     if (ec) return;
     std::string target(req_.target());
     std::string path = pathOf(target);
@@ -166,19 +174,28 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
       std::make_shared<WsClient>(server_, stream_.release_socket())->start(std::move(req_));
       return;
     }
-    if (req_.method() != http::verb::get) return reply(http::status::method_not_allowed, "text/plain", "GET only\n");
+    if (req_.method() != http::verb::get && req_.method() != http::verb::head)
+      return reply(http::status::method_not_allowed, "text/plain", "GET or HEAD only\n");
     if (path == "/" || path == "/index.html") return reply(http::status::ok, "text/html; charset=utf-8", kViewerPage);
     if (path == "/favicon.ico") return reply(http::status::no_content, "text/plain", "");
     reply(http::status::not_found, "text/plain", "not found\n");
   }
 
   void reply(http::status status, const char* type, std::string body) {
-    auto res = std::make_shared<http::response<http::string_body>>(status, req_.version());
+    // A request that could not be read has no version: answer in HTTP/1.1.
+    auto res = std::make_shared<http::response<http::string_body>>(status, req_.version() ? req_.version() : 11);
     res->set(http::field::server, "envgi");
     res->set(http::field::content_type, type);
     res->set(http::field::cache_control, "no-store");
+    if (status == http::status::method_not_allowed) res->set(http::field::allow, "GET, HEAD");
+    const size_t length = body.size();
     res->body() = std::move(body);
     res->prepare_payload();
+    if (req_.method() == http::verb::head) {
+      // HEAD: the headers GET would send, Content-Length included, and no body.
+      res->body().clear();
+      res->content_length(length);
+    }
     res->keep_alive(false);
     http::async_write(stream_, *res, [self = shared_from_this(), res](beast::error_code, size_t) {
       beast::error_code ec;

@@ -103,6 +103,24 @@ inline int httpGet(int port, const std::string& target, std::string* body) {
   return int(res.result_int());
 }
 
+// Sends `request` as it is to 127.0.0.1:port and returns all the server answers before it
+// closes the connection (the viewer closes after each reply).
+inline std::string httpRaw(int port, const std::string& request) {
+  net::io_context ioc;
+  tcp::socket sock(ioc);
+  sock.connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)));
+  net::write(sock, net::buffer(request));
+  std::string out;
+  beast::error_code ec;
+  char buf[4096];
+  for (;;) {
+    size_t n = sock.read_some(net::buffer(buf), ec);
+    out.append(buf, n);
+    if (ec) break;
+  }
+  return out;
+}
+
 // A WebSocket to ws://127.0.0.1:port/path, synchronous.
 class WsConnection {
  public:

@@ -188,6 +188,40 @@ TEST(ViewBrowser, WiderBindingRequiresTheToken) {
   EXPECT_EQ(view.wait(20), 0) << view.log();
 }
 
+// Requests other than the page's GET get the status an HTTP client expects: HEAD the page's
+// headers without its body, another method 405 with Allow, a header past Beast's 8 KiB limit
+// 431, a request line that is not HTTP 400.
+TEST(ViewBrowser, OtherRequestsGetTheirHttpStatus) {
+  TempDir d;
+  std::string scene = writeScene(d);
+  Child view({ENVGI_CLI_PATH, "view", scene, "--port", "0", "--threads", "1"}, d.file("v.log"));
+  ASSERT_TRUE(view.waitForLog("view: open http://", 30)) << view.log();
+  const int port = portFrom(view.log());
+  ASSERT_GT(port, 0) << view.log();
+  std::string page;
+  ASSERT_EQ(httpGet(port, "/", &page), 200);
+
+  std::string head = httpRaw(port, "HEAD / HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
+  EXPECT_EQ(head.rfind("HTTP/1.1 200", 0), 0u) << head;
+  EXPECT_NE(head.find("Content-Length: " + std::to_string(page.size()) + "\r\n"), std::string::npos) << head;
+  EXPECT_EQ(head.size(), head.find("\r\n\r\n") + 4) << "a HEAD reply has no body";
+
+  std::string post = httpRaw(port, "POST / HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Length: 1\r\n\r\nx");
+  EXPECT_EQ(post.rfind("HTTP/1.1 405", 0), 0u) << post;
+  EXPECT_NE(post.find("Allow: GET, HEAD\r\n"), std::string::npos) << post;
+
+  std::string longTarget = httpRaw(port, "GET /" + std::string(9000, 'a') + " HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
+  EXPECT_EQ(longTarget.rfind("HTTP/1.1 431", 0), 0u) << longTarget.substr(0, 200);
+
+  std::string garbage = httpRaw(port, "HELLO\r\n\r\n");
+  EXPECT_EQ(garbage.rfind("HTTP/1.1 400", 0), 0u) << garbage;
+
+  // The server is still there for the page.
+  EXPECT_EQ(httpGet(port, "/", nullptr), 200);
+  view.signal(SIGTERM);
+  EXPECT_EQ(view.wait(20), 0) << view.log();
+}
+
 // Bad start-up arguments are one error line and a non-zero exit, before anything listens.
 TEST(ViewBrowser, BadArgumentsAreOneErrorLine) {
   TempDir d;
