@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "cli/Commands.h"
+#include "core/Files.h"
 #include "image/Image.h"
 #include "study/ErrorMetrics.h"
 
@@ -20,7 +21,20 @@ double meanOf(const Image& img) {
   return img.rgb.empty() ? 0.0 : s / double(img.rgb.size());
 }
 
+// The errors are of radiance: an 8-bit file holds tone-mapped, clamped display values, whose
+// error against radiance means nothing (a render's PNG against its own EXR gave RMSE 0.82).
+void requireRadianceImage(const std::string& path) {
+  const std::string e = lowerExtension(path);
+  if (e == ".exr" || e == ".pfm" || e == ".hdr" || e == ".pic") return;
+  throw std::runtime_error(fmt::format(
+      "compare measures radiance, and '{}' is not a radiance image: give the .exr, .pfm or .hdr (a render's "
+      "--png is tone-mapped and clamped)",
+      path));
+}
+
 void runCompare(const CompareArgs& a) {
+  requireRadianceImage(a.reference);
+  for (const std::string& path : a.images) requireRadianceImage(path);
   Image ref = loadImage(a.reference);
   if (size_t n = nonFiniteValues(ref))
     throw std::runtime_error(fmt::format("reference '{}' has {} NaN or infinite values", a.reference, n));
@@ -56,7 +70,7 @@ void addCompareCommand(CLI::App& app) {
   auto a = std::make_shared<CompareArgs>();
   CLI::App* c = app.add_subcommand("compare", "Error of images against a reference (RMSE, relMSE, worst region)");
   c->add_option("reference", a->reference, "Reference image (.exr, .pfm, .hdr)")->required()->check(CLI::ExistingFile);
-  c->add_option("images", a->images, "Images to compare, same size as the reference")->required()->check(CLI::ExistingFile);
+  c->add_option("images", a->images, "Images to compare (.exr, .pfm, .hdr), same size as the reference")->required()->check(CLI::ExistingFile);
   c->callback([a] { runCompare(*a); });
 }
 

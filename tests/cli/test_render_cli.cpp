@@ -748,6 +748,16 @@ TEST(CliCompare, ErrorsAgainstAReference) {
   CliResult nanRef = runCli("compare " + d.file("nan.pfm") + " " + d.file("a.pfm"));
   EXPECT_EQ(nanRef.code, 1);
   EXPECT_NE(nanRef.output.find("has 1 NaN or infinite values"), std::string::npos) << nanRef.output;
+
+  // An 8-bit image on either side is refused before any table: its values are display codes.
+  envgi::saveImage(envgi::loadImage(d.file("a.pfm")), d.file("a.png"));
+  for (std::string args : {d.file("a.pfm") + " " + d.file("a.png"), d.file("a.png") + " " + d.file("a.pfm"),
+                           d.file("a.pfm") + " " + d.file("b.pfm") + " " + d.file("a.png")}) {
+    CliResult ldr = runCli("compare " + args);
+    EXPECT_EQ(ldr.code, 1) << args;
+    EXPECT_NE(ldr.output.find("is not a radiance image"), std::string::npos) << ldr.output;
+    EXPECT_EQ(ldr.output.find("RMSE"), std::string::npos) << "no table: " << ldr.output;
+  }
 }
 
 // Mitsuba's film flag sample_border is what envgi always does (each pixel's samples come from its
