@@ -35,6 +35,11 @@ void addThreadsOption(CLI::App* c, int* threads);
 std::string requireOutputExtension(const std::string& path, const std::vector<std::string>& allowed,
                                    const std::string& what);
 
+// An image whose values are radiance (.exr, .pfm, .hdr), for a command (`who`) that measures
+// error: an 8-bit file holds tone-mapped, clamped display values, whose error against radiance
+// means nothing (a render's PNG against its own EXR gave RMSE 0.82).
+void requireRadianceImage(const std::string& path, const std::string& who);
+
 // -D name=value pairs into a map; throws on a pair without '='.
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds);
 

@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 
 #include "cli/Commands.h"
-#include "core/Files.h"
 #include "image/Image.h"
 #include "study/ErrorMetrics.h"
 
@@ -21,20 +20,9 @@ double meanOf(const Image& img) {
   return img.rgb.empty() ? 0.0 : s / double(img.rgb.size());
 }
 
-// The errors are of radiance: an 8-bit file holds tone-mapped, clamped display values, whose
-// error against radiance means nothing (a render's PNG against its own EXR gave RMSE 0.82).
-void requireRadianceImage(const std::string& path) {
-  const std::string e = lowerExtension(path);
-  if (e == ".exr" || e == ".pfm" || e == ".hdr" || e == ".pic") return;
-  throw std::runtime_error(fmt::format(
-      "compare measures radiance, and '{}' is not a radiance image: give the .exr, .pfm or .hdr (a render's "
-      "--png is tone-mapped and clamped)",
-      path));
-}
-
 void runCompare(const CompareArgs& a) {
-  requireRadianceImage(a.reference);
-  for (const std::string& path : a.images) requireRadianceImage(path);
+  requireRadianceImage(a.reference, "compare");
+  for (const std::string& path : a.images) requireRadianceImage(path, "compare");
   Image ref = loadImage(a.reference);
   if (size_t n = nonFiniteValues(ref))
     throw std::runtime_error(fmt::format("reference '{}' has {} NaN or infinite values", a.reference, n));

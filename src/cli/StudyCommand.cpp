@@ -52,6 +52,15 @@ std::vector<std::string> splitList(const std::string& s) {
   return out;
 }
 
+// A list that names an item twice would run it twice and write its rows twice into results.csv
+// (and the runs' files once, over each other): one error instead.
+template <class T>
+void requireNoRepeats(const std::vector<T>& items, const std::string& option) {
+  for (size_t i = 0; i < items.size(); ++i)
+    for (size_t j = 0; j < i; ++j)
+      if (items[i] == items[j]) throw std::runtime_error(fmt::format("{} names '{}' twice", option, items[i]));
+}
+
 // A comma-separated list of positive finite numbers; `what` names the option in errors.
 std::vector<double> positiveNumbers(const std::string& list, const std::string& option, const std::string& what) {
   std::vector<double> out;
@@ -228,6 +237,14 @@ void runStudy(const StudyArgs& a) {
   std::vector<double> times = positiveNumbers(a.times, "--time", "a positive number of seconds");
   if (strategies.empty()) throw std::runtime_error("--strategies is empty");
   if (sppList.empty()) throw std::runtime_error("--spp is empty");
+  requireNoRepeats(strategies, "--strategies");
+  requireNoRepeats(sppList, "--spp");
+  requireNoRepeats(times, "--time");
+  // In increasing order, whatever order they were given in: the plots and the report's middle
+  // sample count (the one whose images it shows) read them so.
+  std::sort(sppList.begin(), sppList.end());
+  std::sort(times.begin(), times.end());
+  if (!a.reference.empty()) requireRadianceImage(a.reference, "study");
   if (a.noiseThreshold > 0.f) {
     spdlog::info("study: adaptive sampling in every run, noise threshold {:g} from {} spp", a.noiseThreshold, a.minSpp);
     if (a.minSpp >= sppList.back())
@@ -370,7 +387,7 @@ void addStudyCommand(CLI::App& app) {
   c->add_option("--time", a->times, "Comma-separated time budgets in seconds for equal-time runs");
   // Each seed is one more run of every configuration; 10^8 of them had ended in std::bad_alloc.
   c->add_option("--seeds", a->seeds, "Seeds per configuration (default 2), at most 1000")->check(wholeNumberFrom(1, 1000));
-  c->add_option("--reference", a->reference, "Reference image (.exr); default: rendered with mis");
+  c->add_option("--reference", a->reference, "Reference image (.exr, .pfm, .hdr); default: rendered with mis");
   c->add_option("--reference-spp", a->referenceSpp, "Samples for the rendered reference (default 4096)")->check(atLeast(1));
   c->add_option("--integrator", a->integrator, "direct (default) or path");
   c->add_option("-D", a->defines, "Set a scene parameter: -D name=value (repeatable)");

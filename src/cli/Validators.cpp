@@ -69,4 +69,13 @@ std::string requireOutputExtension(const std::string& path, const std::vector<st
   return e;
 }
 
+void requireRadianceImage(const std::string& path, const std::string& who) {
+  const std::string e = lowerExtension(path);
+  if (e == ".exr" || e == ".pfm" || e == ".hdr" || e == ".pic") return;
+  throw std::runtime_error(fmt::format(
+      "{} measures radiance, and '{}' is not a radiance image: give the .exr, .pfm or .hdr (a render's --png is "
+      "tone-mapped and clamped)",
+      who, path));
+}
+
 }  // namespace envgi::cli

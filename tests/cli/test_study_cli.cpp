@@ -19,7 +19,7 @@ TEST(StudyCli, WritesResultsAndResumes) {
   TempDir d;
   std::string out = d.file("study");
   std::string args = "study " + buddha() + " -o " + out +
-                     " -D res=24 --spp 1,16 --seeds 1 --reference-spp 256 --strategies uniform,importance,points-8 --time 0.02";
+                     " -D res=24 --spp 16,1 --seeds 1 --reference-spp 256 --strategies uniform,importance,points-8 --time 0.02";
   CliResult r = runCli(args);
   ASSERT_EQ(r.code, 0) << r.output;
   for (const char* f : {"reference.exr", "results.csv", "results.json", "report.html"})
@@ -30,6 +30,8 @@ TEST(StudyCli, WritesResultsAndResumes) {
   EXPECT_EQ(csv.substr(0, csv.find('\n')),
             "strategy,spp,time_budget,seed,seconds,rmse,relmse,worst_region_rmse,device,mean_spp");
   EXPECT_NE(csv.find(",\"cpu\",16\n"), std::string::npos) << "without adaptive sampling every sample is taken\n" << csv;
+  // Sample counts run in increasing order, whatever order --spp gave them in.
+  EXPECT_LT(csv.find("uniform,1,"), csv.find("uniform,16,")) << csv;
   // The unbiased strategies converge: importance at 16 spp beats importance at 1.
   auto rmseOf = [&](const std::string& prefix) {
     size_t p = csv.find(prefix);
@@ -167,6 +169,10 @@ TEST(StudyCli, BadInputIsOneErrorLine) {
   expectError("--strategies points-0", "points-N needs a whole N from 1 to 16777216");
   expectError("--strategies points-99999999999", "points-N needs a whole N from 1 to 16777216");
   expectError("--strategies points-12x", "points-N needs a whole N from 1 to 16777216");
+  // A list that names an item twice (its rows were written twice into results.csv).
+  expectError("--strategies importance,uniform,importance", "--strategies names 'importance' twice");
+  expectError("--spp 4,1,4", "--spp names '4' twice");
+  expectError("--time 0.5,0.5", "--time names '0.5' twice");
   // --seeds is an option's range: exit 2 (10^8 seeds had ended in std::bad_alloc).
   for (const char* seeds : {"0", "100000000"}) {
     CliResult r = runCli("study " + buddha() + " -o " + d.file("s") + " -D res=16 --seeds " + seeds);
@@ -182,6 +188,8 @@ TEST(StudyCli, BadInputIsOneErrorLine) {
   envgi::saveImage(nan, d.file("nan.pfm"));
   expectError("--reference " + d.file("nan.pfm"), "has NaN or infinite pixels");
   expectError("--reference " + d.file("missing.exr"), "cannot open image");
+  envgi::saveImage(envgi::Image(16, 16), d.file("ref16.png"));
+  expectError("--reference " + d.file("ref16.png"), "is not a radiance image");
   // A given reference is checked before the study's folder is made: a wrong one leaves none.
   EXPECT_FALSE(fs::exists(d.file("s"))) << "the folder of a study that never started";
   CliResult unwritable = runCli("study " + buddha() + " -o /proc/envgi_study -D res=16");
