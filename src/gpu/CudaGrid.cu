@@ -4,9 +4,11 @@
 // (finishGather, as the CPU) and uploads it, and the camera passes run GridSample, the CPU's
 // per-sample body. Before each pass after the first, refine_rays more rays a point refine the
 // grid, as on the CPU.
+#include <algorithm>
 #include <chrono>
 
 #include "gpu/CudaPassExecutor.cuh"
+#include "render/Cancellation.h"
 #include "render/IlluminationGridBuilder.h"
 
 namespace envgi::gpu {
@@ -15,11 +17,16 @@ namespace {
 
 constexpr int kThreads = 64;
 
+// Points a launch of the gather covers: between launches the host looks at Ctrl-C (the CPU's
+// gather looks at it every point), so a 256^3 grid stops within a launch of milliseconds.
+constexpr int kPointsPerLaunch = 1 << 16;
+
 __global__ void gridGatherKernel(const SceneView* sc, BvhTracer tracer, IlluminationGridView grid, ChainParams cp,
                                  IrradianceCacheView global, IrradianceCacheView caustic, uint32_t seed, int first,
-                                 int rays, int length, int n, ShL1* sums, int* backs, unsigned long long* rayCount) {
-  int i = int(blockIdx.x * blockDim.x + threadIdx.x);
-  if (i >= n) return;
+                                 int rays, int length, int begin, int end, ShL1* sums, int* backs,
+                                 unsigned long long* rayCount) {
+  int i = begin + int(blockIdx.x * blockDim.x + threadIdx.x);
+  if (i >= end) return;
   uint64_t r = 0;
   gridPointGather(*sc, tracer, grid.point(size_t(i)), uint64_t(i), cp, global, caustic, seed, first, rays, length,
                   &sums[i], &backs[i], &r);
@@ -88,10 +95,19 @@ class CudaGridExecutor final : public PassExecutor {
   void gather(int first, int rays) {
     auto t0 = std::chrono::steady_clock::now();
     check(cudaMemset(rays_, 0, sizeof(unsigned long long)), "clearing counters");
-    gridGatherKernel<<<(n_ + kThreads - 1) / kThreads, kThreads>>>(sceneView_, tracer_, gridView_, s_.params.chain,
-                                                                   global_, caustic_, s_.seed, first, rays,
-                                                                   s_.sequenceLength(), n_, sums_, backs_, rays_);
-    check(cudaGetLastError(), "launching the grid gather kernel");
+    // As on the CPU, only the first fill stops early: a refinement runs to the end, since every
+    // point must keep the same count of rays.
+    const std::atomic<bool>* cancel = first == 0 ? s_.cancel : nullptr;
+    for (int begin = 0; begin < n_; begin += kPointsPerLaunch) {
+      throwIfCancelled(cancel);
+      const int end = std::min(n_, begin + kPointsPerLaunch);
+      gridGatherKernel<<<(end - begin + kThreads - 1) / kThreads, kThreads>>>(
+          sceneView_, tracer_, gridView_, s_.params.chain, global_, caustic_, s_.seed, first, rays,
+          s_.sequenceLength(), begin, end, sums_, backs_, rays_);
+      check(cudaGetLastError(), "launching the grid gather kernel");
+      if (cancel) check(cudaDeviceSynchronize(), "gathering into the grid");
+    }
+    throwIfCancelled(cancel);
     std::vector<ShL1> sums(static_cast<size_t>(n_));
     std::vector<int> backs(static_cast<size_t>(n_));
     unsigned long long rayCount = 0;
