@@ -73,6 +73,7 @@ void runRender(const RenderArgs& a) {
     return requireOutputExtension(path, {".exr", ".pfm", ".hdr", ".png"}, what);
   };
   std::string ext = requireImageName(a.output, "output");
+  if (a.png && ext != ".png") requireWritableDirectoryOf(fs::path(a.output).replace_extension(".png").string());
   if (!a.sampleMap.empty()) {
     requireImageName(a.sampleMap, "--sample-map");
     // Written after the image, it would replace it (or the PNG beside it) without a word.
@@ -121,7 +122,9 @@ void runRender(const RenderArgs& a) {
   so.toneMap = a.aces ? ToneMap::Aces : ToneMap::Clamp;
   std::string pngPath = fs::path(a.output).replace_extension(".png").string();
   std::vector<ImageChannel> aovs;
-  auto write = [&](const Image& img) {
+  // The image (with its AOVs) to the output and, with --png, the PNG beside it; or, given a
+  // path, the image alone there.
+  auto write = [&](const Image& img, const std::string& elsewhere = "") {
     const Image* out = &img;
     Image withAovs;  // a copy only where there are channels to add
     if (!aovs.empty()) {
@@ -129,8 +132,8 @@ void runRender(const RenderArgs& a) {
       withAovs.channels = aovs;
       out = &withAovs;
     }
-    saveImage(*out, a.output, so);
-    if (a.png && ext != ".png") saveImage(*out, pngPath, so);
+    saveImage(*out, elsewhere.empty() ? a.output : elsewhere, so);
+    if (elsewhere.empty() && a.png && ext != ".png") saveImage(*out, pngPath, so);
   };
   // The AOVs take only camera rays, traced here on the CPU before the image (so that every
   // checkpoint holds them), whichever device renders it.
@@ -149,8 +152,15 @@ void runRender(const RenderArgs& a) {
   ro.threads = a.threads;
   ro.progress = !a.noProgress && spdlog::should_log(spdlog::level::info);  // -q: errors and warnings only, as pbrt's --quiet
   ro.checkpointSeconds = a.checkpoint;
+  // A checkpoint that cannot be written (a full disk, the folder gone) is a warning: the render
+  // goes on with its samples and tries again at the next checkpoint and at the end.
   ro.checkpoint = [&](const Image& img, int done) {
-    write(img);
+    try {
+      write(img);
+    } catch (const std::exception& e) {
+      spdlog::warn("checkpoint at {} spp not written ({}); rendering on", done, e.what());
+      return;
+    }
     spdlog::info("checkpoint: {} spp written to {}", done, a.output);
   };
   ro.cancel = &g_cancel;
@@ -200,7 +210,21 @@ void runRender(const RenderArgs& a) {
   }
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
-  write(img);
+  try {
+    write(img);
+  } catch (const std::exception& e) {
+    // The output cannot be written now (it could at the start): the samples go to the temporary
+    // folder rather than be lost, and the command still fails.
+    const std::string rescue =
+        (fs::temp_directory_path() / fmt::format("envgi-rescue-{}{}", static_cast<long>(::getpid()), ext)).string();
+    try {
+      write(img, rescue);
+    } catch (const std::exception&) {
+      throw std::runtime_error(e.what());
+    }
+    throw std::runtime_error(
+        fmt::format("{}; the {} spp rendered were written to '{}' instead", e.what(), st.sppDone, rescue));
+  }
   if (!a.sampleMap.empty()) {
     // Each pixel's share of the requested samples: 1 where it took them all.
     Image map(scene.camera.width, scene.camera.height);

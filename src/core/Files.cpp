@@ -30,6 +30,8 @@ void requireWritableDirectoryOf(const std::string& path) {
   fs::path p(path);
   fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
   if (!fs::is_directory(dir)) throw std::runtime_error("cannot write '" + path + "': directory does not exist");
+  // The rename onto a folder fails only once the output is made (a render's samples lost).
+  if (fs::is_directory(p)) throw std::runtime_error("cannot write '" + path + "': it is a folder");
   // The temporary file is made beside the output and renamed onto it: both need w and x.
   if (::access(dir.c_str(), W_OK | X_OK) != 0)
     throw std::runtime_error("cannot write '" + path + "': directory '" + dir.string() + "' is not writable");

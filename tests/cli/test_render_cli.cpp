@@ -706,6 +706,60 @@ TEST(RenderCli, ASampleMapCannotOverwriteTheImage) {
   EXPECT_TRUE(fs::exists(d.file("c.png")) && fs::exists(d.file("c-samples.png")));
 }
 
+// An output (or the PNG beside it, or a sample map) that names a folder is refused before the
+// render: the rename onto it failed only once every sample had been taken.
+TEST(RenderCli, AnOutputThatIsAFolderIsRefusedBeforeTheRender) {
+  TempDir d;
+  std::string scene = tinyScene(d, 8, 2);
+  fs::create_directories(d.file("a.exr") + "/x");
+  fs::create_directories(d.file("b.png") + "/x");
+  fs::create_directories(d.file("m.png") + "/x");
+  for (const std::string& extra : {" -o " + d.file("a.exr"), " -o " + d.file("b.exr") + " --png",
+                                   " -o " + d.file("c.exr") + " --sample-map " + d.file("m.png")}) {
+    CliResult r = runCli("render " + scene + extra + " --no-progress");
+    EXPECT_EQ(r.code, 1) << extra << ": " << r.output;
+    EXPECT_NE(r.output.find("it is a folder"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("rendering "), std::string::npos) << "refused before the render: " << r.output;
+  }
+}
+
+// An output that stops being writable during the render (its folder gone, a full disk; here a
+// folder made where the image was): each checkpoint after that is a warning and the render goes
+// on; at the end its samples go to the temporary folder, named in the one error line (exit 1).
+TEST(RenderCli, AnOutputThatStopsBeingWritableLosesNoSamples) {
+  TempDir d;
+  std::string scene = tinyScene(d, 32, 100000);
+  const std::string out = d.file("img.exr"), log = d.file("log.txt");
+  std::string cmd = "sh -c '" + std::string(ENVGI_CLI_PATH) + " render " + scene + " -o " + out +
+                    " --no-progress --checkpoint 0.2 --time-limit 3; echo rc=$?' > " + log + " 2>&1 & echo $!";
+  FILE* p = popen(cmd.c_str(), "r");
+  ASSERT_NE(p, nullptr);
+  int pid = 0;
+  ASSERT_EQ(fscanf(p, "%d", &pid), 1);
+  pclose(p);
+  for (int i = 0; i < 200 && !fs::exists(out); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_TRUE(fs::exists(out)) << "no first checkpoint in 10 s\n" << slurp(log);
+  fs::remove(out);
+  fs::create_directories(out + "/x");
+  for (int i = 0; i < 600 && slurp(log).find("rc=") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  const std::string text = slurp(log);
+  ASSERT_NE(text.find("rc=1"), std::string::npos) << text;
+  EXPECT_NE(text.find("not written (cannot write '" + out + "': it is a folder); rendering on"), std::string::npos)
+      << text;
+  const std::string said = "were written to '";
+  size_t at = text.find(said);
+  ASSERT_NE(at, std::string::npos) << text;
+  at += said.size();
+  const std::string rescue = text.substr(at, text.find('\'', at) - at);
+  envgi::Image img = envgi::loadImage(rescue);
+  fs::remove(rescue);
+  EXPECT_EQ(img.width, 32);
+  double sum = 0.0;
+  for (float v : img.rgb) sum += v;
+  EXPECT_GT(sum, 0.0);
+}
+
 // compare: an image against itself has no error, a noisier one has some, a wrong size is one
 // error line and no table.
 TEST(CliCompare, ErrorsAgainstAReference) {
