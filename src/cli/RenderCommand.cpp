@@ -122,9 +122,9 @@ void runRender(const RenderArgs& a) {
   so.toneMap = a.aces ? ToneMap::Aces : ToneMap::Clamp;
   std::string pngPath = fs::path(a.output).replace_extension(".png").string();
   std::vector<ImageChannel> aovs;
-  // The image (with its AOVs) to the output and, with --png, the PNG beside it; or, given a
-  // path, the image alone there.
-  auto write = [&](const Image& img, const std::string& elsewhere = "") {
+  // The image (with its AOVs) to `path`; with no path, to the output and, with --png, the PNG
+  // beside it (a checkpoint).
+  auto write = [&](const Image& img, const std::string& path = "") {
     const Image* out = &img;
     Image withAovs;  // a copy only where there are channels to add
     if (!aovs.empty()) {
@@ -132,8 +132,8 @@ void runRender(const RenderArgs& a) {
       withAovs.channels = aovs;
       out = &withAovs;
     }
-    saveImage(*out, elsewhere.empty() ? a.output : elsewhere, so);
-    if (elsewhere.empty() && a.png && ext != ".png") saveImage(*out, pngPath, so);
+    saveImage(*out, path.empty() ? a.output : path, so);
+    if (path.empty() && a.png && ext != ".png") saveImage(*out, pngPath, so);
   };
   // The AOVs take only camera rays, traced here on the CPU before the image (so that every
   // checkpoint holds them), whichever device renders it.
@@ -211,7 +211,7 @@ void runRender(const RenderArgs& a) {
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
   try {
-    write(img);
+    write(img, a.output);
   } catch (const std::exception& e) {
     // The output cannot be written now (it could at the start): the samples go to the temporary
     // folder rather than be lost, and the command still fails.
@@ -225,6 +225,7 @@ void runRender(const RenderArgs& a) {
     throw std::runtime_error(
         fmt::format("{}; the {} spp rendered were written to '{}' instead", e.what(), st.sppDone, rescue));
   }
+  if (a.png && ext != ".png") write(img, pngPath);  // the image itself is safe by now
   if (!a.sampleMap.empty()) {
     // Each pixel's share of the requested samples: 1 where it took them all.
     Image map(scene.camera.width, scene.camera.height);
