@@ -1,11 +1,13 @@
 // `envgi render SCENE.xml -o OUT.exr`: the renderer from the command line, on the CPU or a GPU.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <atomic>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 
@@ -210,28 +212,42 @@ void runRender(const RenderArgs& a) {
   }
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
-  try {
-    write(img, a.output);
-  } catch (const std::exception& e) {
-    // The output cannot be written now (it could at the start): the samples go to the temporary
-    // folder rather than be lost, and the command still fails.
-    const std::string rescue =
-        (fs::temp_directory_path() / fmt::format("envgi-rescue-{}{}", static_cast<long>(::getpid()), ext)).string();
+  // Each file the render made, written where it was asked for; one that cannot be written now
+  // (it could at the start: a full disk, the folder gone) goes to the temporary folder instead,
+  // so that no sample is lost, and the command fails naming where each went.
+  std::string firstError;
+  std::vector<std::string> rescued;
+  auto keep = [&](const std::string& path, const std::function<void(const std::string&)>& save) {
     try {
-      write(img, rescue);
-    } catch (const std::exception&) {
-      throw std::runtime_error(e.what());
+      save(path);
+    } catch (const std::exception& e) {
+      if (firstError.empty()) firstError = e.what();
+      const std::string name =
+          fmt::format("envgi-rescue-{}-{}", static_cast<long>(::getpid()), fs::path(path).filename().string());
+      const std::string rescue = (fs::temp_directory_path() / name).string();
+      try {
+        save(rescue);
+        rescued.push_back("'" + rescue + "'");
+      } catch (const std::exception&) {
+      }
     }
-    throw std::runtime_error(
-        fmt::format("{}; the {} spp rendered were written to '{}' instead", e.what(), st.sppDone, rescue));
-  }
-  if (a.png && ext != ".png") write(img, pngPath);  // the image itself is safe by now
+  };
+  keep(a.output, [&](const std::string& path) { write(img, path); });
+  if (a.png && ext != ".png") keep(pngPath, [&](const std::string& path) { write(img, path); });
   if (!a.sampleMap.empty()) {
     // Each pixel's share of the requested samples: 1 where it took them all.
     Image map(scene.camera.width, scene.camera.height);
     for (size_t i = 0; i < samples.size(); ++i)
       map.rgb[3 * i] = map.rgb[3 * i + 1] = map.rgb[3 * i + 2] = float(samples[i]) / float(requestedSpp);
-    saveImage(map, a.sampleMap, SaveOptions{});
+    keep(a.sampleMap, [&](const std::string& path) { saveImage(map, path, SaveOptions{}); });
+  }
+  if (!firstError.empty()) {
+    if (rescued.empty()) throw std::runtime_error(firstError);
+    std::string where = rescued.back();
+    if (rescued.size() > 1)
+      where = fmt::format("{} and {}", fmt::join(rescued.begin(), rescued.end() - 1, ", "), rescued.back());
+    throw std::runtime_error(
+        fmt::format("{}; the {} spp rendered were written to {} instead", firstError, st.sppDone, where));
   }
   if (st.converged)
     spdlog::info("adaptive sampling: every pixel met the noise threshold after {} of {} spp", st.sppDone,

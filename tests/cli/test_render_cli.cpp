@@ -729,8 +729,8 @@ TEST(RenderCli, AnOutputThatIsAFolderIsRefusedBeforeTheRender) {
 TEST(RenderCli, AnOutputThatStopsBeingWritableLosesNoSamples) {
   TempDir d;
   std::string scene = tinyScene(d, 32, 100000);
-  const std::string out = d.file("img.exr"), log = d.file("log.txt");
-  std::string cmd = "sh -c '" + std::string(ENVGI_CLI_PATH) + " render " + scene + " -o " + out +
+  const std::string out = d.file("img.exr"), map = d.file("spp.exr"), log = d.file("log.txt");
+  std::string cmd = "sh -c '" + std::string(ENVGI_CLI_PATH) + " render " + scene + " -o " + out + " --sample-map " + map +
                     " --no-progress --checkpoint 0.2 --time-limit 3; echo rc=$?' > " + log + " 2>&1 & echo $!";
   FILE* p = popen(cmd.c_str(), "r");
   ASSERT_NE(p, nullptr);
@@ -741,23 +741,34 @@ TEST(RenderCli, AnOutputThatStopsBeingWritableLosesNoSamples) {
   ASSERT_TRUE(fs::exists(out)) << "no first checkpoint in 10 s\n" << slurp(log);
   fs::remove(out);
   fs::create_directories(out + "/x");
+  fs::create_directories(map + "/x");  // the sample map, written only at the end
   for (int i = 0; i < 600 && slurp(log).find("rc=") == std::string::npos; ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   const std::string text = slurp(log);
   ASSERT_NE(text.find("rc=1"), std::string::npos) << text;
   EXPECT_NE(text.find("not written (cannot write '" + out + "': it is a folder); rendering on"), std::string::npos)
       << text;
+  // Both files, each under its own name: "were written to 'A' and 'B' instead".
   const std::string said = "were written to '";
   size_t at = text.find(said);
   ASSERT_NE(at, std::string::npos) << text;
   at += said.size();
   const std::string rescue = text.substr(at, text.find('\'', at) - at);
-  envgi::Image img = envgi::loadImage(rescue);
+  at = text.find(" and '", at);
+  ASSERT_NE(at, std::string::npos) << text;
+  at += 6;
+  const std::string rescuedMap = text.substr(at, text.find('\'', at) - at);
+  EXPECT_NE(rescue.find("img.exr"), std::string::npos) << rescue;
+  EXPECT_NE(rescuedMap.find("spp.exr"), std::string::npos) << rescuedMap;
+  envgi::Image img = envgi::loadImage(rescue), spp = envgi::loadImage(rescuedMap);
   fs::remove(rescue);
+  fs::remove(rescuedMap);
   EXPECT_EQ(img.width, 32);
   double sum = 0.0;
   for (float v : img.rgb) sum += v;
   EXPECT_GT(sum, 0.0);
+  EXPECT_EQ(spp.width, 32);
+  EXPECT_GT(spp.rgb[0], 0.f) << "every pixel took samples";
 }
 
 // compare: an image against itself has no error, a noisier one has some, a wrong size is one
