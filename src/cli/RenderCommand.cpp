@@ -67,6 +67,12 @@ double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
+// "a", "a and b", "a, b and c".
+std::string listInWords(const std::vector<std::string>& items) {
+  if (items.size() < 2) return items.empty() ? "" : items[0];
+  return fmt::format("{} and {}", fmt::join(items.begin(), items.end() - 1, ", "), items.back());
+}
+
 
 void runRender(const RenderArgs& a) {
   namespace fs = std::filesystem;
@@ -75,13 +81,18 @@ void runRender(const RenderArgs& a) {
     return requireOutputExtension(path, {".exr", ".pfm", ".hdr", ".png"}, what);
   };
   std::string ext = requireImageName(a.output, "output");
-  if (a.png && ext != ".png") requireWritableDirectoryOf(fs::path(a.output).replace_extension(".png").string());
+  // What the render writes at each checkpoint and at the end: the image and, with --png, the
+  // tone-mapped PNG beside it.
+  std::vector<std::string> images = {a.output};
+  if (a.png && ext != ".png") images.push_back(fs::path(a.output).replace_extension(".png").string());
+  for (size_t i = 1; i < images.size(); ++i) requireWritableDirectoryOf(images[i]);
   if (!a.sampleMap.empty()) {
     requireImageName(a.sampleMap, "--sample-map");
     // Written after the image, it would replace it (or the PNG beside it) without a word.
-    const fs::path map = fs::weakly_canonical(a.sampleMap), out = fs::weakly_canonical(a.output);
-    if (map == out || (a.png && map == fs::path(out).replace_extension(".png")))
-      throw std::runtime_error("--sample-map '" + a.sampleMap + "' would overwrite the rendered image: give it a name of its own");
+    const fs::path map = fs::weakly_canonical(a.sampleMap);
+    for (const std::string& image : images)
+      if (map == fs::weakly_canonical(image))
+        throw std::runtime_error("--sample-map '" + a.sampleMap + "' would overwrite the rendered image: give it a name of its own");
   }
   auto t0 = std::chrono::steady_clock::now();
   Scene scene;
@@ -122,11 +133,9 @@ void runRender(const RenderArgs& a) {
   SaveOptions so;
   so.exposure = a.exposure;
   so.toneMap = a.aces ? ToneMap::Aces : ToneMap::Clamp;
-  std::string pngPath = fs::path(a.output).replace_extension(".png").string();
   std::vector<ImageChannel> aovs;
-  // The image (with its AOVs) to `path`; with no path, to the output and, with --png, the PNG
-  // beside it (a checkpoint).
-  auto write = [&](const Image& img, const std::string& path = "") {
+  // The image, with its AOVs, to each of `paths`.
+  auto write = [&](const Image& img, const std::vector<std::string>& paths) {
     const Image* out = &img;
     Image withAovs;  // a copy only where there are channels to add
     if (!aovs.empty()) {
@@ -134,8 +143,7 @@ void runRender(const RenderArgs& a) {
       withAovs.channels = aovs;
       out = &withAovs;
     }
-    saveImage(*out, path.empty() ? a.output : path, so);
-    if (path.empty() && a.png && ext != ".png") saveImage(*out, pngPath, so);
+    for (const std::string& path : paths) saveImage(*out, path, so);
   };
   // The AOVs take only camera rays, traced here on the CPU before the image (so that every
   // checkpoint holds them), whichever device renders it.
@@ -158,7 +166,7 @@ void runRender(const RenderArgs& a) {
   // goes on with its samples and tries again at the next checkpoint and at the end.
   ro.checkpoint = [&](const Image& img, int done) {
     try {
-      write(img);
+      write(img, images);
     } catch (const std::exception& e) {
       spdlog::warn("checkpoint at {} spp not written ({}); rendering on", done, e.what());
       return;
@@ -216,7 +224,7 @@ void runRender(const RenderArgs& a) {
   // (it could at the start: a full disk, the folder gone) goes to the temporary folder instead,
   // so that no sample is lost, and the command fails naming where each went.
   std::string firstError;
-  std::vector<std::string> rescued;
+  std::vector<std::string> rescued, lost;  // quoted, for the error line
   auto keep = [&](const std::string& path, const std::function<void(const std::string&)>& save) {
     try {
       save(path);
@@ -229,11 +237,11 @@ void runRender(const RenderArgs& a) {
         save(rescue);
         rescued.push_back("'" + rescue + "'");
       } catch (const std::exception&) {
+        lost.push_back("'" + path + "'");
       }
     }
   };
-  keep(a.output, [&](const std::string& path) { write(img, path); });
-  if (a.png && ext != ".png") keep(pngPath, [&](const std::string& path) { write(img, path); });
+  for (const std::string& image : images) keep(image, [&](const std::string& path) { write(img, {path}); });
   if (!a.sampleMap.empty()) {
     // Each pixel's share of the requested samples: 1 where it took them all.
     Image map(scene.camera.width, scene.camera.height);
@@ -243,11 +251,10 @@ void runRender(const RenderArgs& a) {
   }
   if (!firstError.empty()) {
     if (rescued.empty()) throw std::runtime_error(firstError);
-    std::string where = rescued.back();
-    if (rescued.size() > 1)
-      where = fmt::format("{} and {}", fmt::join(rescued.begin(), rescued.end() - 1, ", "), rescued.back());
-    throw std::runtime_error(
-        fmt::format("{}; the {} spp rendered were written to {} instead", firstError, st.sppDone, where));
+    std::string message = fmt::format("{}; the {} spp rendered were written to {} instead", firstError, st.sppDone,
+                                      listInWords(rescued));
+    if (!lost.empty()) message += fmt::format("; {} could not be written anywhere", listInWords(lost));
+    throw std::runtime_error(message);
   }
   if (st.converged)
     spdlog::info("adaptive sampling: every pixel met the noise threshold after {} of {} spp", st.sppDone,
@@ -263,8 +270,9 @@ void runRender(const RenderArgs& a) {
     spdlog::info("time limit of {:g} s: stopped after {} of {} spp", a.timeLimit, st.sppDone, requestedSpp);
   spdlog::info("done in {:.2f} s: {} spp, {:.3g} rays, {:.3g} Mrays/s", st.seconds, st.sppDone, double(st.rays),
                st.raysPerSecond() / 1e6);
-  spdlog::info("wrote {}{}", fs::absolute(a.output).string(),
-               a.png && ext != ".png" ? " and " + fs::absolute(pngPath).string() : "");
+  std::vector<std::string> written;
+  for (const std::string& image : images) written.push_back(fs::absolute(image).string());
+  spdlog::info("wrote {}", fmt::join(written, " and "));
 }
 
 }  // namespace

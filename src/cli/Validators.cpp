@@ -8,6 +8,7 @@
 
 #include "cli/Commands.h"
 #include "core/Files.h"
+#include "image/Image.h"
 #include "render/WorkerThreads.h"
 
 namespace envgi::cli {
@@ -70,8 +71,7 @@ std::string requireOutputExtension(const std::string& path, const std::vector<st
 }
 
 void requireRadianceImage(const std::string& path, const std::string& who) {
-  const std::string e = lowerExtension(path);
-  if (e == ".exr" || e == ".pfm" || e == ".hdr" || e == ".pic") return;
+  if (holdsRadiance(path)) return;
   throw std::runtime_error(fmt::format(
       "{} measures radiance, and '{}' is not a radiance image: give the .exr, .pfm or .hdr (a render's --png is "
       "tone-mapped and clamped)",

@@ -279,6 +279,11 @@ bool writeExr(const Image& img, const fs::path& path) {
 
 }  // namespace
 
+bool holdsRadiance(const std::string& path) {
+  const std::string ext = lowerExtension(path);
+  return ext == ".exr" || ext == ".pfm" || ext == ".hdr" || ext == ".pic";
+}
+
 Image loadImage(const std::string& path, bool decodeSrgb) {
   if (!fs::exists(path)) throw std::runtime_error("cannot open image '" + path + "': no such file");
   std::string ext = lowerExtension(path);

@@ -46,6 +46,9 @@ struct SaveOptions {
 // .pfm into linear RGB; throws std::runtime_error naming the file on a missing, unreadable or
 // truncated file. decodeSrgb = false keeps 8-bit codes as code / 255 (Mitsuba's `raw`).
 Image loadImage(const std::string& path, bool decodeSrgb = true);
+// Whether loadImage reads `path` as linear radiance (.exr, .pfm, .hdr), not as 8-bit display
+// codes (.png, .jpg): what an error against a reference can be measured on.
+bool holdsRadiance(const std::string& path);
 
 // Writes by extension: .exr, .pfm and .hdr as linear float, .png/.jpg as 8-bit sRGB after
 // exposure and tone curve. The file appears atomically (a temporary file, then rename).
