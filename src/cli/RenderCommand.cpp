@@ -230,10 +230,10 @@ void runRender(const RenderArgs& a) {
       save(path);
     } catch (const std::exception& e) {
       if (firstError.empty()) firstError = e.what();
-      const std::string name =
-          fmt::format("envgi-rescue-{}-{}", static_cast<long>(::getpid()), fs::path(path).filename().string());
-      const std::string rescue = (fs::temp_directory_path() / name).string();
-      try {
+      try {  // no temporary folder (TMPDIR gone) is one more place it cannot go, not a new error
+        const std::string name =
+            fmt::format("envgi-rescue-{}-{}", static_cast<long>(::getpid()), fs::path(path).filename().string());
+        const std::string rescue = (fs::temp_directory_path() / name).string();
         save(rescue);
         rescued.push_back("'" + rescue + "'");
       } catch (const std::exception&) {

@@ -729,22 +729,24 @@ TEST(RenderCli, AnOutputThatIsAFolderIsRefusedBeforeTheRender) {
 TEST(RenderCli, AnOutputThatStopsBeingWritableLosesNoSamples) {
   TempDir d;
   std::string scene = tinyScene(d, 32, 100000);
-  const std::string out = d.file("img.exr"), map = d.file("spp.exr"), log = d.file("log.txt");
-  std::string cmd = "sh -c '" + std::string(ENVGI_CLI_PATH) + " render " + scene + " -o " + out + " --sample-map " + map +
-                    " --no-progress --checkpoint 0.2 --time-limit 3; echo rc=$?' > " + log + " 2>&1 & echo $!";
-  FILE* p = popen(cmd.c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  int pid = 0;
-  ASSERT_EQ(fscanf(p, "%d", &pid), 1);
-  pclose(p);
-  for (int i = 0; i < 200 && !fs::exists(out); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  ASSERT_TRUE(fs::exists(out)) << "no first checkpoint in 10 s\n" << slurp(log);
-  fs::remove(out);
-  fs::create_directories(out + "/x");
-  fs::create_directories(map + "/x");  // the sample map, written only at the end
-  for (int i = 0; i < 600 && slurp(log).find("rc=") == std::string::npos; ++i)
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  const std::string text = slurp(log);
+  // Renders for `seconds` with `env` before the command; once the first checkpoint is written,
+  // makes folders where the image and the sample map go. Returns the log, ending "rc=N".
+  auto breakMidRender = [&](const std::string& env, const std::string& name, double seconds) {
+    const std::string out = d.file(name + ".exr"), map = d.file(name + "-spp.exr"), log = d.file(name + ".log");
+    std::string cmd = "sh -c '" + env + " " + std::string(ENVGI_CLI_PATH) + " render " + scene + " -o " + out +
+                      " --sample-map " + map + " --no-progress --checkpoint 0.2 --time-limit " +
+                      std::to_string(seconds) + "; echo rc=$?' > " + log + " 2>&1 &";
+    EXPECT_EQ(std::system(cmd.c_str()), 0);
+    for (int i = 0; i < 200 && !fs::exists(out); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    EXPECT_TRUE(fs::exists(out)) << "no first checkpoint in 10 s\n" << slurp(log);
+    fs::remove(out);
+    fs::create_directories(out + "/x");
+    fs::create_directories(map + "/x");  // the sample map, written only at the end
+    for (int i = 0; i < 600 && slurp(log).find("rc=") == std::string::npos; ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    return slurp(log);
+  };
+  const std::string text = breakMidRender("", "img", 3.0), out = d.file("img.exr");
   ASSERT_NE(text.find("rc=1"), std::string::npos) << text;
   EXPECT_NE(text.find("not written (cannot write '" + out + "': it is a folder); rendering on"), std::string::npos)
       << text;
@@ -759,7 +761,7 @@ TEST(RenderCli, AnOutputThatStopsBeingWritableLosesNoSamples) {
   at += 6;
   const std::string rescuedMap = text.substr(at, text.find('\'', at) - at);
   EXPECT_NE(rescue.find("img.exr"), std::string::npos) << rescue;
-  EXPECT_NE(rescuedMap.find("spp.exr"), std::string::npos) << rescuedMap;
+  EXPECT_NE(rescuedMap.find("img-spp.exr"), std::string::npos) << rescuedMap;
   envgi::Image img = envgi::loadImage(rescue), spp = envgi::loadImage(rescuedMap);
   fs::remove(rescue);
   fs::remove(rescuedMap);
@@ -769,6 +771,13 @@ TEST(RenderCli, AnOutputThatStopsBeingWritableLosesNoSamples) {
   EXPECT_GT(sum, 0.0);
   EXPECT_EQ(spp.width, 32);
   EXPECT_GT(spp.rgb[0], 0.f) << "every pixel took samples";
+
+  // With no temporary folder either, the error is still the output's, and claims no rescue.
+  const std::string none = breakMidRender("TMPDIR=" + d.file("absent"), "none", 1.5);
+  ASSERT_NE(none.find("rc=1"), std::string::npos) << none;
+  EXPECT_NE(none.find("envgi: error: cannot write '" + d.file("none.exr") + "': it is a folder\n"), std::string::npos)
+      << none;
+  EXPECT_EQ(none.find("were written to"), std::string::npos) << none;
 }
 
 // compare: an image against itself has no error, a noisier one has some, a wrong size is one
