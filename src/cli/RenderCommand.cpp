@@ -17,6 +17,7 @@
 #include "accel/EmbreeAccel.h"
 #include "cli/Commands.h"
 #include "core/Files.h"
+#include "core/PhysicalMemory.h"
 #include "envmap/CollapsedMap.h"
 #include "gpu/CudaExecutor.h"
 #include "render/AovRenderer.h"
@@ -179,6 +180,9 @@ void runRender(const RenderArgs& a) {
   ro.adaptiveMinSpp = a.minSpp;
   std::vector<int> samples;
   if (!a.sampleMap.empty()) ro.samplesOut = &samples;
+  for (const Aov& aov : scene.aovs) ro.aovChannels += int(aovChannelNames(aov).size());
+  // Before the AOVs, which are traced first and are as large as the film.
+  requireFilmFits(scene.camera, ro, physicalMemoryBytes());
   std::signal(SIGINT, onInterrupt);
   std::signal(SIGTERM, onInterrupt);
   RenderStats st;

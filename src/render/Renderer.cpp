@@ -276,14 +276,19 @@ size_t filmBytesPerPixel(const Camera& cam, const RenderOptions& opts) {
   const bool adaptive = opts.noiseThreshold > 0.f;
   size_t sums = sizeof(Color) + (opts.keepsVariance() ? sizeof(double) : 0) +
                 (cam.filter.hasNegativeLobes() ? sizeof(float) : 0);
+  // AOVs: each channel, and its copy in the image that is written; then that image's RGB copy.
+  const size_t aovs = opts.aovChannels > 0 ? size_t(opts.aovChannels) * 2 * sizeof(float) + sizeof(Color) : 0;
   // The sums twice (renderPasses' FilmSums copies them, not the executor's mask).
-  return 2 * sums + (adaptive ? 1 : 0) + sizeof(int) + 1 + sizeof(Color);
+  return 2 * sums + (adaptive ? 1 : 0) + sizeof(int) + 1 + sizeof(Color) + aovs;
 }
 
 void requireFilmFits(const Camera& cam, const RenderOptions& opts, double memoryBytes) {
   const double bytes = double(cam.width) * double(cam.height) * double(filmBytesPerPixel(cam, opts));
-  requireFitsInHalfOfMemory(bytes, memoryBytes, fmt::format("a {}x{} film would take about", cam.width, cam.height),
-                            "render fewer pixels (the film's width and height)");
+  const std::string aovs = opts.aovChannels > 0 ? fmt::format(" with {} AOV channels", opts.aovChannels) : "";
+  requireFitsInHalfOfMemory(bytes, memoryBytes,
+                            fmt::format("a {}x{} film{} would take about", cam.width, cam.height, aovs),
+                            opts.aovChannels > 0 ? "render fewer pixels (the film's width and height) or fewer AOVs"
+                                                 : "render fewer pixels (the film's width and height)");
 }
 
 Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts, RenderStats* stats) {

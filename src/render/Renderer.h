@@ -45,6 +45,9 @@ struct RenderOptions {
   int adaptiveMinSpp = 16;
   // When set, receives the samples each pixel took (row-major).
   std::vector<int>* samplesOut = nullptr;
+  // AOV channels the caller writes beside the image (render's --aov): counted in the film's
+  // memory bound (filmBytesPerPixel), since they are as large as the film.
+  int aovChannels = 0;
   // Whether executors must keep per-pixel sums of squared luminance.
   bool keepsVariance() const { return varianceOut != nullptr || noiseThreshold > 0.f; }
   CpuTracer cpuTracer = CpuTracer::Embree;

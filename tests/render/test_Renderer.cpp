@@ -114,6 +114,21 @@ TEST(Film, AFilmThatCannotFitIsRefused) {
   o.noiseThreshold = 0.05f;
   EXPECT_EQ(filmBytesPerPixel(cam, o), 58u);  // adaptive: the variance, and the executor's mask once
   o.noiseThreshold = 0.f;
+  o.aovChannels = 10;  // each channel and its copy in the written image, then that image's RGB
+  EXPECT_EQ(filmBytesPerPixel(cam, o), 41u + 80u + 12u);
+  cam.width = cam.height = 8192;  // 2.75 GB alone, 8.9 GB with the AOVs
+  EXPECT_NO_THROW(requireFilmFits(cam, o, 100e9));
+  try {
+    requireFilmFits(cam, o, 16e9);
+    ADD_FAILURE() << "an 8.9 GB film and AOVs were let through on a 16 GB machine";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("a 8192x8192 film with 10 AOV channels would take about 8.9 GB"),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("or fewer AOVs"), std::string::npos) << e.what();
+  }
+  cam.width = cam.height = 32768;
+  o.aovChannels = 0;
   try {
     requireFilmFits(cam, o, 25.3e9);
     ADD_FAILURE() << "a 44 GB film was let through on a 25.3 GB machine";
