@@ -358,7 +358,10 @@ def add_shape(sc, e, i):
     if emitter is not None:
         if emitter.get('type') != 'area':
             fail(f"a shape's emitter must be 'area', not '{emitter.get('type')}'")
-        add_area_emission(m, sc.prop(emitter, 'radiance', (1.0,) * 3))
+        radiance = sc.prop(emitter, 'radiance', (1.0,) * 3)
+        if not isinstance(radiance, tuple):
+            fail("an area emitter's radiance must be an rgb value here, not a texture")
+        add_area_emission(m, radiance)
     obj.data.materials.clear()
     obj.data.materials.append(m)
 
@@ -404,6 +407,8 @@ def main():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     sensor = sc.root.find('sensor')
+    if sensor is None or sensor.get('type') != 'perspective':
+        fail(f"needs a perspective sensor, not '{None if sensor is None else sensor.get('type')}'")
     integ = sc.root.find('integrator')
     if integ is None or integ.get('type') not in ('path', 'direct'):
         fail('needs a path (or direct) integrator')
