@@ -30,15 +30,16 @@ namespace envgi::cli {
 namespace {
 
 std::atomic<bool> g_cancel{false};
-// The first SIGINT or SIGTERM asks the render to stop after the pass in flight (and write what
-// is finished); a second one ends the process at once, as the signal's default would.
+// The first SIGINT or SIGTERM asks the render to stop after the tiles in flight (the first pass,
+// and a GPU's, after the pass) and write what is finished; a second one ends the process at
+// once, as the signal's default would.
 extern "C" void onInterrupt(int sig) {
   if (g_cancel.exchange(true)) {
     std::signal(sig, SIG_DFL);
     std::raise(sig);
     return;
   }
-  static const char msg[] = "\nenvgi: stopping after the pass in flight (again to stop now)\n";
+  static const char msg[] = "\nenvgi: stopping after the tiles in flight, keeping every finished sample (again to stop now)\n";
   ssize_t ignored = write(2, msg, sizeof(msg) - 1);  // async-signal-safe, unlike the logger
   (void)ignored;
 }
@@ -269,7 +270,13 @@ void runRender(const RenderArgs& a) {
                  double(st.pixelSamples), full > 0 ? 100.0 * double(st.pixelSamples) / full : 0.0, st.sppDone,
                  100.0 * double(st.pixelsStopped) / (double(scene.camera.width) * scene.camera.height));
   }
-  if (st.cancelled) spdlog::warn("interrupted: wrote the {} samples per pixel finished so far", st.sppDone);
+  if (st.cancelled && st.pixelsAhead > 0)
+    spdlog::warn("interrupted: wrote the {} samples per pixel finished so far, and {} in {} pixels ({:.1f}%) whose "
+                 "tiles had finished the pass in flight",
+                 st.sppDone, st.sppAhead, st.pixelsAhead,
+                 100.0 * double(st.pixelsAhead) / (double(scene.camera.width) * scene.camera.height));
+  else if (st.cancelled)
+    spdlog::warn("interrupted: wrote the {} samples per pixel finished so far", st.sppDone);
   if (st.timeLimited)
     spdlog::info("time limit of {:g} s: stopped after {} of {} spp", a.timeLimit, st.sppDone, requestedSpp);
   spdlog::info("done in {:.2f} s: {} spp, {:.3g} rays, {:.3g} Mrays/s", st.seconds, st.sppDone, double(st.rays),

@@ -28,6 +28,14 @@ void ActivePixels::passDone(int s0, int s1) {
   pixelSamples_ += uint64_t(activeCount_) * uint64_t(s1 - s0);
 }
 
+size_t ActivePixels::passDone(int s0, int s1, const std::vector<unsigned char>& took) {
+  size_t n = 0;
+  for (size_t i = 0; i < samples_.size() && i < took.size(); ++i)
+    if (active_[i] && took[i]) samples_[i] = s1, ++n;
+  pixelSamples_ += uint64_t(n) * uint64_t(s1 - s0);
+  return n;
+}
+
 size_t ActivePixels::update(PassExecutor& ex, FilmSums* film) {
   ex.readFilm(film);
   activeCount_ = updateActivePixels(film->sum, film->sumSqLum, samples_, width_, height_, threshold_, 1, &active_);

@@ -23,6 +23,9 @@ class ActivePixels {
 
   // Samples [s0, s1) of every active pixel were taken.
   void passDone(int s0, int s1);
+  // Samples [s0, s1) of the active pixels where took is non-zero (a pass cut by Ctrl-C,
+  // PassExecutor::cutPass); returns how many pixels that is.
+  size_t passDone(int s0, int s1, const std::vector<unsigned char>& took);
   // Reads ex's film into *film, stops the pixels that converged with their neighbours, and hands
   // ex the new mask unless none is left. Returns the pixels still sampling.
   size_t update(PassExecutor& ex, FilmSums* film);

@@ -49,10 +49,21 @@ class CpuExecutor final : public PassExecutor {
     FilmView fv{film_.sum.data(), film_.sumSqLum.empty() ? nullptr : film_.sumSqLum.data(), W, H,
                 active_.empty() ? nullptr : active_.data(), film_.weightSum.empty() ? nullptr : film_.weightSum.data()};
     std::atomic<uint64_t> rays{0}, dropped{0};
+    // Which tiles ran, where Ctrl-C may cut the pass: a tile once started runs whole, so each
+    // pixel takes all of the pass's samples or none.
+    std::vector<unsigned char> tileRan(cancel_ ? size_t(tilesX) * size_t(tilesY) : 0, 0);
+    std::atomic<bool> cut{false};
     arena_.execute([&] {
       tbb::parallel_for(tbb::blocked_range<int>(0, tilesX * tilesY, 1), [&](const tbb::blocked_range<int>& r) {
         PixelCounters pc;
         for (int t = r.begin(); t < r.end(); ++t) {
+          if (cancel_) {
+            if (cancel_->load(std::memory_order_relaxed)) {
+              cut.store(true, std::memory_order_relaxed);
+              continue;
+            }
+            tileRan[size_t(t)] = 1;
+          }
           int x0 = (t % tilesX) * tile_, y0 = (t / tilesX) * tile_;
           int x1 = std::min(W, x0 + tile_), y1 = std::min(H, y0 + tile_);
           // Progress counts the samples taken: the tile's pixels that adaptive sampling left on.
@@ -76,7 +87,21 @@ class CpuExecutor final : public PassExecutor {
     });
     counters->rays += rays.load();
     counters->dropped += dropped.load();
+    took_.clear();
+    if (cut.load()) {
+      took_.assign(size_t(W) * size_t(H), 0);
+      for (int t = 0; t < tilesX * tilesY; ++t) {
+        if (!tileRan[size_t(t)]) continue;
+        int x0 = (t % tilesX) * tile_, y0 = (t / tilesX) * tile_;
+        for (int y = y0; y < std::min(H, y0 + tile_); ++y)
+          std::fill_n(took_.begin() + std::ptrdiff_t(size_t(y) * size_t(W) + size_t(x0)), std::min(W, x0 + tile_) - x0,
+                      (unsigned char)1);
+      }
+    }
   }
+
+  void watchCancel(const std::atomic<bool>* cancel) override { cancel_ = cancel; }
+  const std::vector<unsigned char>* cutPass() const override { return took_.empty() ? nullptr : &took_; }
 
   void readFilm(FilmSums* out) override { *out = film_; }
 
@@ -87,6 +112,7 @@ class CpuExecutor final : public PassExecutor {
     film_.weightSum.clear();
     if (cam.filter.hasNegativeLobes()) film_.weightSum.assign(film_.sum.size(), 0.f);
     active_.clear();
+    took_.clear();
     return true;
   }
 
@@ -107,6 +133,8 @@ class CpuExecutor final : public PassExecutor {
   bool byBounce_ = false;
   FilmSums film_;
   std::vector<unsigned char> active_;  // empty: every pixel takes samples
+  const std::atomic<bool>* cancel_ = nullptr;  // watchCancel's
+  std::vector<unsigned char> took_;  // the last pass's pixels where Ctrl-C cut it; else empty
   // renderTileByBounce's room, one per thread. In memory from the standard allocator, not TBB's
   // scalable one (mmap'd, unseen by LeakSanitizer, which then took each batch's arrays for leaks
   // while the executor lived: a false report in the viewer's fuzzer).

@@ -3,6 +3,7 @@
 // its device: the CPU through oneTBB, or a CUDA GPU (src/gpu).
 #pragma once
 
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,13 @@ class PassExecutor {
   virtual bool setActivePixels(const std::vector<unsigned char>& /*mask*/) { return false; }
   // Whether readFilm returns each pixel's sum of squared luminance (adaptive sampling's noise).
   virtual bool keepsVariance() const { return false; }
+  // Ctrl-C inside a pass (null: none). An executor that watches it starts no tile once it is
+  // set, so that a pass of minutes (one sample of a huge image) stops within a tile's time;
+  // cutPass() then says which pixels took the pass. One that does not runs its passes whole.
+  virtual void watchCancel(const std::atomic<bool>* /*cancel*/) {}
+  // After runPass: null where the pass ran whole; else one entry a pixel (row-major), non-zero
+  // where the pixel took every sample of the pass, zero where it took none of them.
+  virtual const std::vector<unsigned char>* cutPass() const { return nullptr; }
 };
 
 }  // namespace envgi

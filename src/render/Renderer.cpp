@@ -310,7 +310,8 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   FilmSums film;
   auto t0 = Clock::now();
   auto lastCheckpoint = t0;
-  int sppDone = 0;
+  int sppDone = 0, sppAhead = 0;
+  size_t pixelsAhead = 0;
   bool cancelled = false, timeLimited = false;
   const size_t px = size_t(W) * size_t(H);
   // Each pixel's samples so far, and adaptive sampling's mask: every pixel starts active.
@@ -338,7 +339,17 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
         break;
       }
     }
+    // Ctrl-C stops a pass at its next tile, but for the first, which every pixel takes whole
+    // (an image with black tiles would not be finished work). The finished tiles' samples are
+    // kept: each pixel's mean is over its own count.
+    ex.watchCancel(s0 > 0 ? opts.cancel : nullptr);
     ex.runPass(s0, s1, progress, &counters);
+    if (const std::vector<unsigned char>* took = ex.cutPass()) {
+      pixelsAhead = pixels.passDone(s0, s1, *took);
+      sppAhead = s1;
+      cancelled = true;
+      break;
+    }
     pixels.passDone(s0, s1);
     sppDone = s1;
     if (adaptive && sppDone >= opts.adaptiveMinSpp && sppDone < spp) {
@@ -354,6 +365,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
       lastCheckpoint = Clock::now();
     }
   }
+  ex.watchCancel(nullptr);
   progress.finish();
   Image img = meanImage();
   if (stats) {
@@ -366,6 +378,8 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     stats->pixelSamples = pixels.pixelSamples();
     stats->pixelsStopped = px - pixels.activeCount();  // 0 unless adaptive
     stats->converged = pixels.converged();
+    stats->pixelsAhead = pixelsAhead;
+    stats->sppAhead = sppAhead;
   }
   if (opts.varianceOut && sppDone > 0) {
     if (film.sumSqLum.empty()) throw std::runtime_error("this executor kept no per-pixel variance");

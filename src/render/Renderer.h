@@ -65,6 +65,9 @@ struct RenderStats {
   uint64_t pixelSamples = 0;  // samples taken over all pixels (fewer than pixels x sppDone when adaptive)
   size_t pixelsStopped = 0;   // pixels that adaptive sampling stopped before the samples asked for
   bool converged = false;     // adaptive sampling stopped every pixel: the render ended early
+  // Ctrl-C cut the pass after sppDone at a tile: the pixels that took it whole, at sppAhead.
+  size_t pixelsAhead = 0;
+  int sppAhead = 0;
   double raysPerSecond() const { return seconds > 0.0 ? double(rays) / seconds : 0.0; }
 };
 

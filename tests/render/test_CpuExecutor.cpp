@@ -2,6 +2,10 @@
 // expectation as the Embree path: a per-region Z-test on the bundled scenes and on a glossy
 // test scene, for path and direct.
 #include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <thread>
 #if defined(__SANITIZE_ADDRESS__)
 #include <sanitizer/lsan_interface.h>
 #endif
@@ -172,4 +176,70 @@ TEST(CpuExecutor, ALeakCheckDuringARenderFindsNothing) {
 #else
   GTEST_SKIP() << "needs LeakSanitizer: runs in the sanitizer build (.ci/run's second suite)";
 #endif
+}
+
+// Ctrl-C inside a pass (PassExecutor::watchCancel): no tile starts once it is set, a started
+// tile runs whole, and cutPass() names the pixels that took the pass; the others keep their
+// film as it was. Set before the pass, nothing runs; unwatched, the pass runs whole.
+TEST(CpuExecutor, CtrlCCutsAPassBetweenTiles) {
+  auto same = [](const Color& a, const Color& b) { return a.x == b.x && a.y == b.y && a.z == b.z; };
+  Scene s;
+  test::loadBundledSmall("buddha", 128, IntegratorType::Path, &s);
+  s.finalize();
+  EmbreeAccel accel(s);
+  RenderOptions o;
+  o.progress = false;
+  o.threads = 2;
+  PreparedRender pr = prepareRender(s, accel, o);
+  PassExecutor& ex = *pr.executor;
+  Progress quiet(1, false);
+  PassCounters counters;
+  std::atomic<bool> cancel{true};
+  ex.runPass(0, 1, quiet, &counters);  // not watched: whole, though cancel is set
+  EXPECT_EQ(ex.cutPass(), nullptr);
+  FilmSums before, after;
+  ex.readFilm(&before);
+  size_t lit = 0;
+  for (const Color& c : before.sum) lit += c.x + c.y + c.z > 0.f;
+  EXPECT_GT(lit, before.sum.size() * 9 / 10) << "the first pass missed pixels";
+
+  ex.watchCancel(&cancel);
+  ex.runPass(1, 2, quiet, &counters);  // set before the pass: no tile runs
+  ASSERT_NE(ex.cutPass(), nullptr);
+  for (unsigned char t : *ex.cutPass()) ASSERT_EQ(t, 0);
+  ex.readFilm(&after);
+  for (size_t i = 0; i < after.sum.size(); ++i) ASSERT_TRUE(same(after.sum[i], before.sum[i])) << i;
+
+  // Set while the pass runs (1M samples: a second or more on two cores).
+  cancel = false;
+  std::thread ctrlC([&] {
+    std::this_thread::sleep_for(std::chrono::milliseconds(60));
+    cancel = true;
+  });
+  ex.runPass(1, 65, quiet, &counters);
+  ctrlC.join();
+  const std::vector<unsigned char>* took = ex.cutPass();
+  ASSERT_NE(took, nullptr) << "the pass ended before Ctrl-C";
+  ex.readFilm(&after);
+  size_t ran = 0;
+  for (int y = 0; y < 128; ++y)
+    for (int x = 0; x < 128; ++x) {
+      const size_t i = size_t(y) * 128 + size_t(x);
+      ran += (*took)[i];
+      // Whole tiles of 16 x 16: a pixel took the pass as its tile's corner did.
+      ASSERT_EQ((*took)[i], (*took)[size_t(y / 16 * 16) * 128 + size_t(x / 16 * 16)]) << x << ", " << y;
+      if (!(*took)[i]) {
+        ASSERT_TRUE(same(after.sum[i], before.sum[i])) << x << ", " << y;
+      }
+    }
+  EXPECT_GT(ran, 0u);
+  EXPECT_LT(ran, size_t(128 * 128));
+  size_t changed = 0;
+  for (size_t i = 0; i < after.sum.size(); ++i) changed += !same(after.sum[i], before.sum[i]);
+  EXPECT_LE(changed, ran);
+  EXPECT_GT(changed, ran * 9 / 10) << "the pixels of the tiles that ran took their samples";
+
+  ex.watchCancel(nullptr);
+  ex.runPass(65, 66, quiet, &counters);
+  EXPECT_EQ(ex.cutPass(), nullptr);
 }

@@ -31,6 +31,36 @@ class RecordingExecutor final : public PassExecutor {
   double budget_;
 };
 
+// Each sample adds radiance 1 to its pixel. Watching Ctrl-C, it raises it itself at the start
+// of pass cutAt (a user's Ctrl-C in that pass) and then gives the pass to the first `keep`
+// pixels only, as a CPU pass cut between tiles does.
+class CuttingExecutor final : public PassExecutor {
+ public:
+  CuttingExecutor(size_t pixels, size_t cutAt, size_t keep) : sum_(pixels, Color(0.f)), cutAt_(cutAt), keep_(keep) {}
+  std::string deviceName() const override { return "cutting"; }
+  void watchCancel(const std::atomic<bool>* c) override { watched_ = c; }
+  void runPass(int s0, int s1, Progress&, PassCounters*) override {
+    took_.clear();
+    if (++passes == cutAt_) raise->store(true);
+    if (watched_ && watched_->load()) took_.assign(sum_.size(), 0);
+    for (size_t i = 0; i < sum_.size(); ++i) {
+      if (!took_.empty() && i >= keep_) continue;
+      if (!took_.empty()) took_[i] = 1;
+      sum_[i] += Color(float(s1 - s0));
+    }
+  }
+  const std::vector<unsigned char>* cutPass() const override { return took_.empty() ? nullptr : &took_; }
+  void readFilm(FilmSums* out) override { out->sum = sum_; }
+  std::atomic<bool>* raise = nullptr;
+  size_t passes = 0;
+
+ private:
+  std::vector<Color> sum_;
+  size_t cutAt_, keep_;
+  const std::atomic<bool>* watched_ = nullptr;
+  std::vector<unsigned char> took_;
+};
+
 std::vector<std::pair<int, int>> passesOf(int w, int h, int spp, double budget) {
   RecordingExecutor ex(w, h, budget);
   RenderOptions o;
@@ -142,4 +172,36 @@ TEST(Film, AFilmThatCannotFitIsRefused) {
   EXPECT_NO_THROW(requireFilmFits(cam, o, 100e9));
   cam.width = cam.height = 8192;  // 2.75 GB
   EXPECT_NO_THROW(requireFilmFits(cam, o, 25.3e9));
+}
+
+// Ctrl-C in a pass that the executor cuts between tiles: the pixels that took it keep its
+// samples, each pixel's mean is over its own count (so the image is 1 everywhere), and the
+// first pass is never cut (it runs whole, then the render stops before the second).
+TEST(RenderPasses, ACutPassKeepsTheSamplesOfThePixelsThatTookIt) {
+  for (size_t cutAt : {1, 4}) {
+    CuttingExecutor ex(8, cutAt, 3);
+    std::atomic<bool> cancel{false};
+    ex.raise = &cancel;
+    RenderOptions o;
+    o.progress = false;
+    o.cancel = &cancel;
+    std::vector<int> samples;
+    o.samplesOut = &samples;
+    RenderStats st;
+    Image img = renderPasses(ex, 4, 2, 64, o, &st);
+    EXPECT_TRUE(st.cancelled);
+    for (float v : img.rgb) EXPECT_FLOAT_EQ(v, 1.f) << "cut at pass " << cutAt;
+    if (cutAt == 1) {  // the first pass: whole, and no pixel ahead
+      EXPECT_EQ(ex.passes, 1u);
+      EXPECT_EQ(st.sppDone, 1);
+      EXPECT_EQ(st.pixelsAhead, 0u);
+      EXPECT_EQ(samples, std::vector<int>(8, 1));
+    } else {  // passes 0-1, 1-2, 2-4 done; 4-8 cut after the first 3 pixels
+      EXPECT_EQ(st.sppDone, 4);
+      EXPECT_EQ(st.pixelsAhead, 3u);
+      EXPECT_EQ(st.sppAhead, 8);
+      EXPECT_EQ(samples, (std::vector<int>{8, 8, 8, 4, 4, 4, 4, 4}));
+      EXPECT_EQ(st.pixelSamples, uint64_t(8 * 4 + 3 * 4));
+    }
+  }
 }
