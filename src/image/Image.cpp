@@ -8,6 +8,7 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfThreading.h>
 #include <openexr.h>
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
@@ -24,6 +25,8 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <mutex>
+#include <thread>
 #include <stdexcept>
 
 // After <cstdio>: jpeglib.h needs FILE and size_t declared first.
@@ -77,9 +80,17 @@ void checkExrHeader(const std::string& path) {
                                          path, w, h, fileBytes));
 }
 
+// OpenEXR's worker threads, set once before the first file unless setImageThreads came first.
+std::once_flag g_exrThreadsSet;
+void setExrThreads(int threads) {
+  Imf::setGlobalThreadCount(threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency())));
+}
+void useExrThreads() { std::call_once(g_exrThreadsSet, [] { setExrThreads(0); }); }
+
 // OpenEXR (as pbrt-v4 and Mitsuba 3 read it): R, G, B as float, or Y alone as grey.
 Image loadExr(const std::string& path) {
   checkExrHeader(path);
+  useExrThreads();
   try {
     Imf::InputFile in(path.c_str());
     const Imath::Box2i dw = in.header().dataWindow();
@@ -255,6 +266,7 @@ bool writePfm(const Image& img, const fs::path& path) {
 }
 
 bool writeExr(const Image& img, const fs::path& path) {
+  useExrThreads();
   Imf::Header header(img.width, img.height);
   header.compression() = Imf::ZIP_COMPRESSION;
   const char* names[3] = {"R", "G", "B"};
@@ -278,6 +290,11 @@ bool writeExr(const Image& img, const fs::path& path) {
 }
 
 }  // namespace
+
+void setImageThreads(int threads) {
+  std::call_once(g_exrThreadsSet, [] {});
+  setExrThreads(threads);
+}
 
 bool holdsRadiance(const std::string& path) {
   const std::string ext = lowerExtension(path);
