@@ -29,7 +29,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('--envgi', required=True)
     ap.add_argument('--scenes', required=True)
-    ap.add_argument('--names', default='buddha,teapot-glass,bunny-sunrise,cornell-box,textured,microfacets')
+    ap.add_argument('--names', default='buddha,teapot-glass,bunny-sunrise,cornell-box,textured,microfacets,mask')
     a = ap.parse_args()
     here = os.path.dirname(os.path.abspath(__file__))
     failed = 0

@@ -228,7 +228,8 @@ def colour(sc, nt, b, name, default, kind):
     tex = next((c for c in b if c.get('name') == name and c.tag in ('texture', 'ref')), None)
     if tex is None:
         rgb = nt.nodes.new('ShaderNodeRGB')
-        rgb.outputs[0].default_value = (*sc.prop(b, name, default), 1)
+        value = sc.prop(b, name, default)
+        rgb.outputs[0].default_value = (*((value,) * 3 if isinstance(value, float) else value), 1)
         return rgb.outputs[0]
     if tex.tag == 'ref':
         tex = sc.ids[tex.get('id')]
@@ -263,19 +264,27 @@ def colour(sc, nt, b, name, default, kind):
 
 
 def material(sc, b, name, kind):
-    if b.tag == 'ref':
-        b = sc.ids[b.get('id')]
-    t = b.get('type')
-    if t == 'twosided':  # Cycles' surfaces are two-sided already
-        return material(sc, next(c for c in b if c.tag in ('bsdf', 'ref')), name, kind)
     m = bpy.data.materials.new(name)
     m.use_nodes = True
     nt = m.node_tree
     nt.nodes.clear()
     out = nt.nodes.new('ShaderNodeOutputMaterial')
-    textured = {c.get('name') for c in b if c.tag in ('texture', 'ref')}
+    nt.links.new(bsdf_node(sc, nt, b, kind), out.inputs['Surface'])
+    return m
+
+
+def bsdf_node(sc, nt, b, kind):
+    """The shader output for Mitsuba's BSDF element b, built in the node tree nt."""
+    if b.tag == 'ref':
+        b = sc.ids[b.get('id')]
+    t = b.get('type')
+    inner = next((c for c in b if c.tag in ('bsdf', 'ref')), None)
+    if t == 'twosided':  # Cycles' surfaces are two-sided already
+        return bsdf_node(sc, nt, inner, kind)
+    textured = {c.get('name') for c in b if c.tag in ('texture', 'ref') and c.get('name')}
     allowed = {'diffuse': {'reflectance'}, 'plastic': {'diffuse_reflectance'}, 'roughplastic': {'diffuse_reflectance'},
-               'conductor': {'specular_reflectance'}, 'roughconductor': {'specular_reflectance'}}.get(t, set())
+               'conductor': {'specular_reflectance'}, 'roughconductor': {'specular_reflectance'},
+               'mask': {'opacity'}}.get(t, set())
     if textured - allowed:
         fail(f"bsdf '{t}' with a texture for {sorted(textured - allowed)} is not supported")
     # Mitsuba's rough BSDFs default to Beckmann; Cycles' Principled BSDF (rough plastic here) has GGX only.
@@ -284,6 +293,13 @@ def material(sc, b, name, kind):
         fail(f"bsdf '{t}' with alpha_u / alpha_v (anisotropic) is not supported here")
     if t == 'roughplastic' and dist != 'ggx':
         fail("roughplastic needs distribution 'ggx' here: Cycles' Principled BSDF has no Beckmann")
+    if t == 'mask':
+        # Mitsuba's mask: the inner BSDF with probability `opacity`, else the ray passes on.
+        mix = nt.nodes.new('ShaderNodeMixShader')
+        nt.links.new(colour(sc, nt, b, 'opacity', 0.5, kind), mix.inputs['Fac'])
+        nt.links.new(nt.nodes.new('ShaderNodeBsdfTransparent').outputs[0], mix.inputs[1])
+        nt.links.new(bsdf_node(sc, nt, inner, kind), mix.inputs[2])
+        return mix.outputs[0]
     if t == 'diffuse':
         n = nt.nodes.new('ShaderNodeBsdfDiffuse')
         nt.links.new(colour(sc, nt, b, 'reflectance', (0.5,) * 3, kind), n.inputs['Color'])
@@ -321,8 +337,7 @@ def material(sc, b, name, kind):
         nt.links.new(tint.outputs[0], n.inputs['Color'])
     else:
         fail(f"bsdf '{t}' is not supported")
-    nt.links.new(n.outputs[0], out.inputs['Surface'])
-    return m
+    return n.outputs[0]
 
 
 def add_shape(sc, e, i):
@@ -452,7 +467,17 @@ def add_envmap(sc, nt, env):
     tex.interpolation = 'Linear'
     coord = nt.nodes.new('ShaderNodeTexCoord')
     mapping = nt.nodes.new('ShaderNodeMapping')
-    mapping.inputs['Rotation'].default_value = (0.0, 0.0, math.radians(ENV_TURN_DEG))
+    turn = Matrix.Rotation(math.radians(ENV_TURN_DEG), 3, 'Z')
+    if env.find('transform') is not None:
+        # Mitsuba looks the map up at to_world^-1 d (its frame, y up): here at
+        # turn . Y . to_world^-1 . Y^-1 d, with Y Mitsuba's frame to Blender's (z up).
+        r = sc.transform(env).to_3x3()
+        e = r @ r.transposed()
+        if r.determinant() < 0 or any(abs(e[i][j] - (i == j)) > 1e-4 for i in range(3) for j in range(3)):
+            fail("an envmap's to_world must be a rotation here")
+        y = Y_UP_TO_Z_UP.to_3x3()
+        turn = turn @ y @ r.transposed() @ y.inverted()
+    mapping.inputs['Rotation'].default_value = turn.to_euler('XYZ')
     bg = nt.nodes.new('ShaderNodeBackground')
     bg.inputs['Strength'].default_value = sc.prop(env, 'scale', 1.0)
     out = nt.nodes.new('ShaderNodeOutputWorld')
@@ -460,8 +485,6 @@ def add_envmap(sc, nt, env):
     nt.links.new(mapping.outputs['Vector'], tex.inputs['Vector'])
     nt.links.new(tex.outputs['Color'], bg.inputs['Color'])
     nt.links.new(bg.outputs['Background'], out.inputs['Surface'])
-    if env.find('transform') is not None:
-        fail('a rotated envmap is not supported')
 
 
 def render(sc, scene, a, max_depth):
