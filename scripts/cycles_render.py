@@ -28,6 +28,13 @@ Y_UP_TO_Z_UP = Matrix.Rotation(math.radians(90.0), 4, 'X')
 # after the turn above: of the four, the only one whose buddha render matches envgi's (relative
 # RMSE 0.24 at 64 spp against 3.8-15 for the others; the windows of Grace line up by eye).
 ENV_TURN_DEG = 90.0
+# Mitsuba principled parameters whose Cycles Principled inputs take them as they are, with
+# Mitsuba's defaults (base_color, eta and clearcoat_gloss are mapped apart).
+PRINCIPLED_INPUTS = {'metallic': ('Metallic', 0.0), 'roughness': ('Roughness', 0.5),
+                     'anisotropic': ('Anisotropic', 0.0), 'spec_trans': ('Transmission', 0.0),
+                     'specular': ('Specular', 0.5), 'spec_tint': ('Specular Tint', 0.0),
+                     'sheen': ('Sheen', 0.0), 'sheen_tint': ('Sheen Tint', 0.0),
+                     'clearcoat': ('Clearcoat', 0.0)}
 # Typical linear-RGB normal-incidence reflectances of the metals a scene may name: Cycles 3.4 has
 # no conductor with a complex index of refraction, its glossy BSDF takes a colour.
 CONDUCTOR_F0 = {'Cu': (0.955, 0.638, 0.538), 'Cr': (0.549, 0.556, 0.554), 'Al': (0.913, 0.922, 0.924),
@@ -284,7 +291,7 @@ def bsdf_node(sc, nt, b, kind):
     textured = {c.get('name') for c in b if c.tag in ('texture', 'ref') and c.get('name')}
     allowed = {'diffuse': {'reflectance'}, 'plastic': {'diffuse_reflectance'}, 'roughplastic': {'diffuse_reflectance'},
                'conductor': {'specular_reflectance'}, 'roughconductor': {'specular_reflectance'},
-               'mask': {'opacity'}}.get(t, set())
+               'mask': {'opacity'}, 'principled': set(PRINCIPLED_INPUTS) | {'base_color'}}.get(t, set())
     if textured - allowed:
         fail(f"bsdf '{t}' with a texture for {sorted(textured - allowed)} is not supported")
     # Mitsuba's rough BSDFs default to Beckmann; Cycles' Principled BSDF (rough plastic here) has GGX only.
@@ -322,6 +329,22 @@ def bsdf_node(sc, nt, b, kind):
         n = nt.nodes.new('ShaderNodeBsdfGlass')
         n.distribution = 'SHARP'
         n.inputs['IOR'].default_value = sc.prop(b, 'int_ior', 1.5046) / sc.prop(b, 'ext_ior', 1.000277)
+    elif t == 'principled':
+        # Both are Burley's Disney BSDF, single-scattering GGX (Cycles' Principled v1).
+        n = nt.nodes.new('ShaderNodeBsdfPrincipled')
+        n.distribution = 'GGX'
+        nt.links.new(colour(sc, nt, b, 'base_color', (0.5,) * 3, kind), n.inputs['Base Color'])
+        for name, (socket, default) in PRINCIPLED_INPUTS.items():
+            nt.links.new(colour(sc, nt, b, name, default, kind), n.inputs[socket])
+        eta = sc.prop(b, 'eta', None)
+        if eta is not None:  # Mitsuba's specular follows eta when eta is given; Cycles' F0 is 0.08 x Specular
+            n.inputs['IOR'].default_value = eta
+            n.inputs['Specular'].default_value = ((eta - 1) / (eta + 1)) ** 2 / 0.08
+        # Disney's clearcoat roughness (an alpha) from its gloss.
+        gloss = sc.prop(b, 'clearcoat_gloss', 0.0)
+        if isinstance(gloss, str):
+            fail("principled: a textured clearcoat_gloss is not supported")
+        n.inputs['Clearcoat Roughness'].default_value = math.sqrt(0.1 * (1 - gloss) + 0.001 * gloss)
     elif t in ('conductor', 'roughconductor'):
         n = nt.nodes.new('ShaderNodeBsdfGlossy')
         n.distribution = {'ggx': 'GGX', 'beckmann': 'BECKMANN'}[dist] if t == 'roughconductor' else 'SHARP'
