@@ -291,6 +291,9 @@ void requireFilmFits(const Camera& cam, const RenderOptions& opts, double memory
                                                  : "render fewer pixels (the film's width and height)");
 }
 
+// The most of a render's time that checkpoints may take.
+constexpr double kCheckpointShare = 0.1;
+
 Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts, RenderStats* stats) {
   // Passes double the samples done (1, 1, 2, 4, ...) up to the executor's limit (64 samples on
   // the CPU), so a checkpoint comes early, and each pass ends at a power of two or a multiple of
@@ -310,6 +313,8 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   FilmSums film;
   auto t0 = Clock::now();
   auto lastCheckpoint = t0;
+  double checkpointGap = opts.checkpointSeconds;
+  bool gapSaid = false;
   int sppDone = 0, sppAhead = 0;
   size_t pixelsAhead = 0;
   bool cancelled = false, timeLimited = false;
@@ -360,9 +365,19 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
       if (left == 0) break;  // every pixel has converged: the render is done
     }
     double sinceCheckpoint = std::chrono::duration<double>(Clock::now() - lastCheckpoint).count();
-    if (opts.checkpoint && opts.checkpointSeconds > 0.0 && sinceCheckpoint >= opts.checkpointSeconds && sppDone < spp) {
+    if (opts.checkpoint && opts.checkpointSeconds > 0.0 && sinceCheckpoint >= checkpointGap && sppDone < spp) {
+      const auto start = Clock::now();
       opts.checkpoint(meanImage(), sppDone);
       lastCheckpoint = Clock::now();
+      // A checkpoint stops the passes while it is written (an 8192² EXR: seconds), so the next
+      // waits at least ten times as long as this one took: they cost at most a tenth.
+      const double took = std::chrono::duration<double>(lastCheckpoint - start).count();
+      checkpointGap = std::max(opts.checkpointSeconds, took / kCheckpointShare);
+      if (checkpointGap > opts.checkpointSeconds && !gapSaid) {
+        spdlog::info("checkpoints every {:.0f} s or more, not {:g}: writing one took {:.1f} s", checkpointGap,
+                     opts.checkpointSeconds, took);
+        gapSaid = true;
+      }
     }
   }
   ex.watchCancel(nullptr);

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <climits>
+#include <thread>
 
 #include "render/Renderer.h"
 
@@ -204,4 +206,33 @@ TEST(RenderPasses, ACutPassKeepsTheSamplesOfThePixelsThatTookIt) {
       EXPECT_EQ(st.pixelSamples, uint64_t(8 * 4 + 3 * 4));
     }
   }
+}
+
+// A checkpoint stops the passes while it is written, so checkpoints take at most about a tenth
+// of the render: asked for after every pass (period 1 ms), with passes of 2 ms and a write of
+// 40 ms, a render of 150 passes (about 0.3 s of passes) writes a handful, not 150.
+TEST(RenderPasses, CheckpointsTakeAtMostATenthOfTheRender) {
+  class SlowExecutor final : public PassExecutor {
+   public:
+    std::string deviceName() const override { return "slow"; }
+    void runPass(int, int, Progress&, PassCounters*) override {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    void readFilm(FilmSums* out) override { out->sum.assign(4, Color(0.f)); }
+    int maxPassSize() const override { return 1; }
+  } ex;
+  RenderOptions o;
+  o.progress = false;
+  o.checkpointSeconds = 0.001;
+  int written = 0;
+  o.checkpoint = [&](const Image&, int) {
+    ++written;
+    std::this_thread::sleep_for(std::chrono::milliseconds(40));
+  };
+  RenderStats st;
+  renderPasses(ex, 2, 2, 151, o, &st);
+  EXPECT_EQ(st.sppDone, 151);
+  EXPECT_GE(written, 1);
+  // Each write makes the next wait 0.4 s or more: at most a write a 0.4 s of the render.
+  EXPECT_LE(written, 3) << "checkpoints every pass, each taking 20 times a pass";
 }
