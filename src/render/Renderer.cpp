@@ -329,20 +329,25 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     ex.readFilm(&film);
     return filmMean(film, W, H, pixels.samples());
   };
+  // Whether the pass that would start at s0 ends past the time limit, at the rate of the passes
+  // so far, a pixel-sample at a time (adaptive passes shrink). Decided after each pass, before
+  // its checkpoint, which is then left to the final write.
+  auto pastTimeLimit = [&](int s0) {
+    if (opts.timeLimitSeconds <= 0.0 || pixels.pixelSamples() == 0) return false;
+    double spent = std::chrono::duration<double>(Clock::now() - t0).count();
+    return spent + spent / double(pixels.pixelSamples()) * double(pixels.activeCount()) * (passEnd(s0) - s0) >
+           opts.timeLimitSeconds;
+  };
+  bool nextPastTimeLimit = false;
   for (int s0 = 0, s1 = 0; s0 < spp; s0 = s1) {
     s1 = passEnd(s0);
     if (opts.cancel && opts.cancel->load()) {
       cancelled = true;
       break;
     }
-    if (opts.timeLimitSeconds > 0.0 && pixels.pixelSamples() > 0) {
-      // At the rate of the passes so far, a pixel-sample at a time (adaptive passes shrink).
-      double spent = std::chrono::duration<double>(Clock::now() - t0).count();
-      if (spent + spent / double(pixels.pixelSamples()) * double(pixels.activeCount()) * (s1 - s0) >
-          opts.timeLimitSeconds) {
-        timeLimited = true;
-        break;
-      }
+    if (nextPastTimeLimit) {
+      timeLimited = true;
+      break;
     }
     // Ctrl-C stops a pass at its next tile, but for the first, which every pixel takes whole
     // (an image with black tiles would not be finished work). The finished tiles' samples are
@@ -364,8 +369,10 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
       spdlog::debug("adaptive sampling: {} of {} pixels still sampling after {} spp", left, px, sppDone);
       if (left == 0) break;  // every pixel has converged: the render is done
     }
+    nextPastTimeLimit = sppDone < spp && pastTimeLimit(sppDone);
     double sinceCheckpoint = std::chrono::duration<double>(Clock::now() - lastCheckpoint).count();
-    if (opts.checkpoint && opts.checkpointSeconds > 0.0 && sinceCheckpoint >= checkpointGap && sppDone < spp) {
+    if (opts.checkpoint && opts.checkpointSeconds > 0.0 && sinceCheckpoint >= checkpointGap && sppDone < spp &&
+        !nextPastTimeLimit) {
       const auto start = Clock::now();
       opts.checkpoint(meanImage(), sppDone);
       lastCheckpoint = Clock::now();
@@ -373,6 +380,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
       // waits at least ten times as long as this one took: they cost at most a tenth.
       const double took = std::chrono::duration<double>(lastCheckpoint - start).count();
       checkpointGap = std::max(opts.checkpointSeconds, took / kCheckpointShare);
+      nextPastTimeLimit = pastTimeLimit(sppDone);  // the write's time counts against the limit
       if (checkpointGap > opts.checkpointSeconds && !gapSaid) {
         spdlog::info("checkpoints every {:.0f} s or more, not {:g}: writing one took {:.1f} s", checkpointGap,
                      opts.checkpointSeconds, took);

@@ -236,3 +236,29 @@ TEST(RenderPasses, CheckpointsTakeAtMostATenthOfTheRender) {
   // Each write makes the next wait 0.4 s or more: at most a write a 0.4 s of the render.
   EXPECT_LE(written, 3) << "checkpoints every pass, each taking 20 times a pass";
 }
+
+// With a time limit, the pass after which the render stops gets no checkpoint: the final write
+// follows at once with the same image (at 4096² a checkpoint is 3.5 s, written twice).
+TEST(RenderPasses, NoCheckpointJustBeforeTheTimeLimitStops) {
+  class SlowExecutor final : public PassExecutor {
+   public:
+    std::string deviceName() const override { return "slow"; }
+    void runPass(int, int, Progress&, PassCounters*) override {
+      std::this_thread::sleep_for(std::chrono::milliseconds(30));
+    }
+    void readFilm(FilmSums* out) override { out->sum.assign(4, Color(0.f)); }
+    int maxPassSize() const override { return 1; }
+  } ex;
+  RenderOptions o;
+  o.progress = false;
+  o.checkpointSeconds = 0.001;
+  o.timeLimitSeconds = 0.2;
+  std::vector<int> written;
+  o.checkpoint = [&](const Image&, int done) { written.push_back(done); };
+  RenderStats st;
+  renderPasses(ex, 2, 2, 1000, o, &st);
+  EXPECT_TRUE(st.timeLimited);
+  ASSERT_GE(st.sppDone, 2);
+  ASSERT_FALSE(written.empty());
+  EXPECT_LT(written.back(), st.sppDone) << "a checkpoint of the image the final write writes again";
+}
