@@ -63,6 +63,21 @@ class CuttingExecutor final : public PassExecutor {
   std::vector<unsigned char> took_;
 };
 
+// Passes of one sample, each taking `ms` milliseconds; a black film of 4 pixels.
+class SlowExecutor final : public PassExecutor {
+ public:
+  explicit SlowExecutor(int ms) : ms_(ms) {}
+  std::string deviceName() const override { return "slow"; }
+  void runPass(int, int, Progress&, PassCounters*) override {
+    std::this_thread::sleep_for(std::chrono::milliseconds(ms_));
+  }
+  void readFilm(FilmSums* out) override { out->sum.assign(4, Color(0.f)); }
+  int maxPassSize() const override { return 1; }
+
+ private:
+  int ms_;
+};
+
 std::vector<std::pair<int, int>> passesOf(int w, int h, int spp, double budget) {
   RecordingExecutor ex(w, h, budget);
   RenderOptions o;
@@ -212,15 +227,7 @@ TEST(RenderPasses, ACutPassKeepsTheSamplesOfThePixelsThatTookIt) {
 // of the render: asked for after every pass (period 1 ms), with passes of 2 ms and a write of
 // 40 ms, a render of 150 passes (about 0.3 s of passes) writes a handful, not 150.
 TEST(RenderPasses, CheckpointsTakeAtMostATenthOfTheRender) {
-  class SlowExecutor final : public PassExecutor {
-   public:
-    std::string deviceName() const override { return "slow"; }
-    void runPass(int, int, Progress&, PassCounters*) override {
-      std::this_thread::sleep_for(std::chrono::milliseconds(2));
-    }
-    void readFilm(FilmSums* out) override { out->sum.assign(4, Color(0.f)); }
-    int maxPassSize() const override { return 1; }
-  } ex;
+  SlowExecutor ex(2);
   RenderOptions o;
   o.progress = false;
   o.checkpointSeconds = 0.001;
@@ -240,15 +247,7 @@ TEST(RenderPasses, CheckpointsTakeAtMostATenthOfTheRender) {
 // With a time limit, the pass after which the render stops gets no checkpoint: the final write
 // follows at once with the same image (at 4096² a checkpoint is 3.5 s, written twice).
 TEST(RenderPasses, NoCheckpointJustBeforeTheTimeLimitStops) {
-  class SlowExecutor final : public PassExecutor {
-   public:
-    std::string deviceName() const override { return "slow"; }
-    void runPass(int, int, Progress&, PassCounters*) override {
-      std::this_thread::sleep_for(std::chrono::milliseconds(30));
-    }
-    void readFilm(FilmSums* out) override { out->sum.assign(4, Color(0.f)); }
-    int maxPassSize() const override { return 1; }
-  } ex;
+  SlowExecutor ex(30);
   RenderOptions o;
   o.progress = false;
   o.checkpointSeconds = 0.001;
