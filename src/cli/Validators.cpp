@@ -55,8 +55,11 @@ void addThreadsOption(CLI::App* c, int* threads) {
   c->add_option("--threads", *threads, fmt::format("Worker threads, 0 for every core (the default), at most {}",
                                                    kMaxWorkerThreads))
       ->check(wholeNumberFrom(0, kMaxWorkerThreads))
-      // OpenEXR's reads and writes (maps, images, checkpoints) keep to the same count.
-      ->each([](const std::string& s) { setImageThreads(int(std::stod(s))); });
+      // Every oneTBB loop, and OpenEXR's reads and writes (maps, images, checkpoints), keep to it.
+      ->each([](const std::string& s) {
+        limitWorkerThreads(int(std::stod(s)));
+        setImageThreads(int(std::stod(s)));
+      });
 }
 
 std::string requireOutputExtension(const std::string& path, const std::vector<std::string>& allowed,
