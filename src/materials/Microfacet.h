@@ -31,7 +31,8 @@ struct MicrofacetDistribution {
       t = (sqr(m.x / alphaX) + sqr(m.y / alphaY)) / cos2;
       a2 = alphaX * alphaY;
     }
-    if (type == MicrofacetType::Beckmann) return std::exp(-t) / (kPi * a2 * cos2 * cos2);
+    // Past t = 104, exp(-t) is 0 in float: said at once, not through libm's slow underflow path.
+    if (type == MicrofacetType::Beckmann) return t > 104.f ? 0.f : std::exp(-t) / (kPi * a2 * cos2 * cos2);
     float e = 1.f + t;
     return 1.f / (kPi * a2 * cos2 * cos2 * e * e);
   }
@@ -66,8 +67,11 @@ struct MicrofacetDistribution {
  private:
   // Out of line on the device, as sampleVisibleBeckmann: erfc is long, and lambda is inlined
   // into every BSDF evaluation of every kernel.
+  // Past a = 3.7, lambda is below 7e-9, which 1 + lambda (G1's and G's only use) rounds away
+  // in float: 0 is returned without erfc and exp, whose underflow paths took a fifth of a
+  // Beckmann-lit render, and G1 and G stay the same to the bit.
   ENVGI_HD_NOINLINE static float beckmannLambda(float a2tan2) {
-    if (a2tan2 <= 0.f) return 0.f;
+    if (a2tan2 <= 1.f / (3.7f * 3.7f)) return 0.f;
     float a = 1.f / std::sqrt(a2tan2);  // 1 / (alpha tan theta)
     return fmaxf(0.f, 0.5f * (std::exp(-a * a) / (a * 1.7724538509f) - std::erfc(a)));
   }
