@@ -18,25 +18,30 @@ struct DirectParams {
 // Direct light reflected at si towards wo (its own emission excluded): nE light samples and
 // nB BSDF samples, power heuristic weighted by the counts. Also used by the photon mappers,
 // which follow delta lobes themselves and so leave out BSDF samples of them (skipDelta).
+// mixBlend: a blend's two materials evaluated as their mix (materials/BsdfMix.h), which only a
+// caller that estimates direct light at every hit may ask for; the photon mappers' specular
+// chains do so only where the chosen material is not a delta, so they keep the choice alone.
 template <class Tracer>
 ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& si, Vec3f wo,
                               Sampler& smp, EnvStrategy strategy, int emitterSamples, int bsdfSamples,
-                              uint64_t* rayCount, bool skipDelta = false) {
+                              uint64_t* rayCount, bool skipDelta = false, bool mixBlend = false) {
   Color L(0.f);
-  BsdfScratch textured;
+  BsdfScratch textured, texturedPartner;
   const Bsdf& bsdf = sc.bsdfAt(si, &textured);
+  const Bsdf* partner = mixBlend ? sc.partnerAt(si, &texturedPartner) : nullptr;
   Vec3f woLocal = si.shading.toLocal(wo);
   Vec3f axis = envSamplingAxis(si, wo, bsdf);
   float nE = float(emitterSamples), nB = float(bsdfSamples);
 
   for (int i = 0; i < emitterSamples; ++i)
-    L += sampleLd(sc, tracer, si, bsdf, woLocal, axis, strategy, nE, nB, smp, rayCount);
+    L += sampleLd(sc, tracer, si, bsdf, woLocal, axis, strategy, nE, nB, smp, rayCount, partner);
 
   for (int j = 0; j < bsdfSamples; ++j) {
     BsdfSample bs;
     float uc = smp.get1DIf(bsdfPicksALobe(bsdf));  // skipped for a one-lobe BSDF
     Vec2f ub = smp.get2D();
     if (!bsdfSample(bsdf, woLocal, uc, ub, &bs) || (skipDelta && bs.delta)) continue;
+    if (partner) bsdfMixReweight(*partner, si.partnerWeight, woLocal, &bs);
     Vec3f wi = si.shading.toWorld(bs.wi);
     Ray r2{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};
     Hit h2;
@@ -68,7 +73,8 @@ ENVGI_HD Color directTrace(const SceneView& sc, const Tracer& tracer, Ray ray, S
   SurfaceInteraction si = sc.interaction(ray, h);
   Vec3f wo = -ray.d;
   Color L = dp.hideEmitters ? Color(0.f) : sc.emitted(si, wo);
-  return L + directLighting(sc, tracer, si, wo, smp, dp.envStrategy, dp.emitterSamples, dp.bsdfSamples, rayCount);
+  return L + directLighting(sc, tracer, si, wo, smp, dp.envStrategy, dp.emitterSamples, dp.bsdfSamples, rayCount,
+                            false, true);
 }
 
 }  // namespace envgi

@@ -5,6 +5,7 @@
 #pragma once
 
 #include "lights/LightSampling.h"
+#include "materials/BsdfMix.h"
 #include "sampling/Mis.h"
 #include "sampling/Sampler.h"
 
@@ -21,20 +22,21 @@ struct LightSampleLd {
 };
 
 // Its three sample dimensions are taken whatever happens, so sequences stay aligned across
-// pixels. With the map the only light, the kind's choice and the area light's second pair would
+// pixels. `partner` (with its weight) is a blend's other material, evaluated beside bsdf
+// (materials/BsdfMix.h). With the map the only light, the kind's choice and the area light's second pair would
 // go unused: they are skipped, not drawn (2 of a bounce's 6 draws; the image stays the same).
 ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
                                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
-                                        Sampler& smp) {
+                                        Sampler& smp, const Bsdf* partner = nullptr, float partnerWeight = 0.f) {
   LightSampleLd out;
   const bool mapOnly = sc.envSelectProb() == 1.f;  // sampleLight then takes the map for any uSel < 1
   float uSel = smp.get1DIf(!mapOnly);
   Vec2f uL = smp.get2D(), uL2 = smp.get2DIf(!mapOnly);
   LightSample ls;
-  if (bsdfIsDelta(bsdf) || !sampleLight(sc, si, axis, strategy, uSel, uL, uL2, &ls)) return out;
+  if (bsdfMixIsDelta(bsdf, partner) || !sampleLight(sc, si, axis, strategy, uSel, uL, uL2, &ls)) return out;
   Vec3f wiLocal = si.shading.toLocal(ls.dir);
   float bsdfPdfOfLight;
-  Color f = bsdfEvalPdf(bsdf, woLocal, wiLocal, &bsdfPdfOfLight);
+  Color f = bsdfMixEvalPdf(bsdf, partner, partnerWeight, woLocal, wiLocal, &bsdfPdfOfLight);
   if (isBlack(f) || isBlack(ls.radiance)) return out;
   out.o = offsetRayOrigin(si.p, si.ng, ls.dir, si.t);
   out.d = ls.dir;
@@ -74,8 +76,8 @@ ENVGI_HD bool shadowRayBlocked(const Tracer& tracer, const LightSampleLd& ld, ui
 template <class Tracer>
 ENVGI_HD Color sampleLd(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& si, const Bsdf& bsdf,
                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB, Sampler& smp,
-                        uint64_t* rayCount) {
-  LightSampleLd ld = prepareLd(sc, si, bsdf, woLocal, axis, strategy, nE, nB, smp);
+                        uint64_t* rayCount, const Bsdf* partner = nullptr) {
+  LightSampleLd ld = prepareLd(sc, si, bsdf, woLocal, axis, strategy, nE, nB, smp, partner, si.partnerWeight);
   return resolvedLd(ld, shadowRayBlocked(tracer, ld, rayCount));
 }
 

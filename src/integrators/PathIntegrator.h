@@ -76,18 +76,21 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
     }
   }
   if (pp.maxDepth >= 0 && depth >= pp.maxDepth) return false;
-  BsdfScratch textured;
+  BsdfScratch textured, texturedPartner;
   const Bsdf& bsdf = sc.bsdfAt(si, &textured);
+  // A blend's other material: the two are evaluated as their mix (materials/BsdfMix.h).
+  const Bsdf* partner = sc.partnerAt(si, &texturedPartner);
   Vec3f woLocal = si.shading.toLocal(wo);
   Vec3f axis = envSamplingAxis(si, wo, bsdf);
 
   // Next-event estimation, weighted against this bounce's BSDF sample.
-  shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp), st);
+  shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, partner, si.partnerWeight), st);
 
   BsdfSample bs;
   float uc = smp.get1DIf(bsdfPicksALobe(bsdf));  // skipped for a one-lobe BSDF
   Vec2f ub = smp.get2D();
   if (!bsdfSample(bsdf, woLocal, uc, ub, &bs)) return false;
+  if (partner) bsdfMixReweight(*partner, si.partnerWeight, woLocal, &bs);
   Vec3f wi = si.shading.toWorld(bs.wi);
   st->beta *= bs.weight;
   st->etaScale *= bsdfEtaSquared(bsdf, woLocal, bs.wi);

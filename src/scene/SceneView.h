@@ -67,6 +67,10 @@ struct SurfaceInteraction {
   // material (the only reader).
   Vec2f dpdu{0.f, 0.f}, dpdv{0.f, 0.f};
   int bsdf = 0;
+  // A blend's other material, which the path tracer evaluates beside `bsdf` (SceneView::
+  // blendPartner), and its weight in the mix; -1: none.
+  int partner = -1;
+  float partnerWeight = 0.f;
   int light = -1;
   float t = 0.f;
 };
@@ -188,6 +192,7 @@ struct SceneView {
         }
       }
       si.bsdf = bsdf;
+      if (bsdf != m.bsdf) blendPartner(m.bsdf, &si);
       si.light = m.lightOffset >= 0 ? m.lightOffset + h.primId : -1;
     } else {
       const SphereView& s = spheres[h.geomId - meshCount];
@@ -195,8 +200,8 @@ struct SceneView {
       Vec3f n = normalize(p - s.center);
       si.p = s.center + n * s.radius;  // re-projected: removes the hit point's float error
       int bsdf = s.bsdf;
-      if (bsdfIsBlend(bsdfs[bsdf]))
-        bsdf = blendChoice(bsdf, sphereUv(s, n), ray, h.geomId, dot(n, ray.d) > 0.f ? 1u : 0u);
+      const bool blend = bsdfIsBlend(bsdfs[bsdf]);
+      if (blend) bsdf = blendChoice(bsdf, sphereUv(s, n), ray, h.geomId, dot(n, ray.d) > 0.f ? 1u : 0u);
       const bool texturedLight = s.light >= 0 && lights[s.light].radianceTexture >= 0;
       si.uv = bsdfHasTexture(bsdfs[bsdf]) || texturedLight ? sphereUv(s, n) : Vec2f(0.f, 0.f);
       Vec3f radial = n;
@@ -218,6 +223,10 @@ struct SceneView {
         }
       }
       si.bsdf = bsdf;
+      if (blend) {
+        si.uv = sphereUv(s, n);
+        blendPartner(s.bsdf, &si);
+      }
       si.light = s.light;
     }
     return si;
@@ -239,6 +248,28 @@ struct SceneView {
       index = rayCrossingHash(ray, geomId ^ ((level + 1) << 24), crossing) < w ? b.blend1 : b.blend0;
     }
     return index;
+  }
+
+  // Where blend `index` (one level, of two plain materials) chose si->bsdf, the other one and
+  // its weight, so that the path tracer evaluates the mix (1 - w) f0 + w f1 as Mitsuba and
+  // Cycles do, not only the one chosen: its next-event estimate then carries both, and its BSDF
+  // sample is weighted by the mix's density (one-sample MIS over the two). Left out (the choice
+  // alone, as pbrt-v4's MixMaterial) for nested blends and for materials that transmit or need
+  // their own shading frame, which the two would not share.
+  ENVGI_HD_NOINLINE void blendPartner(int index, SurfaceInteraction* si) const {
+    const Bsdf& b = bsdfs[index];
+    if (si->bsdf != b.blend0 && si->bsdf != b.blend1) return;
+    const int other = si->bsdf == b.blend0 ? b.blend1 : b.blend0;
+    for (int i : {b.blend0, b.blend1}) {
+      const Bsdf& c = bsdfs[i];
+      if (bsdfIsBlend(c) || bsdfTransmits(c) || bsdfNeedsTangentFrame(c) || bsdfIsMasked(c)) return;
+    }
+    float w = b.blendWeightTexture >= 0 ? luminance(textureEval(textures[b.blendWeightTexture], si->uv)) : b.blendWeight;
+    w = fminf(fmaxf(w, 0.f), 1.f);  // as blendChoiceOf: NaN picks blend0 alone
+    const float share = other == b.blend1 ? w : 1.f - w;
+    if (!(share > 0.f)) return;
+    si->partner = other;
+    si->partnerWeight = share;
   }
 
   // The material at a hit, without the rest of interaction() (a blend's own entry).
@@ -324,6 +355,10 @@ struct SceneView {
   }
   ENVGI_HD const Bsdf& bsdfAt(const SurfaceInteraction& si, BsdfScratch* scratch) const {
     return bsdfAt(si.bsdf, si.uv, si.dpdu, si.dpdv, scratch);
+  }
+  // The blend partner's material at si (blendPartner), or none.
+  ENVGI_HD const Bsdf* partnerAt(const SurfaceInteraction& si, BsdfScratch* scratch) const {
+    return si.partner >= 0 ? &bsdfAt(si.partner, si.uv, si.dpdu, si.dpdv, scratch) : nullptr;
   }
 
   // What interaction() reads for a triangle hit, asked for ahead (CPU only: a batch of hits
