@@ -29,7 +29,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('--envgi', required=True)
     ap.add_argument('--scenes', required=True)
-    ap.add_argument('--names', default='buddha,teapot-glass,bunny-sunrise,cornell-box,textured,microfacets,mask')
+    ap.add_argument('--names', default='buddha,teapot-glass,bunny-sunrise,cornell-box,textured,microfacets,mask,instances,'
+                    'uffizi-probe')
     a = ap.parse_args()
     here = os.path.dirname(os.path.abspath(__file__))
     failed = 0
@@ -41,7 +42,8 @@ def main():
                             '--threads', '1', '--no-progress', '-o', e], check=True)
             subprocess.run(['blender', '-b', '--factory-startup', '-noaudio', '--python',
                             os.path.join(here, 'cycles_render.py'), '--', xml, '--out', c, '--spp', '64',
-                            '--threads', '1', '-D', 'res=48'], check=True, stdout=subprocess.DEVNULL)
+                            '--threads', '1', '-D', 'res=48', '--envgi', a.envgi], check=True,
+                           stdout=subprocess.DEVNULL)
             x, y = read(e), read(c)
             ratio = x.mean() / y.mean()
             block = np.sqrt(((blocks(x) - blocks(y)) ** 2).mean()) / y.mean()

@@ -5,17 +5,22 @@ Runs inside Blender (Debian 12's blender 3.4.1, the Cycles the issue was measure
   blender -b --factory-startup -noaudio --python scripts/cycles_render.py -- SCENE.xml
       --out X.exr --spp N --seed S --threads T [-D name=value ...]
 It reads the part of Mitsuba's format that envgi's map-lit example scenes use (perspective
-sensor, envmap, ply/obj/sphere/rectangle shapes, area lights on shapes, diffuse, roughplastic,
-dielectric and (rough)conductor BSDFs, bitmap and checkerboard textures on their colours) and
-stops with an error on anything else. The materials are Cycles'
+sensor, envmap (a light probe through --envgi), ply/obj/sphere/rectangle/cube shapes, shapegroups
+and their instances, area lights on shapes, diffuse, roughplastic (Beckmann drawn as GGX),
+dielectric, (rough)conductor, principled, mask and blendbsdf BSDFs, bitmap and checkerboard
+textures on their colours) and stops with an error on anything else. The materials are Cycles'
 nearest nodes, not the same BSDFs, so each renderer is measured against its own reference.
 Prints 'cycles render: T s' (the render call: scene sync, BVH and samples).
 """
 import argparse
+import atexit
 import math
 import os
 import re
+import shutil
+import subprocess
 import sys
+import tempfile
 import time
 import xml.etree.ElementTree as ET
 
@@ -205,6 +210,8 @@ def mitsuba_uv(nt, kind):
     """Mitsuba's (u, v) on a shape as node outputs: a sphere's lat-long in its own frame, a
     rectangle's ((x + 1) / 2, (y + 1) / 2), a mesh's file uvs with v flipped (Blender's UV
     output keeps the file's v)."""
+    if kind not in ('mesh', 'rectangle', 'sphere'):
+        fail(f"a texture on a {kind} is not supported (its uv is Mitsuba's own)")
     coord = nt.nodes.new('ShaderNodeTexCoord')
     sep = nt.nodes.new('ShaderNodeSeparateXYZ')
     nt.links.new(coord.outputs['UV' if kind == 'mesh' else 'Object'], sep.inputs[0])
@@ -216,6 +223,38 @@ def mitsuba_uv(nt, kind):
                 node_math(nt, 'ADD', node_math(nt, 'MULTIPLY', y, 0.5), 0.5))
     u = node_math(nt, 'FRACT', node_math(nt, 'MULTIPLY', node_math(nt, 'ARCTAN2', y, x), 0.5 / math.pi))
     return u, node_math(nt, 'DIVIDE', node_math(nt, 'ARCCOSINE', z), math.pi)
+
+
+def mitsuba_tangent(nt, kind):
+    """Mitsuba's dp/du in world space as a node output: a sphere's azimuth (-y, x, 0) in its own
+    frame, a rectangle's +x, and on each face of a cube the axis its u follows (envgi's
+    makeCube, after Mitsuba's cube mesh): +y on the x faces, +z on -y, -x on +y, -y on -z, +y on +z."""
+    coord = nt.nodes.new('ShaderNodeTexCoord')
+    t = nt.nodes.new('ShaderNodeCombineXYZ')
+    if kind == 'sphere':
+        sep = nt.nodes.new('ShaderNodeSeparateXYZ')
+        nt.links.new(coord.outputs['Object'], sep.inputs[0])
+        nt.links.new(node_math(nt, 'MULTIPLY', sep.outputs['Y'], -1.0), t.inputs['X'])
+        nt.links.new(sep.outputs['X'], t.inputs['Y'])
+    elif kind == 'rectangle':
+        t.inputs['X'].default_value = 1.0
+    elif kind == 'cube':
+        sep = nt.nodes.new('ShaderNodeSeparateXYZ')
+        nt.links.new(coord.outputs['Normal'], sep.inputs[0])  # the object-space normal: one axis, +-1
+        nx, ny, nz = sep.outputs['X'], sep.outputs['Y'], sep.outputs['Z']
+        nt.links.new(node_math(nt, 'MULTIPLY', node_math(nt, 'GREATER_THAN', ny, 0.5), -1.0), t.inputs['X'])
+        on_x = node_math(nt, 'GREATER_THAN', node_math(nt, 'ABSOLUTE', nx), 0.5)
+        z_sign = node_math(nt, 'SUBTRACT', node_math(nt, 'GREATER_THAN', nz, 0.5), node_math(nt, 'LESS_THAN', nz, -0.5))
+        nt.links.new(node_math(nt, 'ADD', on_x, z_sign), t.inputs['Y'])
+        nt.links.new(node_math(nt, 'LESS_THAN', ny, -0.5), t.inputs['Z'])
+    else:
+        fail(f"an anisotropic BSDF on a {kind} is not supported (its dp/du is Mitsuba's own)")
+    world = nt.nodes.new('ShaderNodeVectorTransform')
+    world.vector_type = 'VECTOR'
+    world.convert_from = 'OBJECT'
+    world.convert_to = 'WORLD'
+    nt.links.new(t.outputs[0], world.inputs[0])
+    return world.outputs[0]
 
 
 def to_uv(sc, tex, nt, u, v):
@@ -291,15 +330,34 @@ def bsdf_node(sc, nt, b, kind):
     textured = {c.get('name') for c in b if c.tag in ('texture', 'ref') and c.get('name')}
     allowed = {'diffuse': {'reflectance'}, 'plastic': {'diffuse_reflectance'}, 'roughplastic': {'diffuse_reflectance'},
                'conductor': {'specular_reflectance'}, 'roughconductor': {'specular_reflectance'},
-               'mask': {'opacity'}, 'principled': set(PRINCIPLED_INPUTS) | {'base_color'}}.get(t, set())
+               'mask': {'opacity'}, 'blendbsdf': {'weight'}, 'principled': set(PRINCIPLED_INPUTS) | {'base_color'}}.get(t, set())
     if textured - allowed:
         fail(f"bsdf '{t}' with a texture for {sorted(textured - allowed)} is not supported")
     # Mitsuba's rough BSDFs default to Beckmann; Cycles' Principled BSDF (rough plastic here) has GGX only.
     dist = sc.prop(b, 'distribution', 'beckmann')
-    if any(c.get('name') in ('alpha_u', 'alpha_v') for c in b):
+    anisotropic = any(c.get('name') in ('alpha_u', 'alpha_v') for c in b)
+    if anisotropic and t != 'roughconductor':
         fail(f"bsdf '{t}' with alpha_u / alpha_v (anisotropic) is not supported here")
     if t == 'roughplastic' and dist != 'ggx':
-        fail("roughplastic needs distribution 'ggx' here: Cycles' Principled BSDF has no Beckmann")
+        # Cycles' Principled BSDF has no Beckmann: the coat is drawn as GGX of the same alpha,
+        # said on stderr. Each renderer is measured against its own reference, and
+        # scripts/crosscheck_cycles.py bounds how far the two images are apart.
+        print(f"cycles_render: note: roughplastic '{b.get('id') or ''}' with Beckmann's distribution is drawn "
+              "with GGX (Cycles' Principled BSDF has no Beckmann)", file=sys.stderr)
+    if t == 'blendbsdf':
+        # Mitsuba's blendbsdf: (1 - w) f0 + w f1, Cycles' mix shader with w as its factor (a
+        # colour texture as its luminance, as Mitsuba reads a float texture from RGB).
+        pair = [c for c in b if c.tag in ('bsdf', 'ref')]
+        if len(pair) != 2:
+            fail('blendbsdf needs two nested BSDFs')
+        mix = nt.nodes.new('ShaderNodeMixShader')
+        if any(c.get('name') == 'weight' and c.tag in ('texture', 'ref') for c in b):
+            nt.links.new(colour(sc, nt, b, 'weight', 0.5, kind), mix.inputs['Fac'])
+        else:
+            mix.inputs['Fac'].default_value = sc.prop(b, 'weight', 0.5)
+        nt.links.new(bsdf_node(sc, nt, pair[0], kind), mix.inputs[1])
+        nt.links.new(bsdf_node(sc, nt, pair[1], kind), mix.inputs[2])
+        return mix.outputs[0]
     if t == 'mask':
         # Mitsuba's mask: the inner BSDF with probability `opacity`, else the ray passes on.
         mix = nt.nodes.new('ShaderNodeMixShader')
@@ -345,27 +403,47 @@ def bsdf_node(sc, nt, b, kind):
         if isinstance(gloss, str):
             fail("principled: a textured clearcoat_gloss is not supported")
         n.inputs['Clearcoat Roughness'].default_value = math.sqrt(0.1 * (1 - gloss) + 0.001 * gloss)
+    elif t in ('conductor', 'roughconductor') and anisotropic:
+        # Cycles' anisotropic glossy: alpha_x = r^2 (1 - a), alpha_y = r^2 / (1 - a) for a >= 0 (and
+        # the mirror of it for a < 0), x along its tangent: Mitsuba's alpha_u along dp/du.
+        au, av = sc.prop(b, 'alpha_u', 0.1), sc.prop(b, 'alpha_v', 0.1)
+        if isinstance(au, str) or isinstance(av, str):
+            fail("roughconductor: textured alpha_u / alpha_v are not supported")
+        n = nt.nodes.new('ShaderNodeBsdfAnisotropic')
+        n.distribution = {'ggx': 'GGX', 'beckmann': 'BECKMANN'}[dist]
+        n.inputs['Roughness'].default_value = (au * av) ** 0.25
+        ratio = math.sqrt(min(au, av) / max(au, av))
+        n.inputs['Anisotropy'].default_value = 1 - ratio if av >= au else ratio - 1
+        nt.links.new(mitsuba_tangent(nt, kind), n.inputs['Tangent'])
+        conductor_tint(sc, nt, b, kind, n)
     elif t in ('conductor', 'roughconductor'):
         n = nt.nodes.new('ShaderNodeBsdfGlossy')
         n.distribution = {'ggx': 'GGX', 'beckmann': 'BECKMANN'}[dist] if t == 'roughconductor' else 'SHARP'
         n.inputs['Roughness'].default_value = math.sqrt(sc.prop(b, 'alpha', 0.1)) if t == 'roughconductor' else 0.0
-        mat = sc.prop(b, 'material', 'none')
-        if mat not in CONDUCTOR_F0:
-            fail(f"conductor material '{mat}' has no colour here")
-        tint = nt.nodes.new('ShaderNodeMixRGB')
-        tint.blend_type = 'MULTIPLY'
-        tint.inputs['Fac'].default_value = 1.0
-        tint.inputs['Color1'].default_value = (*CONDUCTOR_F0[mat], 1)
-        nt.links.new(colour(sc, nt, b, 'specular_reflectance', (1.0,) * 3, kind), tint.inputs['Color2'])
-        nt.links.new(tint.outputs[0], n.inputs['Color'])
+        conductor_tint(sc, nt, b, kind, n)
     else:
         fail(f"bsdf '{t}' is not supported")
     return n.outputs[0]
 
 
-def add_shape(sc, e, i):
+def conductor_tint(sc, nt, b, kind, n):
+    """A conductor's colour into glossy node n: the metal's normal-incidence colour times
+    specular_reflectance."""
+    mat = sc.prop(b, 'material', 'none')
+    if mat not in CONDUCTOR_F0:
+        fail(f"conductor material '{mat}' has no colour here")
+    tint = nt.nodes.new('ShaderNodeMixRGB')
+    tint.blend_type = 'MULTIPLY'
+    tint.inputs['Fac'].default_value = 1.0
+    tint.inputs['Color1'].default_value = (*CONDUCTOR_F0[mat], 1)
+    nt.links.new(colour(sc, nt, b, 'specular_reflectance', (1.0,) * 3, kind), tint.inputs['Color2'])
+    nt.links.new(tint.outputs[0], n.inputs['Color'])
+
+
+def add_shape(sc, e, i, outer=Matrix.Identity(4)):
+    """Shape e, under an instance's to_world `outer` when it is a shapegroup's."""
     t = e.get('type')
-    to_world = sc.transform(e)
+    to_world = outer @ sc.transform(e)
     if t in ('ply', 'obj'):
         f = sc.path(sc.prop(e, 'filename'))
         if t == 'ply':
@@ -385,13 +463,16 @@ def add_shape(sc, e, i):
     elif t == 'rectangle':
         bpy.ops.mesh.primitive_plane_add(size=2.0)
         obj = bpy.context.active_object
+    elif t == 'cube':  # Mitsuba's cube spans [-1, 1]^3, flat faces
+        bpy.ops.mesh.primitive_cube_add(size=2.0)
+        obj = bpy.context.active_object
     else:
         fail(f"shape '{t}' is not supported")
     obj.matrix_world = Y_UP_TO_Z_UP @ to_world
     b = next((c for c in e if c.tag in ('bsdf', 'ref')), None)
     if b is None:
         b = ET.fromstring('<bsdf type="diffuse"/>')  # Mitsuba's default for a shape without one
-    m = material(sc, b, f'm{i}', t if t in ('sphere', 'rectangle') else 'mesh')
+    m = material(sc, b, f'm{i}', t if t in ('sphere', 'rectangle', 'cube') else 'mesh')
     emitter = next((c for c in e if c.tag == 'emitter'), None)
     if emitter is not None:
         if emitter.get('type') != 'area':
@@ -438,6 +519,8 @@ def main():
     ap.add_argument('--noise-threshold', type=float, default=0.0,
                     help="Cycles' adaptive sampling with this noise threshold (0: off, every pixel takes --spp)")
     ap.add_argument('--min-spp', type=int, default=16, help="adaptive sampling's minimum samples")
+    ap.add_argument('--envgi', help="envgi's binary, to resample a light probe (an envmap's layout) to the "
+                    "lat-long map envgi itself renders with (envgi envmap convert)")
     ap.add_argument('-D', action='append', default=[], metavar='name=value')
     a = ap.parse_args(argv)
     sc = Scene(a.scene, dict(d.split('=', 1) for d in a.D))
@@ -476,17 +559,50 @@ def main():
     if not emitters:  # lit by area lights alone: a black world
         nt.nodes['Background'].inputs['Strength'].default_value = 0.0
     else:
-        add_envmap(sc, nt, emitters[0])
+        add_envmap(sc, nt, emitters[0], a.envgi)
 
-    for i, e in enumerate(c for c in sc.root if c.tag == 'shape'):
+    i = 0
+    for e in (c for c in sc.root if c.tag == 'shape'):
+        t = e.get('type')
+        if t == 'shapegroup':  # drawn only through its instances
+            continue
+        if t == 'instance':
+            ref = next((c for c in e if c.tag == 'ref'), None)
+            group = sc.ids.get(ref.get('id')) if ref is not None else None
+            if group is None or group.get('type') != 'shapegroup':
+                fail("an instance needs a <ref> to a shapegroup")
+            for member in (c for c in group if c.tag == 'shape'):
+                add_shape(sc, member, i, sc.transform(e))
+                i += 1
+            continue
         add_shape(sc, e, i)
+        i += 1
     render(sc, scene, a, max_depth)
 
 
-def add_envmap(sc, nt, env):
+def latlong_file(sc, env, envgi):
+    """The envmap's file as a lat-long map: itself, or for envgi's `layout` (a light probe) the
+    map envgi resamples it to as the scene loads, written by `envgi envmap convert`."""
+    path = sc.path(sc.prop(env, 'filename'))
+    layout = sc.prop(env, 'layout', 'latlong')
+    if layout == 'latlong':
+        return path
+    if not envgi:
+        fail(f"an envmap of layout '{layout}' needs --envgi, to resample it to lat-long as envgi does")
+    tmp = tempfile.mkdtemp(prefix='cycles_render_')
+    atexit.register(shutil.rmtree, tmp, True)  # Blender reads the pixels only as it renders
+    out = os.path.join(tmp, 'latlong.exr')
+    r = subprocess.run([envgi, '-q', 'envmap', 'convert', path, '--layout', layout, '-o', out],
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        fail(f"envgi envmap convert failed: {r.stderr.strip()}")
+    return out
+
+
+def add_envmap(sc, nt, env, envgi=None):
     nt.nodes.clear()
     tex = nt.nodes.new('ShaderNodeTexEnvironment')
-    tex.image = bpy.data.images.load(sc.path(sc.prop(env, 'filename')))
+    tex.image = bpy.data.images.load(latlong_file(sc, env, envgi))
     tex.interpolation = 'Linear'
     coord = nt.nodes.new('ShaderNodeTexCoord')
     mapping = nt.nodes.new('ShaderNodeMapping')

@@ -81,7 +81,7 @@ class Cycles:
     def __init__(self, xml, args, out):
         self.cmd = [args.blender, '-b', '--factory-startup', '-noaudio', '--python',
                     os.path.join(os.path.dirname(os.path.abspath(__file__)), 'cycles_render.py'), '--', xml,
-                    '--out', out, '--threads', str(args.threads), '-D', f'res={args.res}']
+                    '--out', out, '--threads', str(args.threads), '-D', f'res={args.res}', '--envgi', args.envgi]
         self.adaptive = ['--noise-threshold', str(args.noise_threshold), '--min-spp', str(args.min_spp)]
         self.out = out
         # One render first, not timed: the first Blender start after an install or a boot reads
