@@ -7,12 +7,18 @@
 
 namespace envgi {
 
+// b's part, out of line on the GPU: only blends reach it, and a second inlined copy of
+// bsdfEvalPdf would grow every kernel that shades (as texturedCopy, docs/gpu.md stop 54).
+inline ENVGI_HD_NOINLINE Color bsdfPartnerEvalPdf(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
+  return bsdfEvalPdf(b, wo, wi, pdf);
+}
+
 // f and, through *pdf, the density of non-delta directions: a's alone without b.
 ENVGI_INLINE Color bsdfMixEvalPdf(const Bsdf& a, const Bsdf* b, float wb, Vec3f wo, Vec3f wi, float* pdf) {
   Color f = bsdfEvalPdf(a, wo, wi, pdf);
   if (!b) return f;
   float pb;
-  Color fb = bsdfEvalPdf(*b, wo, wi, &pb);
+  Color fb = bsdfPartnerEvalPdf(*b, wo, wi, &pb);
   *pdf = (1.f - wb) * *pdf + wb * pb;
   return f * (1.f - wb) + fb * wb;
 }
@@ -27,7 +33,7 @@ ENVGI_INLINE bool bsdfMixIsDelta(const Bsdf& a, const Bsdf* b) { return bsdfIsDe
 ENVGI_INLINE void bsdfMixReweight(const Bsdf& b, float wb, Vec3f wo, BsdfSample* s) {
   if (s->delta) return;
   float pb;
-  Color fb = bsdfEvalPdf(b, wo, s->wi, &pb);
+  Color fb = bsdfPartnerEvalPdf(b, wo, s->wi, &pb);
   const float pdf = (1.f - wb) * s->pdf + wb * pb;
   s->weight = pdf > 0.f ? (s->weight * (s->pdf * (1.f - wb)) + fb * wb) / pdf : Color(0.f);
   s->pdf = pdf;
