@@ -226,6 +226,24 @@ TEST(Blend, PathAndDirectEvaluateTheWholeMix) {
   EXPECT_GT(std::sqrt(sum2 / (img.width * img.height)), 0.1);
 }
 
+// A textured material as the partner (its own copy at the hit, beside the chosen one's): the
+// whole mix and the same mix one level down (the choice alone) show the same mean, the
+// texture's.
+TEST(Blend, ATexturedPartnerIsReadAtTheHit) {
+  auto mean = [](bool nested) {
+    Bsdf checker = diffuse(0.2f);  // the texture's 0.1 and 0.9 in its place: 0.5 on average
+    checker.reflectanceTexture = 0;
+    std::vector<Bsdf> bsdfs = {checker, diffuse(0.5f), blendOf(0, 1, 0.6f)};
+    if (nested) bsdfs.push_back(blendOf(2, 2, 0.5f));
+    Scene s = blendFurnace(bsdfs);
+    s.textures.push_back(test::checkerboard(0.1f, 0.9f));
+    return test::renderedMean(s, IntegratorType::Path, 64);
+  };
+  const double whole = mean(false), chosen = mean(true);
+  EXPECT_NEAR(whole, chosen, 0.01);
+  EXPECT_NEAR(whole, 0.5, 0.01);  // about 0.43 if the partner took its untextured 0.2
+}
+
 // Under a sky of radiance 1 a convex diffuse sphere shows its albedo and a mirror shows the sky:
 // a blend shows (1 - w) of the first and w of the second. Two diffuse materials (0.75 x 0.2 +
 // 0.25 x 0.8 = 0.35), and a diffuse one with a mirror (0.6 x 0.5 + 0.4 = 0.7), which the photon
