@@ -474,6 +474,8 @@ def add_shape(sc, e, i, outer=Matrix.Identity(4)):
     elif t == 'cube':  # Mitsuba's cube spans [-1, 1]^3, flat faces
         bpy.ops.mesh.primitive_cube_add(size=2.0)
         obj = bpy.context.active_object
+    elif t == 'cylinder':
+        obj = open_cylinder(sc, e, i)
     else:
         fail(f"shape '{t}' is not supported")
     obj.matrix_world = Y_UP_TO_Z_UP @ to_world
@@ -491,6 +493,44 @@ def add_shape(sc, e, i, outer=Matrix.Identity(4)):
         add_area_emission(m, radiance)
     obj.data.materials.clear()
     obj.data.materials.append(m)
+
+
+def open_cylinder(sc, e, i, segments=128):
+    """Mitsuba's open cylinder from p0 to p1 as a smooth mesh in world space (the shape's
+    to_world comes on top), its (u, v) Mitsuba's: u the azimuth / 2 pi about the axis from
+    Mitsuba's frame of it (Duff et al.'s, as envgi's makeCylinder), v the height / length."""
+    def point(name, default):
+        c = next((c for c in e if c.get('name') == name), None)
+        if c is None:
+            return Vector(default)
+        return Vector(floats(sc.val(c), 3) if c.get('value') is not None else tuple(float(c.get(k, 0)) for k in 'xyz'))
+    p0, p1, r = point('p0', (0, 0, 0)), point('p1', (0, 0, 1)), sc.prop(e, 'radius', 1.0)
+    d = p1 - p0
+    n = d.normalized()
+    sign = math.copysign(1.0, n.z)
+    a = -1.0 / (sign + n.z)
+    b = n.x * n.y * a
+    fs, ft = Vector((1 + sign * n.x * n.x * a, sign * b, -sign * n.x)), Vector((b, sign + n.y * n.y * a, -n.y))
+    verts, faces, uvs = [], [], []
+    for k in range(segments + 1):
+        phi = 2 * math.pi * k / segments
+        radial = fs * math.cos(phi) + ft * math.sin(phi)
+        verts += [p0 + radial * r, p0 + radial * r + d]
+    for k in range(segments):
+        b0, t0, b1, t1 = 2 * k, 2 * k + 1, 2 * k + 2, 2 * k + 3
+        faces.append((b0, b1, t1, t0))  # counter-clockwise from outside
+        u0, u1 = k / segments, (k + 1) / segments
+        uvs += [(u0, 0.0), (u1, 0.0), (u1, 1.0), (u0, 1.0)]
+    mesh = bpy.data.meshes.new(f'cylinder{i}')
+    mesh.from_pydata([tuple(v) for v in verts], [], faces)
+    layer = mesh.uv_layers.new()
+    for loop, (u, v) in zip(layer.data, uvs):
+        loop.uv = (u, 1.0 - v)  # mitsuba_uv reads a mesh's v flipped, as a PLY file's
+    mesh.polygons.foreach_set('use_smooth', [True] * len(faces))
+    mesh.update()
+    obj = bpy.data.objects.new(f'cylinder{i}', mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
 
 
 def add_area_emission(m, radiance):
@@ -536,8 +576,8 @@ def main():
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     sensor = sc.root.find('sensor')
-    if sensor is None or sensor.get('type') != 'perspective':
-        fail(f"needs a perspective sensor, not '{None if sensor is None else sensor.get('type')}'")
+    if sensor is None or sensor.get('type') not in ('perspective', 'orthographic'):
+        fail(f"needs a perspective or orthographic sensor, not '{None if sensor is None else sensor.get('type')}'")
     integ = sc.root.find('integrator')
     if integ is None or integ.get('type') not in ('path', 'direct'):
         fail('needs a path (or direct) integrator')
@@ -549,12 +589,25 @@ def main():
     scene.render.resolution_percentage = 100
 
     cam = bpy.data.cameras.new('cam')
-    cam.sensor_fit = 'VERTICAL' if sc.prop(sensor, 'fov_axis', 'x') == 'y' else 'HORIZONTAL'
-    cam.angle = math.radians(sc.prop(sensor, 'fov'))
+    to_world = sc.transform(sensor)
+    if sensor.get('type') == 'orthographic':
+        # Mitsuba's view is [-1, 1] across (x) on its near plane, which to_world's scale sizes;
+        # Blender's ortho_scale is the view's width, with the camera's matrix left unscaled.
+        loc, rot, scale = to_world.decompose()
+        if abs(scale.x - scale.y) > 1e-5 * abs(scale.x) or scene.render.resolution_x != scene.render.resolution_y:
+            fail("an orthographic sensor needs a square film and to_world's x and y scales equal here")
+        cam.type = 'ORTHO'
+        cam.sensor_fit = 'HORIZONTAL'
+        cam.ortho_scale = 2.0 * scale.x
+        cam.clip_start = sc.prop(sensor, 'near_clip', 1e-2)
+        to_world = Matrix.Translation(loc) @ rot.to_matrix().to_4x4()
+    else:
+        cam.sensor_fit = 'VERTICAL' if sc.prop(sensor, 'fov_axis', 'x') == 'y' else 'HORIZONTAL'
+        cam.angle = math.radians(sc.prop(sensor, 'fov'))
     cobj = bpy.data.objects.new('cam', cam)
     scene.collection.objects.link(cobj)
     # Mitsuba's camera looks along +z with x to its left; Blender's along -z with x to its right.
-    cobj.matrix_world = Y_UP_TO_Z_UP @ sc.transform(sensor) @ Matrix.Diagonal((-1.0, 1.0, -1.0, 1.0))
+    cobj.matrix_world = Y_UP_TO_Z_UP @ to_world @ Matrix.Diagonal((-1.0, 1.0, -1.0, 1.0))
     scene.camera = cobj
 
     emitters = [e for e in sc.root if e.tag == 'emitter']
