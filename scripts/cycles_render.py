@@ -5,10 +5,10 @@ Runs inside Blender (Debian 12's blender 3.4.1, the Cycles the issue was measure
   blender -b --factory-startup -noaudio --python scripts/cycles_render.py -- SCENE.xml
       --out X.exr --spp N --seed S --threads T [-D name=value ...]
 It reads the part of Mitsuba's format that envgi's map-lit example scenes use (perspective
-sensor, envmap (a light probe through --envgi), ply/obj/sphere/rectangle/cube shapes, shapegroups
-and their instances, area lights on shapes, diffuse, roughplastic (Beckmann drawn as GGX),
-dielectric, (rough)conductor, principled, mask and blendbsdf BSDFs, bitmap and checkerboard
-textures on their colours) and stops with an error on anything else. The materials are Cycles'
+or orthographic sensor, envmap (a light probe through --envgi), directional and point
+emitters, ply/obj/sphere/rectangle/cube/cylinder shapes, shapegroups and their instances, area
+lights on shapes, diffuse, roughplastic (Beckmann drawn as GGX), dielectric, (rough)conductor,
+principled, mask and blendbsdf BSDFs, bitmap and checkerboard textures on their colours) and stops with an error on anything else. The materials are Cycles'
 nearest nodes, not the same BSDFs, so each renderer is measured against its own reference.
 Prints 'cycles render: T s' (the render call: scene sync, BVH and samples).
 """
@@ -611,16 +611,19 @@ def main():
     scene.camera = cobj
 
     emitters = [e for e in sc.root if e.tag == 'emitter']
-    if len(emitters) > 1 or any(e.get('type') != 'envmap' for e in emitters):
-        fail('needs at most one emitter outside the shapes, an envmap')
+    maps = [e for e in emitters if e.get('type') == 'envmap']
+    if len(maps) > 1 or any(e.get('type') not in ('envmap', 'directional', 'point') for e in emitters):
+        fail('needs at most one envmap, and directional and point emitters, outside the shapes')
     world = bpy.data.worlds.new('world')
     scene.world = world
     world.use_nodes = True
     nt = world.node_tree
-    if not emitters:  # lit by area lights alone: a black world
+    if not maps:  # lit by its other lights alone: a black world
         nt.nodes['Background'].inputs['Strength'].default_value = 0.0
     else:
-        add_envmap(sc, nt, emitters[0], a.envgi)
+        add_envmap(sc, nt, maps[0], a.envgi)
+    for k, e in enumerate(x for x in emitters if x.get('type') != 'envmap'):
+        add_delta_light(sc, scene, e, k)
 
     i = 0
     for e in (c for c in sc.root if c.tag == 'shape'):
@@ -658,6 +661,40 @@ def latlong_file(sc, env, envgi):
     if r.returncode != 0:
         fail(f"envgi envmap convert failed: {r.stderr.strip()}")
     return out
+
+
+def add_delta_light(sc, scene, e, k):
+    """Mitsuba's directional emitter (irradiance E along `direction`) as a sun of angle 0, whose
+    strength is its irradiance; its point emitter (intensity I at `position`) as a point lamp of
+    radius 0, whose power P gives I = P / (4 pi). Blender keeps the colour's largest channel in
+    the strength."""
+    def vec(name, default):
+        c = next((c for c in e if c.get('name') == name), None)
+        if c is None:
+            return Vector(default)
+        return Vector(floats(sc.val(c), 3) if c.get('value') is not None else tuple(float(c.get(q, 0)) for q in 'xyz'))
+    if next((c for c in e if c.tag == 'transform'), None) is not None:
+        fail(f"a {e.get('type')} emitter with a to_world is not supported here")
+    directional = e.get('type') == 'directional'
+    value = sc.prop(e, 'irradiance' if directional else 'intensity', (1.0,) * 3)
+    if not isinstance(value, tuple):
+        fail(f"a {e.get('type')} emitter's value must be an rgb value here")
+    peak = max(value)
+    light = bpy.data.lights.new(f'light{k}', 'SUN' if directional else 'POINT')
+    light.color = tuple(v / peak for v in value) if peak > 0 else (0.0, 0.0, 0.0)
+    if directional:
+        light.angle = 0.0
+        light.energy = peak
+    else:
+        light.shadow_soft_size = 0.0
+        light.energy = 4 * math.pi * peak
+    obj = bpy.data.objects.new(f'light{k}', light)
+    scene.collection.objects.link(obj)
+    if directional:  # a sun shines along its own -z
+        d = (Y_UP_TO_Z_UP.to_3x3() @ vec('direction', (0, 0, 1))).normalized()
+        obj.matrix_world = d.to_track_quat('-Z', 'Y').to_matrix().to_4x4()
+    else:
+        obj.matrix_world = Matrix.Translation(Y_UP_TO_Z_UP @ vec('position', (0, 0, 0)))
 
 
 def add_envmap(sc, nt, env, envgi=None):
