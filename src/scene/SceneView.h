@@ -142,14 +142,13 @@ struct SceneView {
   Camera camera;
   Vec3f boundsMin, boundsMax;
 
-  // Next-event estimation picks a kind of light, each kind the scene has alike (the map, the
-  // area lights, the delta lights), then a light of that kind: these are the kinds' chances.
-  ENVGI_HD float lightKinds() const {
-    return float(int(hasEnvironment) + int(lightCount > 0) + int(deltaLightCount > 0));
-  }
+  // Next-event estimation picks the map, the area lights as one (then one of them by power), or
+  // one delta light, each of these alike, as Cycles 3.4 gives each lamp and the background a
+  // share: these are their chances (deltaSelectProb the delta lights' together).
+  ENVGI_HD float lightKinds() const { return float(int(hasEnvironment) + int(lightCount > 0) + deltaLightCount); }
   ENVGI_HD float envSelectProb() const { return hasEnvironment ? 1.f / lightKinds() : 0.f; }
   ENVGI_HD float areaSelectProb() const { return lightCount > 0 ? 1.f / lightKinds() : 0.f; }
-  ENVGI_HD float deltaSelectProb() const { return deltaLightCount > 0 ? 1.f / lightKinds() : 0.f; }
+  ENVGI_HD float deltaSelectProb() const { return deltaLightCount > 0 ? float(deltaLightCount) / lightKinds() : 0.f; }
 
   ENVGI_HD SurfaceInteraction interaction(const Ray& ray, const Hit& h) const {
     SurfaceInteraction si;

@@ -112,6 +112,25 @@ TEST(DeltaLights, SunUnderAConstantSkyAddsToTheSky) {
   }
 }
 
+// Each delta light is a choice of its own beside the map (and the area lights as one), as Cycles
+// 3.4 shares its lamps and background: a sky, a sun and a point light get a third of the light
+// samples each, and the three still add up.
+TEST(DeltaLights, EachDeltaLightIsAChoiceOfItsOwn) {
+  for (const char* integrator : {"direct", "path"}) {
+    auto s = litFloor();
+    s->env = std::make_unique<EnvironmentMap>(EnvironmentMap::constant(Color(1.f)));
+    s->deltaLights = {sun(2.f, 30.f), {Vec3f(0.f, 2.f, 0.f), Color(4.f), true}};
+    s->sampler.sampleCount = 256;
+    s->finalize();
+    const SceneView& v = s->view();
+    EXPECT_FLOAT_EQ(v.envSelectProb(), 1.f / 3.f);
+    EXPECT_FLOAT_EQ(v.deltaSelectProb(), 2.f / 3.f);
+    EXPECT_EQ(v.areaSelectProb(), 0.f);
+    double expected = kRho + kRho / kPi * (2.0 * std::cos(30.0 * kPi / 180.0) + 1.0);
+    EXPECT_NEAR(meanRadiance(*s, integrator), expected, 0.02 * expected) << integrator;
+  }
+}
+
 // Photons from a sun of irradiance E at angle theta onto the floor's central 2 x 2 square carry
 // E cos(theta) 4; from a point light of intensity I at height h above its centre, I times the
 // square's solid angle 4 atan(1 / (h sqrt(2 + h^2))).
