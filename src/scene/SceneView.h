@@ -200,9 +200,10 @@ struct SceneView {
       si.p = s.center + n * s.radius;  // re-projected: removes the hit point's float error
       int bsdf = s.bsdf;
       const bool blend = bsdfIsBlend(bsdfs[bsdf]);
-      if (blend) bsdf = blendChoice(bsdf, sphereUv(s, n), ray, h.geomId, dot(n, ray.d) > 0.f ? 1u : 0u);
       const bool texturedLight = s.light >= 0 && lights[s.light].radianceTexture >= 0;
-      si.uv = bsdfHasTexture(bsdfs[bsdf]) || texturedLight ? sphereUv(s, n) : Vec2f(0.f, 0.f);
+      // A blend reads its weight at uv (blendChoice, and blendPartner below), before the normal's flip.
+      si.uv = blend || bsdfHasTexture(bsdfs[bsdf]) || texturedLight ? sphereUv(s, n) : Vec2f(0.f, 0.f);
+      if (blend) bsdf = blendChoice(bsdf, si.uv, ray, h.geomId, dot(n, ray.d) > 0.f ? 1u : 0u);
       Vec3f radial = n;
       if (s.flipNormals) n = -n;
       si.ng = n;
@@ -222,10 +223,7 @@ struct SceneView {
         }
       }
       si.bsdf = bsdf;
-      if (blend) {
-        si.uv = sphereUv(s, n);
-        blendPartner(s.bsdf, &si);
-      }
+      if (blend) blendPartner(s.bsdf, &si);
       si.light = s.light;
     }
     return si;
@@ -242,11 +240,14 @@ struct SceneView {
   ENVGI_HD_NOINLINE int blendChoiceOf(int index, Vec2f uv, const Ray& ray, int geomId, uint32_t crossing) const {
     for (int level = 0; level < kMaxBlendDepth && bsdfIsBlend(bsdfs[index]); ++level) {
       const Bsdf& b = bsdfs[index];
-      float w = b.blendWeightTexture >= 0 ? luminance(textureEval(textures[b.blendWeightTexture], uv)) : b.blendWeight;
       // A weight of 1 or more always picks blend1, of 0 or less (or NaN) blend0, as Mitsuba clamps it.
-      index = rayCrossingHash(ray, geomId ^ ((level + 1) << 24), crossing) < w ? b.blend1 : b.blend0;
+      index = rayCrossingHash(ray, geomId ^ ((level + 1) << 24), crossing) < blendWeightAt(b, uv) ? b.blend1 : b.blend0;
     }
     return index;
+  }
+  // Blend b's weight at uv (its texture's luminance, or its number), before any clamping.
+  ENVGI_HD float blendWeightAt(const Bsdf& b, Vec2f uv) const {
+    return b.blendWeightTexture >= 0 ? luminance(textureEval(textures[b.blendWeightTexture], uv)) : b.blendWeight;
   }
 
   // Where blend `index` (one level, of two plain materials) chose si->bsdf, the other one and
@@ -263,8 +264,7 @@ struct SceneView {
       const Bsdf& c = bsdfs[i];
       if (bsdfIsBlend(c) || bsdfTransmits(c) || bsdfNeedsTangentFrame(c) || bsdfIsMasked(c)) return;
     }
-    float w = b.blendWeightTexture >= 0 ? luminance(textureEval(textures[b.blendWeightTexture], si->uv)) : b.blendWeight;
-    w = fminf(fmaxf(w, 0.f), 1.f);  // as blendChoiceOf: NaN picks blend0 alone
+    const float w = fminf(fmaxf(blendWeightAt(b, si->uv), 0.f), 1.f);  // as blendChoiceOf: NaN picks blend0 alone
     const float share = other == b.blend1 ? w : 1.f - w;
     if (!(share > 0.f)) return;
     si->partner = other;

@@ -58,6 +58,15 @@ std::vector<int> choices(const Scene& s, Vec2f offset, int n, bool through = fal
   return count;
 }
 
+// interaction() at the first hit of a ray down -z through (x, y), the scene finalized.
+SurfaceInteraction firstHit(Scene& s, float x, float y) {
+  s.finalize();
+  EmbreeAccel accel(s);
+  Ray r{Vec3f(x, y, 5.f), Vec3f(0.f, 0.f, -1.f), INFINITY};
+  Hit h;
+  EXPECT_TRUE(accel.intersect(r, &h));
+  return s.view().interaction(r, h);
+}
 
 }  // namespace
 
@@ -134,12 +143,7 @@ TEST(Blend, ASpheresTwoCrossingsAndTheMaskChooseApart) {
 // weight of 0 or 1 leaves one material alone.
 TEST(Blend, InteractionNamesTheOtherMaterialOfAOneLevelBlend) {
   auto partnerAt = [](Scene& s, int* chosen, float* weight) {
-    s.finalize();
-    EmbreeAccel accel(s);
-    Ray r{Vec3f(0.1f, 0.2f, 5.f), Vec3f(0.f, 0.f, -1.f), INFINITY};
-    Hit h;
-    EXPECT_TRUE(accel.intersect(r, &h));
-    SurfaceInteraction si = s.view().interaction(r, h);
+    SurfaceInteraction si = firstHit(s, 0.1f, 0.2f);
     *chosen = si.bsdf;
     *weight = si.partnerWeight;
     return si.partner;
@@ -172,6 +176,21 @@ TEST(Blend, InteractionNamesTheOtherMaterialOfAOneLevelBlend) {
   glass.bsdfs = {diffuse(0.2f), g, blendOf(0, 1, 0.5f)};
   addPlane(glass, 2);
   EXPECT_EQ(partnerAt(glass, &chosen, &weight), -1);
+}
+
+// A blend on a sphere whose normals are flipped: the hit's (u, v), where the chosen material's
+// textures and the partner's weight are read, is the point's own, as on the unflipped sphere.
+TEST(Blend, AFlippedSpheresBlendReadsThePointsOwnUv) {
+  auto uvAt = [](bool flip) {
+    Scene s;
+    s.bsdfs = {diffuse(0.2f), diffuse(0.8f), blendOf(0, 1, 0.3f)};
+    s.spheres.push_back({Vec3f(0.f), 1.f, flip});
+    s.shapes.push_back({true, 0, 2, false, Color(0.f)});
+    return firstHit(s, 0.3f, 0.4f).uv;
+  };
+  const Vec2f plain = uvAt(false), flipped = uvAt(true);
+  EXPECT_FLOAT_EQ(flipped.x, plain.x);
+  EXPECT_FLOAT_EQ(flipped.y, plain.y);
 }
 
 namespace {
