@@ -159,6 +159,13 @@ class Scene:
                 return self.val(c)
         return default
 
+    def point(self, e, name, default):
+        """A <point> or <vector> property as a Vector: value="x, y, z" or x=, y=, z= (0 where left out)."""
+        c = next((c for c in e if c.get('name') == name), None)
+        if c is None:
+            return Vector(default)
+        return Vector(floats(self.val(c), 3) if c.get('value') is not None else tuple(float(c.get(k, 0)) for k in 'xyz'))
+
     def transform(self, e):
         m = Matrix.Identity(4)
         t = next((c for c in e if c.tag == 'transform'), None)
@@ -463,9 +470,7 @@ def add_shape(sc, e, i, outer=Matrix.Identity(4)):
         bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=1.0)
         obj = bpy.context.active_object
         bpy.ops.object.shade_smooth()
-        ce = next((c for c in e if c.get('name') == 'center'), None)
-        c = Vector((0.0, 0.0, 0.0) if ce is None else floats(sc.val(ce), 3) if ce.get('value') is not None else
-                   tuple(float(ce.get(k, 0)) for k in 'xyz'))
+        c = sc.point(e, 'center', (0.0, 0.0, 0.0))
         r = sc.prop(e, 'radius', 1.0)
         to_world = to_world @ Matrix.Translation(c) @ Matrix.Diagonal((r, r, r, 1.0))
     elif t == 'rectangle':
@@ -499,12 +504,7 @@ def open_cylinder(sc, e, i, segments=128):
     """Mitsuba's open cylinder from p0 to p1 as a smooth mesh in world space (the shape's
     to_world comes on top), its (u, v) Mitsuba's: u the azimuth / 2 pi about the axis from
     Mitsuba's frame of it (Duff et al.'s, as envgi's makeCylinder), v the height / length."""
-    def point(name, default):
-        c = next((c for c in e if c.get('name') == name), None)
-        if c is None:
-            return Vector(default)
-        return Vector(floats(sc.val(c), 3) if c.get('value') is not None else tuple(float(c.get(k, 0)) for k in 'xyz'))
-    p0, p1, r = point('p0', (0, 0, 0)), point('p1', (0, 0, 1)), sc.prop(e, 'radius', 1.0)
+    p0, p1, r = sc.point(e, 'p0', (0, 0, 0)), sc.point(e, 'p1', (0, 0, 1)), sc.prop(e, 'radius', 1.0)
     d = p1 - p0
     n = d.normalized()
     sign = math.copysign(1.0, n.z)
@@ -668,11 +668,6 @@ def add_delta_light(sc, scene, e, k):
     strength is its irradiance; its point emitter (intensity I at `position`) as a point lamp of
     radius 0, whose power P gives I = P / (4 pi). Blender keeps the colour's largest channel in
     the strength."""
-    def vec(name, default):
-        c = next((c for c in e if c.get('name') == name), None)
-        if c is None:
-            return Vector(default)
-        return Vector(floats(sc.val(c), 3) if c.get('value') is not None else tuple(float(c.get(q, 0)) for q in 'xyz'))
     if next((c for c in e if c.tag == 'transform'), None) is not None:
         fail(f"a {e.get('type')} emitter with a to_world is not supported here")
     directional = e.get('type') == 'directional'
@@ -691,10 +686,10 @@ def add_delta_light(sc, scene, e, k):
     obj = bpy.data.objects.new(f'light{k}', light)
     scene.collection.objects.link(obj)
     if directional:  # a sun shines along its own -z
-        d = (Y_UP_TO_Z_UP.to_3x3() @ vec('direction', (0, 0, 1))).normalized()
+        d = (Y_UP_TO_Z_UP.to_3x3() @ sc.point(e, 'direction', (0, 0, 1))).normalized()
         obj.matrix_world = d.to_track_quat('-Z', 'Y').to_matrix().to_4x4()
     else:
-        obj.matrix_world = Matrix.Translation(Y_UP_TO_Z_UP @ vec('position', (0, 0, 0)))
+        obj.matrix_world = Matrix.Translation(Y_UP_TO_Z_UP @ sc.point(e, 'position', (0, 0, 0)))
 
 
 def add_envmap(sc, nt, env, envgi=None):

@@ -22,12 +22,13 @@ struct LightSampleLd {
 };
 
 // Its three sample dimensions are taken whatever happens, so sequences stay aligned across
-// pixels. `partner` (with its weight) is a blend's other material, evaluated beside bsdf
-// (materials/BsdfMix.h). With the map the only light, the kind's choice and the area light's second pair would
-// go unused: they are skipped, not drawn (2 of a bounce's 6 draws; the image stays the same).
+// pixels. `partner` is a blend's other material (sc.partnerAt(si)), evaluated beside bsdf at
+// si.partnerWeight (materials/BsdfMix.h). With the map the only light, the kind's choice and
+// the area light's second pair would go unused: they are skipped, not drawn (2 of a bounce's 6
+// draws; the image stays the same).
 ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
                                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
-                                        Sampler& smp, const Bsdf* partner = nullptr, float partnerWeight = 0.f) {
+                                        Sampler& smp, const Bsdf* partner = nullptr) {
   LightSampleLd out;
   const bool mapOnly = sc.envSelectProb() == 1.f;  // sampleLight then takes the map for any uSel < 1
   float uSel = smp.get1DIf(!mapOnly);
@@ -36,7 +37,7 @@ ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceIntera
   if (bsdfMixIsDelta(bsdf, partner) || !sampleLight(sc, si, axis, strategy, uSel, uL, uL2, &ls)) return out;
   Vec3f wiLocal = si.shading.toLocal(ls.dir);
   float bsdfPdfOfLight;
-  Color f = bsdfMixEvalPdf(bsdf, partner, partnerWeight, woLocal, wiLocal, &bsdfPdfOfLight);
+  Color f = bsdfMixEvalPdf(bsdf, partner, si.partnerWeight, woLocal, wiLocal, &bsdfPdfOfLight);
   if (isBlack(f) || isBlack(ls.radiance)) return out;
   out.o = offsetRayOrigin(si.p, si.ng, ls.dir, si.t);
   out.d = ls.dir;
@@ -77,7 +78,7 @@ template <class Tracer>
 ENVGI_HD Color sampleLd(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& si, const Bsdf& bsdf,
                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB, Sampler& smp,
                         uint64_t* rayCount, const Bsdf* partner = nullptr) {
-  LightSampleLd ld = prepareLd(sc, si, bsdf, woLocal, axis, strategy, nE, nB, smp, partner, si.partnerWeight);
+  LightSampleLd ld = prepareLd(sc, si, bsdf, woLocal, axis, strategy, nE, nB, smp, partner);
   return resolvedLd(ld, shadowRayBlocked(tracer, ld, rayCount));
 }
 

@@ -84,7 +84,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   Vec3f axis = envSamplingAxis(si, wo, bsdf);
 
   // Next-event estimation, weighted against this bounce's BSDF sample.
-  shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, partner, si.partnerWeight), st);
+  shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, partner), st);
 
   BsdfSample bs;
   float uc = smp.get1DIf(bsdfPicksALobe(bsdf));  // skipped for a one-lobe BSDF
