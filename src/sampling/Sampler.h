@@ -113,6 +113,10 @@ struct Sampler {
   uint32_t index = 0;
   uint32_t indexInPixel = 0;  // index % spp, taken once a sample rather than once a draw
   IndexBlock block{0, 1};     // Sobol: the power-of-two block of [0, spp) indexInPixel is in
+  // Sobol: salts the shuffle of each block after the first (0 there, so a power of two is as it
+  // was). Unsalted, block [64, 96)'s shuffle was block [0, 64)'s mod 32: its sample k took
+  // point 64 + (j mod 32) where the first block's took j, in the same 1/32 of every dimension.
+  uint32_t blockSeed = 0;
   uint32_t dim = 0;
   Pcg32 rng;
 
@@ -120,7 +124,7 @@ struct Sampler {
   // shuffle within its power-of-two block (for a power of two, one shuffle of all spp).
   ENVGI_HD uint32_t shuffledIndex(uint32_t h) const {
     // Hashed: the point's own scramble is seeded from the same h.
-    return block.start + nestedShuffle(indexInPixel - block.start, block.size, uint32_t(mixBits(h)));
+    return block.start + nestedShuffle(indexInPixel - block.start, block.size, uint32_t(mixBits(h ^ blockSeed)));
   }
 
   // Begin sample `sampleIndex` of a pixel (a pixel id, or any stream id for non-image work).
@@ -134,6 +138,7 @@ struct Sampler {
     index = sampleIndex;
     indexInPixel = sampleIndex % spp;
     block = powerOfTwoBlock(indexInPixel, spp);
+    blockSeed = block.start == 0 ? 0u : uint32_t(mixBits(block.start));
   }
   ENVGI_HD void startPixel(uint64_t pixel) {
     pixelHash = hashCombine(mixBits(pixel), seed);

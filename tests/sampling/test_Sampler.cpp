@@ -212,6 +212,32 @@ TEST(Sampler, SobolDrawsTheFirstSppPointsAtAnyCount) {
   }
 }
 
+// A count that is not a power of two takes its blocks' samples apart: at 96 spp the second
+// block's sample k must not sit where the first block's sample k sits. With one shuffle for both
+// blocks it did, in every dimension (the same 1/32 of it each time: a rate of 1 where 1/32 is
+// chance), and textured-light at 96 spp had 1.26x the squared error it now has.
+TEST(Sampler, SobolBlocksAreShuffledApart) {
+  Sampler s;
+  s.type = SamplerType::Sobol;
+  s.spp = 96;
+  s.seed = 3;
+  int same = 0, pairs = 0;
+  for (uint64_t pixel = 0; pixel < 500; ++pixel)
+    for (uint32_t k = 0; k < 32; ++k) {
+      float a[3], b[3];
+      for (int blk = 0; blk < 2; ++blk) {
+        s.start(pixel, blk * 64 + k);
+        float* v = blk == 0 ? a : b;
+        v[0] = s.get1D();
+        Vec2f p = s.get2D();
+        v[1] = p.x, v[2] = p.y;
+      }
+      for (int d = 0; d < 3; ++d) same += int(a[d] * 32.f) == int(b[d] * 32.f), ++pairs;
+    }
+  EXPECT_LT(double(same) / pairs, 0.05) << same << " of " << pairs;
+  EXPECT_GT(double(same) / pairs, 0.015) << same << " of " << pairs;
+}
+
 // The fast forms the Sobol sampler draws through must give the very values of the plain ones:
 // the byte-swap bit reversal, the dimensions built already reversed, the scrambler fed reversed
 // input.
