@@ -30,7 +30,7 @@ def main():
     ap.add_argument('--envgi', required=True)
     ap.add_argument('--scenes', required=True)
     ap.add_argument('--names', default='buddha,teapot-glass,bunny-sunrise,cornell-box,textured,microfacets,mask,instances,'
-                    'uffizi-probe,orthographic,sun-and-sky')
+                    'uffizi-probe,orthographic,sun-and-sky,textured-light')
     a = ap.parse_args()
     here = os.path.dirname(os.path.abspath(__file__))
     failed = 0

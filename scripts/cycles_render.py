@@ -485,17 +485,17 @@ def add_shape(sc, e, i, outer=Matrix.Identity(4)):
         fail(f"shape '{t}' is not supported")
     obj.matrix_world = Y_UP_TO_Z_UP @ to_world
     b = next((c for c in e if c.tag in ('bsdf', 'ref')), None)
-    if b is None:
-        b = ET.fromstring('<bsdf type="diffuse"/>')  # Mitsuba's default for a shape without one
-    m = material(sc, b, f'm{i}', t if t in ('sphere', 'rectangle', 'cube') else 'mesh')
     emitter = next((c for c in e if c.tag == 'emitter'), None)
+    if b is None:
+        # Mitsuba's default for a shape without one: diffuse, black on an emitter.
+        b = ET.fromstring('<bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>' if emitter is not None
+                          else '<bsdf type="diffuse"/>')
+    m = material(sc, b, f'm{i}', t if t in ('sphere', 'rectangle', 'cube') else 'mesh')
     if emitter is not None:
         if emitter.get('type') != 'area':
             fail(f"a shape's emitter must be 'area', not '{emitter.get('type')}'")
-        radiance = sc.prop(emitter, 'radiance', (1.0,) * 3)
-        if not isinstance(radiance, tuple):
-            fail("an area emitter's radiance must be an rgb value here, not a texture")
-        add_area_emission(m, radiance)
+        kind = t if t in ('sphere', 'rectangle', 'cube') else 'mesh'
+        add_area_emission(m, colour(sc, m.node_tree, emitter, 'radiance', (1.0,) * 3, kind))
     obj.data.materials.clear()
     obj.data.materials.append(m)
 
@@ -534,14 +534,15 @@ def open_cylinder(sc, e, i, segments=128):
 
 
 def add_area_emission(m, radiance):
-    """Mitsuba's area light: radiance L from the front face only, added to the shape's BSDF.
-    Cycles' emission shader (strength 1) has radiance equal to its colour, from both faces, so
-    the back face is masked to black through the geometry's Backfacing output."""
+    """Mitsuba's area light: radiance L (a colour socket: a constant or a texture) from the front
+    face only, added to the shape's BSDF. Cycles' emission shader (strength 1) has radiance equal
+    to its colour, from both faces, so the back face is masked to black through the geometry's
+    Backfacing output."""
     nt = m.node_tree
     out = next(n for n in nt.nodes if n.type == 'OUTPUT_MATERIAL')
     bsdf_socket = out.inputs['Surface'].links[0].from_socket
     emit = nt.nodes.new('ShaderNodeEmission')
-    emit.inputs['Color'].default_value = (*radiance, 1)
+    nt.links.new(radiance, emit.inputs['Color'])
     emit.inputs['Strength'].default_value = 1.0
     black = nt.nodes.new('ShaderNodeEmission')
     black.inputs['Strength'].default_value = 0.0
