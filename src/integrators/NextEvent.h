@@ -21,20 +21,20 @@ struct LightSampleLd {
   bool needsRay = false;
 };
 
-// Its three sample dimensions are taken whatever happens, so sequences stay aligned across
-// pixels. `partner` is a blend's other material (sc.partnerAt(si)), evaluated beside bsdf at
-// si.partnerWeight (materials/BsdfMix.h). With the map the only light, the kind's choice and
-// the area light's second pair would go unused: they are skipped, not drawn (2 of a bounce's 6
-// draws; the image stays the same).
+// Its sample dimensions are taken whatever happens, so sequences stay aligned across pixels.
+// `partner` is a blend's other material (sc.partnerAt(si)), evaluated beside bsdf at
+// si.partnerWeight (materials/BsdfMix.h). The kind of light is picked by uL.x (sampleLight), so
+// the dimension a choice of its own once took is skipped, as is the area light's second pair
+// where the map is the only light (the image stays the same there).
 ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
                                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
                                         Sampler& smp, const Bsdf* partner = nullptr) {
   LightSampleLd out;
-  const bool mapOnly = sc.envSelectProb() == 1.f;  // sampleLight then takes the map for any uSel < 1
-  float uSel = smp.get1DIf(!mapOnly);
+  const bool mapOnly = sc.envSelectProb() == 1.f;  // sampleLight then takes the map for any uL
+  smp.skip1D();
   Vec2f uL = smp.get2D(), uL2 = smp.get2DIf(!mapOnly);
   LightSample ls;
-  if (bsdfMixIsDelta(bsdf, partner) || !sampleLight(sc, si, axis, strategy, uSel, uL, uL2, &ls)) return out;
+  if (bsdfMixIsDelta(bsdf, partner) || !sampleLight(sc, si, axis, strategy, uL, uL2, &ls)) return out;
   Vec3f wiLocal = si.shading.toLocal(ls.dir);
   float bsdfPdfOfLight;
   Color f = bsdfMixEvalPdf(bsdf, partner, si.partnerWeight, woLocal, wiLocal, &bsdfPdfOfLight);

@@ -45,11 +45,19 @@ ENVGI_INLINE float areaLightPdf(const SceneView& sc, int light, Vec3f p, Vec3f l
   return sc.areaSelectProb() * sc.lightSelect.pmf(light) * sc.lightAreaPdf(sc.lights[light], lp) * dist2 / cosL;
 }
 
-// sampleLight's choice of a delta or an area light (uSel at or past the map's share pe). Out of
+// A draw u in [lo, lo + p) that picked a kind of light, stretched back over [0, 1) for that
+// light's own draw.
+ENVGI_INLINE float stretchedDraw(float u, float lo, float p) {
+  float s = (u - lo) / p;
+  return s < kOneMinusEpsilon ? s : kOneMinusEpsilon;
+}
+
+// sampleLight's choice of a delta or an area light (u.x at or past the map's share pe). Out of
 // line on the GPU: most scenes are lit by the map alone, and this code in the path kernel's hot
 // loop cost instruction fetch (docs/gpu.md, stop 54).
-inline ENVGI_HD_NOINLINE bool sampleDeltaOrAreaLight(const SceneView& sc, const SurfaceInteraction& si, float pe, float uSel,
+inline ENVGI_HD_NOINLINE bool sampleDeltaOrAreaLight(const SceneView& sc, const SurfaceInteraction& si, float pe,
                                                      Vec2f u, Vec2f u2, LightSample* ls) {
+  const float uSel = u.x;
   float pa = sc.areaSelectProb();
   if (sc.deltaLightCount > 0 && !(uSel < pe + pa)) {
     // One delta light, all alike; the kind's share of uSel picks it.
@@ -66,7 +74,7 @@ inline ENVGI_HD_NOINLINE bool sampleDeltaOrAreaLight(const SceneView& sc, const 
   float pmf, areaPdf;
   Vec3f p, n;
   Color Le;
-  sampleAreaLight(sc, u2, u, &pmf, &p, &n, &Le, &areaPdf);
+  sampleAreaLight(sc, u2, Vec2f(stretchedDraw(uSel, pe, pa), u.y), &pmf, &p, &n, &Le, &areaPdf);
   Vec3f d = p - si.p;
   float dist2 = lengthSq(d);
   if (dist2 <= 0.f) return false;
@@ -83,10 +91,15 @@ inline ENVGI_HD_NOINLINE bool sampleDeltaOrAreaLight(const SceneView& sc, const 
   return ls->pdf > 0.f;
 }
 
+// u.x picks the kind of light by the kinds' shares and is then stretched back over [0, 1) for
+// that light's own draw (sample reuse, as Mitsuba's emitter selection does): the draws that land
+// on one kind keep the sequence's strata, where a draw of their own handed each kind a random
+// subset of the points. With the map the only light, u is the map's draw as it is.
 ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si, Vec3f axis, EnvStrategy strategy,
-                              float uSel, Vec2f u, Vec2f u2, LightSample* ls) {
+                              Vec2f u, Vec2f u2, LightSample* ls) {
   float pe = sc.envSelectProb();
-  if (!(uSel < pe)) return sampleDeltaOrAreaLight(sc, si, pe, uSel, u, u2, ls);
+  if (!(u.x < pe)) return sampleDeltaOrAreaLight(sc, si, pe, u, u2, ls);
+  if (pe < 1.f) u.x = stretchedDraw(u.x, 0.f, pe);
   EnvSample es = sc.env.sample(strategy, u, axis);
   if (!(es.pdf > 0.f)) return false;
   ls->dir = es.dir;

@@ -3,6 +3,7 @@
 // light sample's density alone, then with its shadow ray through Embree.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -84,9 +85,8 @@ double estimatedIrradiance(const SceneView& sc, Vec3f p, int n) {
   double sum = 0.0;
   for (int i = 0; i < n; ++i) {
     LightSample ls;
-    float uSel = rng.nextFloat();
     Vec2f u(rng.nextFloat(), rng.nextFloat()), u2(rng.nextFloat(), rng.nextFloat());
-    if (!sampleLight(sc, si, si.ng, EnvStrategy::Importance, uSel, u, u2, &ls)) continue;
+    if (!sampleLight(sc, si, si.ng, EnvStrategy::Importance, u, u2, &ls)) continue;
     float cosP = dot(ls.dir, si.ng);
     if (cosP > 0.f) sum += double(ls.radiance.y) * cosP / ls.pdf;
   }
@@ -220,10 +220,9 @@ std::pair<double, double> irradianceSamples(const SceneView& sc, Vec3f p, int n)
   double sum = 0.0, sumSq = 0.0;
   for (int i = 0; i < n; ++i) {
     LightSample ls;
-    float uSel = rng.nextFloat();
     Vec2f u(rng.nextFloat(), rng.nextFloat()), u2(rng.nextFloat(), rng.nextFloat());
     double f = 0.0;
-    if (sampleLight(sc, si, si.ng, EnvStrategy::Importance, uSel, u, u2, &ls)) {
+    if (sampleLight(sc, si, si.ng, EnvStrategy::Importance, u, u2, &ls)) {
       float cosP = dot(ls.dir, si.ng);
       if (cosP > 0.f) f = double(ls.radiance.y) * cosP / ls.pdf;
     }
@@ -417,6 +416,59 @@ TEST(LightSampling, ATexturedLightSeenDirectlyShowsItsTexture) {
     EXPECT_NEAR(img.at(6, 6).y, 1.f, 1e-4f) << integratorName(type);
     EXPECT_NEAR(img.at(1, 6).y, 9.f, 1e-4f) << integratorName(type);
   }
+}
+
+// One draw picks the kind of light and then serves that light, stretched back over [0, 1): with a
+// map and a square light each taking half, evenly spaced u.x must reach the whole map and the
+// whole light. Read raw, the map's half would see only u.x < 1/2 (half of its azimuths) and the
+// light's only u.x >= 1/2 (half of its width).
+TEST(LightSampling, TheKindsDrawServesTheChosenLightWhole) {
+  test::TempDir dir;
+  std::string path = dir.file("both.xml");
+  std::ofstream(path) << R"(<scene version="3.0.0">
+  <sensor type="perspective"><transform name="to_world"><lookat origin="0,3,3" target="0,0,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
+  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+  <shape type="rectangle"><transform name="to_world"><scale value="0.4"/><rotate x="1" angle="90"/><translate y="1"/></transform>
+    <emitter type="area"><rgb name="radiance" value="3"/></emitter></shape>
+</scene>)";
+  Scene scene;
+  loadScene(path, {}, scene);
+  const SceneView& sc = scene.view();
+  ASSERT_FLOAT_EQ(sc.envSelectProb(), 0.5f);
+  ASSERT_FLOAT_EQ(sc.areaSelectProb(), 0.5f);
+  SurfaceInteraction si = floorPoint(Vec3f(0, 0, 0));
+  const int n = 256;
+  std::vector<float> azimuths;
+  float xMin = 1.f, xMax = -1.f;
+  for (int i = 0; i < n; ++i) {
+    LightSample ls;
+    if (!sampleLight(sc, si, Vec3f(0.f), EnvStrategy::Importance, Vec2f((i + 0.5f) / n, 0.3f), Vec2f(0.5f, 0.5f), &ls))
+      continue;
+    if (ls.environment) {
+      azimuths.push_back(std::atan2(ls.dir.z, ls.dir.x));
+    } else {
+      float x = si.p.x + ls.dir.x * ls.dist;
+      xMin = std::min(xMin, x), xMax = std::max(xMax, x);
+    }
+  }
+  ASSERT_EQ(azimuths.size(), size_t(n / 2));
+  std::sort(azimuths.begin(), azimuths.end());
+  float gap = azimuths.front() + 2.f * kPi - azimuths.back();  // around the circle
+  for (size_t k = 1; k < azimuths.size(); ++k) gap = std::max(gap, azimuths[k] - azimuths[k - 1]);
+  EXPECT_LT(gap, 4.f * 2.f * kPi / float(n / 2)) << "the map's draws leave a gap of " << gap << " rad";
+  // The light's own draws over the whole of [0, 1) reach from wantMin to wantMax.
+  float wantMin = 1.f, wantMax = -1.f;
+  for (int i = 0; i < n; ++i) {
+    float pmf, areaPdf;
+    Vec3f p, nl;
+    Color Le;
+    sampleAreaLight(sc, Vec2f(0.5f, 0.5f), Vec2f((i + 0.5f) / n, 0.3f), &pmf, &p, &nl, &Le, &areaPdf);
+    wantMin = std::min(wantMin, p.x), wantMax = std::max(wantMax, p.x);
+  }
+  ASSERT_GT(wantMax - wantMin, 0.2f);
+  EXPECT_NEAR(xMin, wantMin, 0.02f * (wantMax - wantMin));
+  EXPECT_NEAR(xMax, wantMax, 0.02f * (wantMax - wantMin));
 }
 
 // Seen edge-on, a tilted light used to shadow itself: the shadow ray, kept parallel to the light
