@@ -490,11 +490,11 @@ def add_shape(sc, e, i, outer=Matrix.Identity(4)):
         # Mitsuba's default for a shape without one: diffuse, black on an emitter.
         b = ET.fromstring('<bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>' if emitter is not None
                           else '<bsdf type="diffuse"/>')
-    m = material(sc, b, f'm{i}', t if t in ('sphere', 'rectangle', 'cube') else 'mesh')
+    kind = t if t in ('sphere', 'rectangle', 'cube') else 'mesh'
+    m = material(sc, b, f'm{i}', kind)
     if emitter is not None:
         if emitter.get('type') != 'area':
             fail(f"a shape's emitter must be 'area', not '{emitter.get('type')}'")
-        kind = t if t in ('sphere', 'rectangle', 'cube') else 'mesh'
         add_area_emission(m, colour(sc, m.node_tree, emitter, 'radiance', (1.0,) * 3, kind))
     obj.data.materials.clear()
     obj.data.materials.append(m)

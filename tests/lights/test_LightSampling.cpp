@@ -45,15 +45,17 @@ struct LitScene {
 };
 
 // A 0.8 x 0.8 square light of radiance 3 (or `emitter`'s) at height 1, turned by tiltDeg about x
-// from facing down.
+// from facing down; `others` adds further elements to the scene (another emitter, say).
 std::unique_ptr<LitScene> squareLight(float tiltDeg,
-                                      const std::string& emitter = R"(<rgb name="radiance" value="3"/>)") {
+                                      const std::string& emitter = R"(<rgb name="radiance" value="3"/>)",
+                                      const std::string& others = "") {
   auto s = std::make_unique<LitScene>();
   test::TempDir dir;
   std::string path = dir.file("light.xml");
   std::ofstream(path) << R"(<scene version="3.0.0">
   <sensor type="perspective"><transform name="to_world"><lookat origin="0,3,3" target="0,0,0"/></transform>
     <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
+  )" << others << R"(
   <shape type="rectangle"><transform name="to_world"><scale value="0.4"/><rotate x="1" angle=")"
                       << 90.f + tiltDeg << R"("/><translate y="1"/></transform>
     <emitter type="area">)" << emitter << R"(</emitter></shape>
@@ -423,18 +425,9 @@ TEST(LightSampling, ATexturedLightSeenDirectlyShowsItsTexture) {
 // whole light. Read raw, the map's half would see only u.x < 1/2 (half of its azimuths) and the
 // light's only u.x >= 1/2 (half of its width).
 TEST(LightSampling, TheKindsDrawServesTheChosenLightWhole) {
-  test::TempDir dir;
-  std::string path = dir.file("both.xml");
-  std::ofstream(path) << R"(<scene version="3.0.0">
-  <sensor type="perspective"><transform name="to_world"><lookat origin="0,3,3" target="0,0,0"/></transform>
-    <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film></sensor>
-  <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
-  <shape type="rectangle"><transform name="to_world"><scale value="0.4"/><rotate x="1" angle="90"/><translate y="1"/></transform>
-    <emitter type="area"><rgb name="radiance" value="3"/></emitter></shape>
-</scene>)";
-  Scene scene;
-  loadScene(path, {}, scene);
-  const SceneView& sc = scene.view();
+  auto s = squareLight(0.f, R"(<rgb name="radiance" value="3"/>)",
+                       R"(<emitter type="constant"><rgb name="radiance" value="1"/></emitter>)");
+  const SceneView& sc = s->scene.view();
   ASSERT_FLOAT_EQ(sc.envSelectProb(), 0.5f);
   ASSERT_FLOAT_EQ(sc.areaSelectProb(), 0.5f);
   SurfaceInteraction si = floorPoint(Vec3f(0, 0, 0));
