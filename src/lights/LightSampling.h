@@ -45,13 +45,6 @@ ENVGI_INLINE float areaLightPdf(const SceneView& sc, int light, Vec3f p, Vec3f l
   return sc.areaSelectProb() * sc.lightSelect.pmf(light) * sc.lightAreaPdf(sc.lights[light], lp) * dist2 / cosL;
 }
 
-// A draw u in [lo, lo + p) that picked a kind of light, stretched back over [0, 1) for that
-// light's own draw.
-ENVGI_INLINE float stretchedDraw(float u, float lo, float p) {
-  float s = (u - lo) / p;
-  return s < kOneMinusEpsilon ? s : kOneMinusEpsilon;
-}
-
 // sampleLight's choice of a delta or an area light (u.x at or past the map's share pe). Out of
 // line on the GPU: most scenes are lit by the map alone, and this code in the path kernel's hot
 // loop cost instruction fetch (docs/gpu.md, stop 54).

@@ -364,8 +364,19 @@ ENVGI_INLINE bool bsdfPicksALobe(const Bsdf& b) {
   return b.type != BsdfType::Diffuse && b.type != BsdfType::Conductor && b.type != BsdfType::RoughConductor;
 }
 
+// Whether bsdfSample(..., lobeFromU = true) picks the lobe by u.x instead of uc: the lobe by where
+// u.x falls among the lobes' shares, then u.x stretched over the chosen share (stretchedDraw).
+// A 2D low-discrepancy u then stays stratified within each lobe, where a separate uc splits it
+// into two unstratified subsets. Only plastics: their shares follow from wo alone, while a
+// rough dielectric's and the principled BSDF's follow from the microfacet that u itself draws.
+ENVGI_INLINE bool bsdfLobeFromU(const Bsdf& b) {
+  return b.type == BsdfType::Plastic || b.type == BsdfType::RoughPlastic;
+}
+// Whether bsdfSample reads uc when the caller asks for the lobe from u where it can.
+ENVGI_INLINE bool bsdfReadsUcBesideU(const Bsdf& b) { return bsdfPicksALobe(b) && !bsdfLobeFromU(b); }
+
 namespace detail {
-ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s) {
+ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s, bool lobeFromU) {
   bool flip = b.twoSided && wo.z < 0.f;
   if (flip) wo.z = -wo.z;
   bool ok = false;
@@ -458,6 +469,10 @@ ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, Bsdf
       float fo = b.type == BsdfType::Plastic ? fresnelDielectric(wo.z, b.ior)
                                              : detail::roughCoatReflectance(b, detail::roughCoat(b), wo.z);
       float ps = detail::plasticSpecularProb(b, fo);
+      if (lobeFromU) {  // bsdfLobeFromU: the coat below ps, the base above
+        uc = u.x;
+        u.x = u.x < ps ? stretchedDraw(u.x, 0.f, ps) : stretchedDraw(u.x, ps, 1.f - ps);
+      }
       if (b.type == BsdfType::Plastic && uc < ps) {
         s->wi = Vec3f(-wo.x, -wo.y, wo.z);
         s->pdf = ps;
@@ -552,11 +567,13 @@ ENVGI_INLINE Color bsdfEvalPdf(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
   return b.bumpShadowing ? v * detail::bumpShadowingTerm(f.n, wi) : v;
 }
 
-// uc picks a lobe, u the direction within it. Returns false when no direction is produced.
-ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s) {
-  if (!bsdfIsNormalMapped(b)) return detail::sampleInFrame(b, wo, uc, u, s);
+// uc picks a lobe, u the direction within it; with lobeFromU, u.x picks the lobe where
+// bsdfLobeFromU says it can, and uc goes unread there. Returns false when no direction is
+// produced.
+ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s, bool lobeFromU = false) {
+  if (!bsdfIsNormalMapped(b)) return detail::sampleInFrame(b, wo, uc, u, s, lobeFromU);
   Frame f = detail::mappedFrame(b, wo);
-  if (!detail::sampleInFrame(b, f.toLocal(wo), uc, u, s)) return false;
+  if (!detail::sampleInFrame(b, f.toLocal(wo), uc, u, s, lobeFromU)) return false;
   Vec3f mi = s->wi;
   s->wi = f.toWorld(mi);
   if (!(s->wi.z * mi.z > 0.f)) return false;

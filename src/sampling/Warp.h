@@ -5,6 +5,13 @@
 
 namespace envgi {
 
+// A draw u in [lo, lo + p) that picked one of several choices (a kind of light, a BSDF's lobe),
+// stretched back over [0, 1) for that choice's own draw.
+ENVGI_INLINE float stretchedDraw(float u, float lo, float p) {
+  float s = (u - lo) / p;
+  return s < kOneMinusEpsilon ? s : kOneMinusEpsilon;
+}
+
 ENVGI_INLINE Vec3f sampleUniformSphere(Vec2f u) {
   float z = 1.f - 2.f * u.x;
   float r = safeSqrt(1.f - z * z);

@@ -136,8 +136,8 @@ void PrintTo(const BsdfCase& c, std::ostream* os) { *os << c.name; }
 
 class BsdfChi2 : public ::testing::TestWithParam<BsdfCase> {};
 
-TEST_P(BsdfChi2, SampleMatchesPdf) {
-  BsdfCase c = GetParam();
+// The chi-square test of bsdfSample against bsdfPdf, the lobe picked by uc or (lobeFromU) by u.x.
+void expectSampleMatchesPdf(BsdfCase c, bool lobeFromU) {
   attachRoughCoat(c.bsdf);
   Vec3f wo = woFor(c.cosTheta);
   Pcg32 rng(123);
@@ -145,7 +145,9 @@ TEST_P(BsdfChi2, SampleMatchesPdf) {
   int badWeight = 0;
   auto sample = [&](int) {
     BsdfSample s;
-    if (!bsdfSample(c.bsdf, wo, rng.nextFloat(), Vec2f(rng.nextFloat(), rng.nextFloat()), &s) || s.delta)
+    float uc = rng.nextFloat();
+    Vec2f u(rng.nextFloat(), rng.nextFloat());
+    if (!bsdfSample(c.bsdf, wo, uc, u, &s, lobeFromU) || s.delta)
       return Vec3f(0.f);  // delta or failed samples count as missing mass
     Color expect = bsdfEval(c.bsdf, wo, s.wi) / s.pdf;
     if (length(expect - s.weight) > 1e-3f * fmaxf(1.f, length(expect))) ++badWeight;
@@ -162,8 +164,79 @@ TEST_P(BsdfChi2, SampleMatchesPdf) {
   EXPECT_GT(r.pValue, test::sidakAlpha(int(cases().size()))) << "chi2 " << r.chi2 << " dof " << r.dof << " " << r.message;
 }
 
+TEST_P(BsdfChi2, SampleMatchesPdf) { expectSampleMatchesPdf(GetParam(), false); }
+
 INSTANTIATE_TEST_SUITE_P(All, BsdfChi2, ::testing::ValuesIn(cases()),
                          [](const ::testing::TestParamInfo<BsdfCase>& i) { return i.param.name; });
+
+// The same with the lobe picked by u.x, for the BSDFs that can (bsdfLobeFromU): the density
+// drawn must stay bsdfPdf's.
+class BsdfChi2LobeFromU : public ::testing::TestWithParam<BsdfCase> {};
+TEST_P(BsdfChi2LobeFromU, SampleMatchesPdf) { expectSampleMatchesPdf(GetParam(), true); }
+
+std::vector<BsdfCase> lobeFromUCases() {
+  std::vector<BsdfCase> out;
+  for (const BsdfCase& c : cases())
+    if (bsdfLobeFromU(c.bsdf)) out.push_back(c);
+  return out;
+}
+INSTANTIATE_TEST_SUITE_P(Plastics, BsdfChi2LobeFromU, ::testing::ValuesIn(lobeFromUCases()),
+                         [](const ::testing::TestParamInfo<BsdfCase>& i) { return i.param.name; });
+
+// With the lobe from u.x, a draw is the two-draw form's with uc = u.x and u.x stretched over the
+// chosen lobe's share: the coat below the share ps, the base above it.
+TEST(Bsdf, LobeFromUIsTheTwoDrawFormWithUcFromUx) {
+  Pcg32 rng(41);
+  for (BsdfType t : {BsdfType::Plastic, BsdfType::RoughPlastic}) {
+    for (bool twoSided : {false, true}) {
+      Bsdf b = coated(make(t, 0.2f));
+      b.twoSided = twoSided;
+      ASSERT_TRUE(bsdfLobeFromU(b));
+      ASSERT_FALSE(bsdfReadsUcBesideU(b));
+      int coat = 0, base = 0;
+      for (int i = 0; i < 4000; ++i) {
+        Vec3f wo = sampleUniformSphere({rng.nextFloat(), rng.nextFloat()});
+        Vec2f u(rng.nextFloat(), rng.nextFloat());
+        float c = twoSided ? std::fabs(wo.z) : wo.z;
+        if (c <= 0.f) continue;
+        float fo = t == BsdfType::Plastic ? fresnelDielectric(c, b.ior)
+                                          : detail::roughCoatReflectance(b, detail::roughCoat(b), c);
+        float ps = detail::plasticSpecularProb(b, fo);
+        Vec2f stretched(u.x < ps ? stretchedDraw(u.x, 0.f, ps) : stretchedDraw(u.x, ps, 1.f - ps), u.y);
+        (u.x < ps ? coat : base)++;
+        BsdfSample a, e;
+        bool okA = bsdfSample(b, wo, rng.nextFloat(), u, &a, true), okE = bsdfSample(b, wo, u.x, stretched, &e);
+        ASSERT_EQ(okA, okE);
+        if (!okA) continue;
+        ASSERT_EQ(a.delta, e.delta);
+        ASSERT_EQ(a.pdf, e.pdf);
+        ASSERT_EQ(a.wi.x, e.wi.x);
+        ASSERT_EQ(a.wi.y, e.wi.y);
+        ASSERT_EQ(a.wi.z, e.wi.z);
+        ASSERT_EQ(a.weight.y, e.weight.y);
+      }
+      EXPECT_GT(coat, 100) << int(t);  // both lobes were drawn
+      EXPECT_GT(base, 100) << int(t);
+    }
+  }
+}
+
+// Hence a regular n x n grid of u splits between smooth plastic's lobes as the coat's share
+// says, to within one column; a separate uc splits it so only in expectation.
+TEST(Bsdf, LobeFromUSplitsAGridAsTheCoatsShare) {
+  Bsdf b = coated(make(BsdfType::Plastic, 0.2f));
+  for (float c : {0.95f, 0.5f, 0.15f}) {
+    const Vec3f wo = woFor(c);
+    const int n = 64;
+    int coat = 0;
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        BsdfSample s;
+        if (bsdfSample(b, wo, 0.5f, Vec2f((i + 0.5f) / n, (j + 0.5f) / n), &s, true)) coat += s.delta;
+      }
+    EXPECT_NEAR(double(coat) / (n * n), bsdfDeltaProb(b, wo), 1.0 / n) << c;
+  }
+}
 
 TEST(Bsdf, NonNegativeAndReciprocal) {
   Pcg32 rng(5);
@@ -226,22 +299,27 @@ TEST(Bsdf, OnlyTwoLobeBsdfsReadTheLobeChoice) {
     glass.ior = 1.5f;
     all.push_back({t == BsdfType::Dielectric ? "Dielectric" : "ThinDielectric", glass, 1.f});
   }
-  for (BsdfCase& c : all) {
-    c.bsdf = coated(c.bsdf);
-    bool differs = false;
-    for (int i = 0; i < 2000; ++i) {
-      Vec3f wo = sampleUniformSphere({rng.nextFloat(), rng.nextFloat()});
-      Vec2f u(rng.nextFloat(), rng.nextFloat());
-      BsdfSample a, b;
-      bool okA = bsdfSample(c.bsdf, wo, 0.02f, u, &a), okB = bsdfSample(c.bsdf, wo, 0.98f, u, &b);
-      bool same = okA == okB && (!okA || (a.wi.x == b.wi.x && a.wi.y == b.wi.y && a.wi.z == b.wi.z &&
-                                          a.weight.x == b.weight.x && a.pdf == b.pdf && a.delta == b.delta));
-      differs = differs || !same;
-      if (!bsdfPicksALobe(c.bsdf)) {
-        ASSERT_TRUE(same) << c.name << " read uc";
+  // The integrators ask for the lobe from u.x (lobeFromU), and skip uc where
+  // bsdfReadsUcBesideU says it goes unread then.
+  for (bool lobeFromU : {false, true}) {
+    for (BsdfCase& c : all) {
+      c.bsdf = coated(c.bsdf);
+      const bool reads = lobeFromU ? bsdfReadsUcBesideU(c.bsdf) : bsdfPicksALobe(c.bsdf);
+      bool differs = false;
+      for (int i = 0; i < 2000; ++i) {
+        Vec3f wo = sampleUniformSphere({rng.nextFloat(), rng.nextFloat()});
+        Vec2f u(rng.nextFloat(), rng.nextFloat());
+        BsdfSample a, b;
+        bool okA = bsdfSample(c.bsdf, wo, 0.02f, u, &a, lobeFromU), okB = bsdfSample(c.bsdf, wo, 0.98f, u, &b, lobeFromU);
+        bool same = okA == okB && (!okA || (a.wi.x == b.wi.x && a.wi.y == b.wi.y && a.wi.z == b.wi.z &&
+                                            a.weight.x == b.weight.x && a.pdf == b.pdf && a.delta == b.delta));
+        differs = differs || !same;
+        if (!reads) {
+          ASSERT_TRUE(same) << c.name << " read uc" << (lobeFromU ? " (lobe from u)" : "");
+        }
       }
+      EXPECT_EQ(differs, reads) << c.name << (lobeFromU ? " (lobe from u)" : "");
     }
-    EXPECT_EQ(differs, bsdfPicksALobe(c.bsdf)) << c.name;
   }
 }
 
