@@ -367,13 +367,18 @@ ENVGI_INLINE bool bsdfPicksALobe(const Bsdf& b) {
 // Whether bsdfSample(..., lobeFromU = true) picks the lobe by u.x instead of uc: the lobe by where
 // u.x falls among the lobes' shares, then u.x stretched over the chosen share (stretchedDraw).
 // A 2D low-discrepancy u then stays stratified within each lobe, where a separate uc splits it
-// into two unstratified subsets. Only plastics: their shares follow from wo alone, while a
-// rough dielectric's and the principled BSDF's follow from the microfacet that u itself draws.
+// into unstratified subsets. Plastics, whose shares follow from wo alone, and the principled
+// BSDF, whose diffuse, clearcoat and specular pair do; not a rough dielectric, whose reflection
+// and transmission shares follow from the microfacet that u itself draws (so does the principled
+// BSDF's split of its specular pair, which still reads uc).
 ENVGI_INLINE bool bsdfLobeFromU(const Bsdf& b) {
-  return b.type == BsdfType::Plastic || b.type == BsdfType::RoughPlastic;
+  return b.type == BsdfType::Plastic || b.type == BsdfType::RoughPlastic || b.type == BsdfType::Principled;
 }
 // Whether bsdfSample reads uc when the caller asks for the lobe from u where it can.
-ENVGI_INLINE bool bsdfReadsUcBesideU(const Bsdf& b) { return bsdfPicksALobe(b) && !bsdfLobeFromU(b); }
+ENVGI_INLINE bool bsdfReadsUcBesideU(const Bsdf& b) {
+  if (b.type == BsdfType::Principled) return principled::readsUcBesideU(b.principled);
+  return bsdfPicksALobe(b) && !bsdfLobeFromU(b);
+}
 
 namespace detail {
 ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s, bool lobeFromU) {
@@ -491,7 +496,7 @@ ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, Bsdf
       break;
     }
     case BsdfType::Principled:
-      if (!principled::sampleDirection(b.principled, b.ior, wo, uc, u, &s->wi)) return false;
+      if (!principled::sampleDirection(b.principled, b.ior, wo, uc, u, &s->wi, lobeFromU)) return false;
       ok = detail::finishSample(b, wo, s);
       break;
   }

@@ -206,25 +206,11 @@ ENVGI_INLINE float pdf(const PrincipledParams& p, float eta, Vec3f o, Vec3f i) {
   return pr;
 }
 
-// A direction by one lobe, chosen by uc; false where it falls on the wrong side. The caller
-// takes its pdf and weight from pdf() and eval() (Bsdf.h's finishSample).
-ENVGI_INLINE bool sampleDirection(const PrincipledParams& p, float eta, Vec3f o, float uc, Vec2f u, Vec3f* wi) {
-  if (!hasSide(p, o.z)) return false;
-  MicrofacetDistribution d = specularLobe(p);
-  Vec3f m = d.sampleVisible(o, u);  // facing +z
-  float F = fresnelDielectric(dot(o, m), eta);
-  LobeProbs l = lobeProbs(p, o.z > 0.f, F);
+// The specular pair's direction about microfacet m (facing +z): refracted through it or
+// reflected; false where it falls on the wrong side.
+ENVGI_INLINE bool specularDirection(float eta, Vec3f o, Vec3f m, bool transmit, Vec3f* wi) {
   float s = o.z > 0.f ? 1.f : -1.f;
-  if (uc < l.diffuse) {
-    *wi = sampleCosineHemisphere(u);
-    return wi->z > 0.f;
-  }
-  if (uc < l.diffuse + l.clearcoat) {
-    Vec3f mc = gtr1Sample(clearcoatAlpha(p), u);
-    *wi = reflect(o, mc);
-    return wi->z > 0.f && dot(o, mc) > 0.f && dot(*wi, mc) > 0.f;
-  }
-  if (uc < l.diffuse + l.clearcoat + l.specTransmit) {
+  if (transmit) {
     float c = dot(o, m), e = eta;
     Vec3f n = m;
     if (c < 0.f) {
@@ -236,6 +222,53 @@ ENVGI_INLINE bool sampleDirection(const PrincipledParams& p, float eta, Vec3f o,
   }
   *wi = reflect(o, m);
   return wi->z * o.z > 0.f && dot(o, m) * s > 0.f && dot(*wi, m) * s > 0.f;
+}
+
+// Whether sampleDirection(..., lobeFromU = true) still reads uc: to split the specular pair
+// between reflection and transmission, which only glass has.
+ENVGI_INLINE bool readsUcBesideU(const PrincipledParams& p) { return glassWeight(p) > 0.f; }
+
+// A direction by one lobe, chosen by uc; false where it falls on the wrong side. The caller
+// takes its pdf and weight from pdf() and eval() (Bsdf.h's finishSample).
+// With lobeFromU, u.x picks among the diffuse, the clearcoat and the specular pair, whose shares
+// do not depend on F (lobeProbs), and is stretched over the chosen share; uc then splits the pair
+// by F at the microfacet drawn. Each lobe keeps u's stratification, and the density is the same.
+ENVGI_INLINE bool sampleDirection(const PrincipledParams& p, float eta, Vec3f o, float uc, Vec2f u, Vec3f* wi,
+                                  bool lobeFromU = false) {
+  if (!hasSide(p, o.z)) return false;
+  if (lobeFromU) {
+    const LobeProbs l0 = lobeProbs(p, o.z > 0.f, 0.f);
+    const float pd = l0.diffuse, pc = l0.clearcoat;
+    if (u.x < pd) {
+      *wi = sampleCosineHemisphere(Vec2f(stretchedDraw(u.x, 0.f, pd), u.y));
+      return wi->z > 0.f;
+    }
+    if (u.x < pd + pc) {
+      Vec3f mc = gtr1Sample(clearcoatAlpha(p), Vec2f(stretchedDraw(u.x, pd, pc), u.y));
+      *wi = reflect(o, mc);
+      return wi->z > 0.f && dot(o, mc) > 0.f && dot(*wi, mc) > 0.f;
+    }
+    if (!(l0.specReflect + l0.specTransmit > 0.f)) return false;
+    const float ps = 1.f - pd - pc;
+    const Vec3f m = specularLobe(p).sampleVisible(o, Vec2f(stretchedDraw(u.x, pd + pc, ps), u.y));
+    const LobeProbs l = lobeProbs(p, o.z > 0.f, fresnelDielectric(dot(o, m), eta));
+    const float pair = l.specReflect + l.specTransmit;
+    return specularDirection(eta, o, m, pair > 0.f && uc * pair < l.specTransmit, wi);
+  }
+  MicrofacetDistribution d = specularLobe(p);
+  Vec3f m = d.sampleVisible(o, u);  // facing +z
+  float F = fresnelDielectric(dot(o, m), eta);
+  LobeProbs l = lobeProbs(p, o.z > 0.f, F);
+  if (uc < l.diffuse) {
+    *wi = sampleCosineHemisphere(u);
+    return wi->z > 0.f;
+  }
+  if (uc < l.diffuse + l.clearcoat) {
+    Vec3f mc = gtr1Sample(clearcoatAlpha(p), u);
+    *wi = reflect(o, mc);
+    return wi->z > 0.f && dot(o, mc) > 0.f && dot(*wi, mc) > 0.f;
+  }
+  return specularDirection(eta, o, m, uc < l.diffuse + l.clearcoat + l.specTransmit, wi);
 }
 
 }  // namespace principled

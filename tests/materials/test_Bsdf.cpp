@@ -169,8 +169,8 @@ TEST_P(BsdfChi2, SampleMatchesPdf) { expectSampleMatchesPdf(GetParam(), false); 
 INSTANTIATE_TEST_SUITE_P(All, BsdfChi2, ::testing::ValuesIn(cases()),
                          [](const ::testing::TestParamInfo<BsdfCase>& i) { return i.param.name; });
 
-// The same with the lobe picked by u.x, for the BSDFs that can (bsdfLobeFromU): the density
-// drawn must stay bsdfPdf's.
+// The same with the lobe picked by u.x, for the BSDFs that can (bsdfLobeFromU: plastics and
+// principled): the density drawn must stay bsdfPdf's.
 class BsdfChi2LobeFromU : public ::testing::TestWithParam<BsdfCase> {};
 TEST_P(BsdfChi2LobeFromU, SampleMatchesPdf) { expectSampleMatchesPdf(GetParam(), true); }
 
@@ -180,7 +180,7 @@ std::vector<BsdfCase> lobeFromUCases() {
     if (bsdfLobeFromU(c.bsdf)) out.push_back(c);
   return out;
 }
-INSTANTIATE_TEST_SUITE_P(Plastics, BsdfChi2LobeFromU, ::testing::ValuesIn(lobeFromUCases()),
+INSTANTIATE_TEST_SUITE_P(LobesFromU, BsdfChi2LobeFromU, ::testing::ValuesIn(lobeFromUCases()),
                          [](const ::testing::TestParamInfo<BsdfCase>& i) { return i.param.name; });
 
 // With the lobe from u.x, a draw is the two-draw form's with uc = u.x and u.x stretched over the
