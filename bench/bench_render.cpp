@@ -3,6 +3,7 @@
 // 2 threads. The ratio is the share of time envgi spends outside Embree.
 // Run: build/bin/envgi_bench_render --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 // BM_ShareOfPlainEmbree gives the ratio itself from back-to-back pairs, robust to drift.
+// BM_PlainEmbreeStreamsSameRays traces them through Embree's stream calls instead, as envgi does.
 // ENVGI_BENCH_MESH=/path/to/mesh.ply swaps the Buddha for another mesh (e.g. the 871k dragon),
 // ENVGI_BENCH_ENVMAP=/path/to/map.hdr Grace Cathedral for another map, ENVGI_BENCH_STRATEGY=S the
 // map's sampling strategy (product, the scene's, for alias, importance, ...). ENVGI_BENCH_DEPTH=N cuts the
@@ -107,6 +108,55 @@ uint64_t renderEnvgi(Fixture& f, int threads) {
   return st.rays;
 }
 
+// The recorded rays through Embree's stream calls (rtcIntersect1M, rtcOccluded1M) in chunks of
+// 256, as envgi's by-bounce loop traces a round's bounce and shadow rays: plain Embree at its
+// best on these rays, for comparison with the one-ray loop below.
+void tracePlainStreams(Fixture& f, tbb::task_arena& arena) {
+  RTCScene scene = f.accel->handle();
+  const auto& is = f.rec.intersects;
+  const auto& os = f.rec.occlusions;
+  std::atomic<uint64_t> hits{0};
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, is.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      std::vector<RTCRayHit> rh(256);
+      uint64_t h = 0;
+      for (size_t i0 = r.begin(); i0 < r.end(); i0 += 256) {
+        const size_t n = std::min<size_t>(256, r.end() - i0);
+        for (size_t k = 0; k < n; ++k) {
+          const Ray& q = is[i0 + k];
+          rh[k] = RTCRayHit{};
+          rh[k].ray.org_x = q.o.x; rh[k].ray.org_y = q.o.y; rh[k].ray.org_z = q.o.z;
+          rh[k].ray.dir_x = q.d.x; rh[k].ray.dir_y = q.d.y; rh[k].ray.dir_z = q.d.z;
+          rh[k].ray.tnear = 0.f; rh[k].ray.tfar = q.tMax; rh[k].ray.mask = 0xFFFFFFFFu;
+          rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        }
+        rtcIntersect1M(scene, &ctx, rh.data(), unsigned(n), sizeof(RTCRayHit));
+        for (size_t k = 0; k < n; ++k) h += rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID;
+      }
+      hits += h;
+    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, os.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+      RTCIntersectContext ctx;
+      rtcInitIntersectContext(&ctx);
+      std::vector<RTCRay> ray(256);
+      for (size_t i0 = r.begin(); i0 < r.end(); i0 += 256) {
+        const size_t n = std::min<size_t>(256, r.end() - i0);
+        for (size_t k = 0; k < n; ++k) {
+          const Ray& q = os[i0 + k];
+          ray[k] = RTCRay{};
+          ray[k].org_x = q.o.x; ray[k].org_y = q.o.y; ray[k].org_z = q.o.z;
+          ray[k].dir_x = q.d.x; ray[k].dir_y = q.d.y; ray[k].dir_z = q.d.z;
+          ray[k].tnear = 0.f; ray[k].tfar = q.tMax; ray[k].mask = 0xFFFFFFFFu;
+        }
+        rtcOccluded1M(scene, &ctx, ray.data(), unsigned(n), sizeof(RTCRay));
+      }
+    });
+  });
+  benchmark::DoNotOptimize(hits.load());
+}
+
 // The recorded rays through a bare Embree loop, intersections then occlusions.
 void tracePlain(Fixture& f, tbb::task_arena& arena) {
   RTCScene scene = f.accel->handle();
@@ -163,6 +213,15 @@ static void BM_PlainEmbreeSameRays(benchmark::State& state) {
   state.counters["rays"] = rays;
 }
 BENCHMARK(BM_PlainEmbreeSameRays)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+static void BM_PlainEmbreeStreamsSameRays(benchmark::State& state) {
+  Fixture& f = fixture();
+  tbb::task_arena arena(int(state.range(0)));
+  for (auto _ : state) tracePlainStreams(f, arena);
+  double rays = double(f.rec.intersects.size() + f.rec.occlusions.size());
+  state.counters["rays/s"] = benchmark::Counter(rays * double(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_PlainEmbreeStreamsSameRays)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The figure directly: each iteration times an envgi render and the plain loop back to
 // back, so that the machine's drift (10-15% within an hour here) hits both alike. "share" is the

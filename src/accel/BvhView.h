@@ -247,6 +247,16 @@ struct BvhTracer {
       out(i, found, h);
     }
   }
+  // A round's bounce rays and shadow rays (renderTileByBounce), one at a time here too.
+  template <class Rays, class Out>
+  void intersectMany(int n, Rays rays, Out out) const { intersectCoherent(n, rays, out); }
+  template <class Rays, class Out>
+  void occludedMany(int n, Rays rays, Out out) const {
+    for (int i = 0; i < n; ++i) {
+      const Ray& r = rays(i);
+      out(i, bvh.occluded(r.o, r.d, r.tMax));
+    }
+  }
 };
 
 }  // namespace envgi

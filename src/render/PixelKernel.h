@@ -183,8 +183,8 @@ struct TileBatch {
   std::vector<PathState> state;
   std::vector<Sampler> sampler;
   std::vector<Hit> hit;
-  std::vector<unsigned char> found, going;
-  std::vector<int> active;
+  std::vector<unsigned char> found, going, blocked;
+  std::vector<int> active, shadow;  // shadow: the round's paths whose light sample has a ray
   std::vector<LightSampleLd> ld;  // each path's next-event sample of this round
   std::vector<Color> ldBeta;      // and the path's beta when it was drawn
   std::vector<float> weight;      // each path's filter weight
@@ -193,7 +193,8 @@ struct TileBatch {
   std::vector<float> accW;
   void resize(size_t n) {
     if (state.size() >= n) return;
-    state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), active.resize(n);
+    state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), blocked.resize(n);
+    active.resize(n), shadow.resize(n);
     ld.resize(n), ldBeta.resize(n), weight.resize(n), acc.resize(n), accSq.resize(n), accW.resize(n);
   }
 };
@@ -223,7 +224,8 @@ inline int blockOrderSlot(int i, int tw) {
 // pixel starts together, then each round traces all live paths' rays back to back and shades
 // them back to back, instead of alternating one ray's traversal with its shading. That keeps
 // the BVH, then the map's tables, in cache across a round (renderPixel took 4-8% longer on the
-// buddha bench: docs/performance.md). The camera rays go to the tracer together, for packets.
+// buddha bench: docs/performance.md). The camera rays go to the tracer together, for packets,
+// and each round's bounce rays and shadow rays, for streams.
 // Each pixel adds its samples in renderPixel's order, so the film's sums are the same to the
 // bit where the tracer's packets give one-ray hits to the bit (the BVH's loop does; Embree's
 // packets round t in their own way).
@@ -260,10 +262,14 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
               if (found) b->hit[k] = h;
             });
       } else {
-        for (int i = 0; i < live; ++i) {
-          int k = b->active[i];
-          b->found[k] = integ.tracer.intersect(b->state[k].ray, &b->hit[k]);
-        }
+        // Incoherent: the tracer may trace them as one stream.
+        integ.tracer.intersectMany(
+            live, [&](int i) -> const Ray& { return b->state[b->active[i]].ray; },
+            [&](int i, bool found, const Hit& h) {
+              const int k = b->active[i];
+              b->found[k] = found;
+              if (found) b->hit[k] = h;
+            });
       }
       counters->rays += uint64_t(live);
       // Ask for the hit triangles' indices, then their vertices, for the whole round before
@@ -283,12 +289,18 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         b->ld[k].needsRay = false;
         b->going[k] = integ.shade(&b->state[k], b->found[k] != 0, b->hit[k], b->sampler[k], ShadowRayLater{b});
       }
+      int shadows = 0;
+      for (int i = 0; i < live; ++i)
+        if (b->ld[b->active[i]].needsRay) b->shadow[shadows++] = b->active[i];
+      counters->rays += uint64_t(shadows);
+      integ.tracer.occludedMany(
+          shadows, [&](int i) { const LightSampleLd& ld = b->ld[b->shadow[i]]; return Ray{ld.o, ld.d, ld.tMax}; },
+          [&](int i, bool blocked) { b->blocked[b->shadow[i]] = blocked; });
       int next = 0;
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];
         const LightSampleLd& ld = b->ld[k];
-        if (ld.needsRay)
-          b->state[k].L += b->ldBeta[k] * resolvedLd(ld, shadowRayBlocked(integ.tracer, ld, &counters->rays));
+        if (ld.needsRay) b->state[k].L += b->ldBeta[k] * resolvedLd(ld, b->blocked[k] != 0);
         if (b->going[k]) {
           b->active[next++] = k;
         } else if (acceptedSample(b->state[k].L, counters)) {

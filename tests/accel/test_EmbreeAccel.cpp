@@ -1,6 +1,7 @@
-// Embree's 16-wide packets (EmbreeAccel::intersectCoherent) against its one-ray call on the
-// same rays: the same hits (t to an ulp or two), for camera rays and for scattered ones, through masked
-// surfaces, with rays Embree cannot take and counts that are not a multiple of 16.
+// Embree's 16-wide packets (EmbreeAccel::intersectCoherent) and its stream calls (intersectMany,
+// occludedMany) against its one-ray calls on the same rays: the same hits (t to an ulp or two)
+// and the same shadow answers, for camera rays and for scattered ones, through masked surfaces,
+// with rays Embree cannot take and counts that are not a multiple of 16 or of the stream's chunk.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -93,4 +94,54 @@ TEST(EmbreeAccel, PacketsPassThroughMasksAsOneRayDoes) {
                             differ += surface && (!found || h.t != all.t);
                           });
   EXPECT_GT(differ, 0) << "no camera ray went through a masked surface";
+}
+
+TEST(EmbreeAccel, StreamsGiveTheOneRayAnswers) {
+  for (std::string name : {"buddha", "mask", "cornell-box", "teapot-glass", "instances"}) {
+    Scene scene;
+    loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/" + name + ".xml", {{"res", "64"}}, scene);
+    scene.finalize();
+    EmbreeAccel accel(scene);
+    for (int n : {1, 37, 256, 600}) {
+      std::vector<Ray> rays = raysFor(scene.view(), std::max(n, 8), 29u + uint64_t(n));
+      rays.resize(size_t(n));
+      std::vector<int> seen(size_t(n), 0), seenShadow(size_t(n), 0);
+      int hits = 0, blockedCount = 0;
+      accel.intersectMany(n, [&](int i) -> const Ray& { return rays[size_t(i)]; },
+                          [&](int i, bool found, const Hit& h) {
+                            ASSERT_GE(i, 0);
+                            ASSERT_LT(i, n);
+                            ++seen[size_t(i)];
+                            Hit one;
+                            const bool oneFound = accel.intersect(rays[size_t(i)], &one);
+                            EXPECT_EQ(found, oneFound) << name << " ray " << i << " of " << n;
+                            if (!found || !oneFound) return;
+                            ++hits;
+                            EXPECT_EQ(h.geomId, one.geomId) << name << " ray " << i;
+                            EXPECT_EQ(h.primId, one.primId) << name << " ray " << i;
+                            EXPECT_NEAR(h.t, one.t, 4e-7f * one.t) << name << " ray " << i;
+                            EXPECT_NEAR(h.u, one.u, 1e-6f) << name << " ray " << i;
+                            EXPECT_NEAR(h.v, one.v, 1e-6f) << name << " ray " << i;
+                          });
+      // Shadow rays: the same rays, and each cut short of its first hit, which must then pass.
+      accel.occludedMany(n, [&](int i) -> const Ray& { return rays[size_t(i)]; },
+                         [&](int i, bool blocked) {
+                           ASSERT_GE(i, 0);
+                           ASSERT_LT(i, n);
+                           ++seenShadow[size_t(i)];
+                           const Ray& r = rays[size_t(i)];
+                           EXPECT_EQ(blocked, accel.occluded(r.o, r.d, r.tMax)) << name << " ray " << i;
+                           blockedCount += blocked;
+                         });
+      for (int i = 0; i < n; ++i) {
+        EXPECT_EQ(seen[size_t(i)], 1) << name << ": each ray answered once, ray " << i;
+        EXPECT_EQ(seenShadow[size_t(i)], 1) << name << ": each shadow ray answered once, ray " << i;
+      }
+      if (n >= 37) {
+        EXPECT_GT(hits, 0) << name << ": some rays hit";
+        EXPECT_GT(blockedCount, 0) << name << ": some shadow rays are blocked";
+        EXPECT_LT(blockedCount, n) << name << ": and some are not";
+      }
+    }
+  }
 }

@@ -112,7 +112,8 @@ TEST(PixelKernel, TileByBounceAddsTheSameSamplesAsRenderPixel) {
 
 // The same over Embree, whose camera rays go through 16-wide packets in 4 x 4 blocks of pixels
 // (whole tiles) or in row order (a tile whose side is not a multiple of 4: 22 pixels in tiles
-// of 16 leaves 6). Embree's packets find the same hits with t to an ulp or two, so the sums
+// of 16 leaves 6), and whose bounce and shadow rays go through its stream calls. Embree's
+// packets and streams find the same hits with t to an ulp or two, so the sums
 // match renderPixel's to float rounding, except where a path's later choices turn on those
 // bits (a mask's stochastic pass-through): there a pixel's samples differ, not its mean.
 TEST(PixelKernel, TileByBounceOverEmbreePacketsAddsTheSameSamplesAsRenderPixel) {
@@ -139,7 +140,8 @@ TEST(PixelKernel, TileByBounceOverEmbreePacketsAddsTheSameSamplesAsRenderPixel) 
         for (int x0 = 0; x0 < cam.width; x0 += 16)
           renderTileByBounce(cam, k.sequence, integ, x0, y0, std::min(x0 + 16, cam.width),
                              std::min(y0 + 16, cam.height), 0, 4, b.view(cam), &batch, &cb);
-      EXPECT_NEAR(double(ca.rays), double(cb.rays), 1e-3 * double(ca.rays)) << name << " " << res;
+      // The mask's pass-through may turn a path another way, and with it its count of rays.
+      EXPECT_NEAR(double(ca.rays), double(cb.rays), (name == "mask" ? 5e-3 : 1e-3) * double(ca.rays)) << name << " " << res;
       size_t same = 0;
       double meanA = 0.0, meanB = 0.0;
       for (size_t i = 0; i < npix; ++i) {
