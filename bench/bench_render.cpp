@@ -108,6 +108,20 @@ uint64_t renderEnvgi(Fixture& f, int threads) {
   return st.rays;
 }
 
+RTCRay rtcRayOf(const Ray& q) {
+  RTCRay ray{};
+  ray.org_x = q.o.x, ray.org_y = q.o.y, ray.org_z = q.o.z;
+  ray.dir_x = q.d.x, ray.dir_y = q.d.y, ray.dir_z = q.d.z;
+  ray.tnear = 0.f, ray.tfar = q.tMax, ray.mask = 0xFFFFFFFFu;
+  return ray;
+}
+RTCRayHit rtcRayHitOf(const Ray& q) {
+  RTCRayHit rh{};
+  rh.ray = rtcRayOf(q);
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+
 // The recorded rays through Embree's stream calls (rtcIntersect1M, rtcOccluded1M) in chunks of
 // 256, as envgi's by-bounce loop traces a round's bounce and shadow rays: plain Embree at its
 // best on these rays, for comparison with the one-ray loop below.
@@ -124,14 +138,7 @@ void tracePlainStreams(Fixture& f, tbb::task_arena& arena) {
       uint64_t h = 0;
       for (size_t i0 = r.begin(); i0 < r.end(); i0 += 256) {
         const size_t n = std::min<size_t>(256, r.end() - i0);
-        for (size_t k = 0; k < n; ++k) {
-          const Ray& q = is[i0 + k];
-          rh[k] = RTCRayHit{};
-          rh[k].ray.org_x = q.o.x; rh[k].ray.org_y = q.o.y; rh[k].ray.org_z = q.o.z;
-          rh[k].ray.dir_x = q.d.x; rh[k].ray.dir_y = q.d.y; rh[k].ray.dir_z = q.d.z;
-          rh[k].ray.tnear = 0.f; rh[k].ray.tfar = q.tMax; rh[k].ray.mask = 0xFFFFFFFFu;
-          rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        }
+        for (size_t k = 0; k < n; ++k) rh[k] = rtcRayHitOf(is[i0 + k]);
         rtcIntersect1M(scene, &ctx, rh.data(), unsigned(n), sizeof(RTCRayHit));
         for (size_t k = 0; k < n; ++k) h += rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID;
       }
@@ -143,13 +150,7 @@ void tracePlainStreams(Fixture& f, tbb::task_arena& arena) {
       std::vector<RTCRay> ray(256);
       for (size_t i0 = r.begin(); i0 < r.end(); i0 += 256) {
         const size_t n = std::min<size_t>(256, r.end() - i0);
-        for (size_t k = 0; k < n; ++k) {
-          const Ray& q = os[i0 + k];
-          ray[k] = RTCRay{};
-          ray[k].org_x = q.o.x; ray[k].org_y = q.o.y; ray[k].org_z = q.o.z;
-          ray[k].dir_x = q.d.x; ray[k].dir_y = q.d.y; ray[k].dir_z = q.d.z;
-          ray[k].tnear = 0.f; ray[k].tfar = q.tMax; ray[k].mask = 0xFFFFFFFFu;
-        }
+        for (size_t k = 0; k < n; ++k) ray[k] = rtcRayOf(os[i0 + k]);
         rtcOccluded1M(scene, &ctx, ray.data(), unsigned(n), sizeof(RTCRay));
       }
     });
@@ -157,7 +158,8 @@ void tracePlainStreams(Fixture& f, tbb::task_arena& arena) {
   benchmark::DoNotOptimize(hits.load());
 }
 
-// The recorded rays through a bare Embree loop, intersections then occlusions.
+// The recorded rays through a bare Embree loop, intersections then occlusions. Kept apart from
+// the streams' loop above, as every stop since 21 has timed it.
 void tracePlain(Fixture& f, tbb::task_arena& arena) {
   RTCScene scene = f.accel->handle();
   const auto& is = f.rec.intersects;
@@ -169,11 +171,7 @@ void tracePlain(Fixture& f, tbb::task_arena& arena) {
       rtcInitIntersectContext(&ctx);
       uint64_t h = 0;
       for (size_t i = r.begin(); i < r.end(); ++i) {
-        RTCRayHit rh{};
-        rh.ray.org_x = is[i].o.x; rh.ray.org_y = is[i].o.y; rh.ray.org_z = is[i].o.z;
-        rh.ray.dir_x = is[i].d.x; rh.ray.dir_y = is[i].d.y; rh.ray.dir_z = is[i].d.z;
-        rh.ray.tnear = 0.f; rh.ray.tfar = is[i].tMax; rh.ray.mask = 0xFFFFFFFFu;
-        rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+        RTCRayHit rh = rtcRayHitOf(is[i]);
         rtcIntersect1(scene, &ctx, &rh);
         h += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
       }
@@ -183,10 +181,7 @@ void tracePlain(Fixture& f, tbb::task_arena& arena) {
       RTCIntersectContext ctx;
       rtcInitIntersectContext(&ctx);
       for (size_t i = r.begin(); i < r.end(); ++i) {
-        RTCRay ray{};
-        ray.org_x = os[i].o.x; ray.org_y = os[i].o.y; ray.org_z = os[i].o.z;
-        ray.dir_x = os[i].d.x; ray.dir_y = os[i].d.y; ray.dir_z = os[i].d.z;
-        ray.tnear = 0.f; ray.tfar = os[i].tMax; ray.mask = 0xFFFFFFFFu;
+        RTCRay ray = rtcRayOf(os[i]);
         rtcOccluded1(scene, &ctx, &ray);
       }
     });

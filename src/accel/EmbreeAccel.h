@@ -116,31 +116,19 @@ class EmbreeAccel {
   void intersectMany(int n, Rays rays, Out out) const {
     RTCRayHit rh[kStreamChunk];
     Ray given[kStreamChunk];
-    int slot[kStreamChunk];
-    Context ctx;
-    rtcInitIntersectContext(&ctx.rtc);
-    ctx.throughMasks = true;
-    ctx.rays = given;
-    for (int b = 0; b < n; b += kStreamChunk) {
-      const int m = n - b < kStreamChunk ? n - b : kStreamChunk;
-      int k = 0;
-      for (int j = 0; j < m; ++j) {
-        const Ray& r = rays(b + j);
-        if (!traceable(r)) continue;  // misses, as intersect() says
-        given[k] = r;
-        slot[k] = b + j;
-        fillRay(r, rh[k].ray);
-        rh[k].ray.id = unsigned(k);
-        rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-        rh[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-        ++k;
-      }
-      if (k > 0) rtcIntersect1M(scene_, &ctx.rtc, rh, unsigned(k), sizeof(RTCRayHit));
-      for (int j = 0, q = 0; j < m; ++j) {
-        Hit h;
-        bool found = false;
-        if (q < k && slot[q] == b + j) {
-          found = rh[q].hit.geomID != RTC_INVALID_GEOMETRY_ID;
+    Context ctx = streamContext(given);
+    streamChunks(
+        n, rays, given,
+        [&](int k, const Ray& r) {
+          fillRay(r, rh[k].ray);
+          rh[k].ray.id = unsigned(k);
+          rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
+          rh[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        },
+        [&](int k) { rtcIntersect1M(scene_, &ctx.rtc, rh, unsigned(k), sizeof(RTCRayHit)); },
+        [&](int i, int q) {
+          Hit h;
+          const bool found = q >= 0 && rh[q].hit.geomID != RTC_INVALID_GEOMETRY_ID;  // -1: misses
           if (found) {
             h.t = rh[q].ray.tfar;
             h.geomId = geometryOf(rh[q].hit.geomID, rh[q].hit.instID[0]);
@@ -148,11 +136,8 @@ class EmbreeAccel {
             h.u = rh[q].hit.u;
             h.v = rh[q].hit.v;
           }
-          ++q;
-        }
-        out(b + j, found, h);
-      }
-    }
+          out(i, found, h);
+        });
   }
 
   // occluded() for n shadow rays (rays(i) the i-th, out(i, blocked) its answer) through
@@ -161,30 +146,16 @@ class EmbreeAccel {
   void occludedMany(int n, Rays rays, Out out) const {
     RTCRay rr[kStreamChunk];
     Ray given[kStreamChunk];
-    int slot[kStreamChunk];
-    Context ctx;
-    rtcInitIntersectContext(&ctx.rtc);
-    ctx.throughMasks = true;
-    ctx.rays = given;
-    for (int b = 0; b < n; b += kStreamChunk) {
-      const int m = n - b < kStreamChunk ? n - b : kStreamChunk;
-      int k = 0;
-      for (int j = 0; j < m; ++j) {
-        const Ray& r = rays(b + j);
-        if (!traceable(r)) continue;  // blocked, as occluded() says
-        given[k] = r;
-        slot[k] = b + j;
-        fillRay(r, rr[k]);
-        rr[k].id = unsigned(k);
-        ++k;
-      }
-      if (k > 0) rtcOccluded1M(scene_, &ctx.rtc, rr, unsigned(k), sizeof(RTCRay));
-      for (int j = 0, q = 0; j < m; ++j) {
-        bool blocked = true;
-        if (q < k && slot[q] == b + j) blocked = rr[q++].tfar < 0.f;  // Embree sets tfar to -inf on a hit
-        out(b + j, blocked);
-      }
-    }
+    Context ctx = streamContext(given);
+    streamChunks(
+        n, rays, given,
+        [&](int k, const Ray& r) {
+          fillRay(r, rr[k]);
+          rr[k].id = unsigned(k);
+        },
+        [&](int k) { rtcOccluded1M(scene_, &ctx.rtc, rr, unsigned(k), sizeof(RTCRay)); },
+        // -1 (untraceable): blocked, as occluded() says; Embree sets tfar to -inf on a hit.
+        [&](int i, int q) { out(i, q < 0 || rr[q].tfar < 0.f); });
   }
 
   bool occluded(Vec3f o, Vec3f d, float tMax) const {
@@ -215,6 +186,39 @@ class EmbreeAccel {
   // Rays per stream call: the bench's shadow rays took 0.80x the one-ray time in chunks of 64
   // and 0.68x in chunks of 256 (docs/performance.md, stop 65); a tile of 16 x 16 has 256 paths.
   static constexpr int kStreamChunk = 256;
+
+  // A context for a stream whose k-th ray is given[k], with RTCRay::id k (the mask filter reads
+  // it there).
+  static Context streamContext(const Ray* given) {
+    Context ctx;
+    rtcInitIntersectContext(&ctx.rtc);
+    ctx.throughMasks = true;
+    ctx.rays = given;
+    return ctx;
+  }
+
+  // The stream calls' loop: n rays in chunks of kStreamChunk. A chunk's rays that Embree can
+  // take go to given[k] and fill(k, ray), k their place in the stream; trace(k) traces the k
+  // filled; answer(i, q) then answers ray i from place q, or from q = -1 where Embree could not
+  // take it.
+  template <class Rays, class Fill, class Trace, class Answer>
+  static void streamChunks(int n, Rays& rays, Ray* given, Fill fill, Trace trace, Answer answer) {
+    int slot[kStreamChunk];
+    for (int b = 0; b < n; b += kStreamChunk) {
+      const int m = n - b < kStreamChunk ? n - b : kStreamChunk;
+      int k = 0;
+      for (int j = 0; j < m; ++j) {
+        const Ray& r = rays(b + j);
+        if (!traceable(r)) continue;
+        given[k] = r;
+        slot[k] = b + j;
+        fill(k, r);
+        ++k;
+      }
+      if (k > 0) trace(k);
+      for (int j = 0, q = 0; j < m; ++j) answer(b + j, q < k && slot[q] == b + j ? q++ : -1);
+    }
+  }
 
   static void fillRay(const Ray& ray, RTCRay& r) {
     r.org_x = ray.o.x;

@@ -35,6 +35,22 @@ std::vector<Ray> raysFor(const SceneView& sc, int n, uint64_t seed) {
   return rays;
 }
 
+// Ray i's answer from packets or streams against the one-ray call's: the same hit, t to an ulp
+// or two (Embree's packet kernels divide for it in their own way), u and v to the bit.
+void expectOneRayHit(const EmbreeAccel& accel, const std::vector<Ray>& rays, const std::string& name, int i, bool found,
+                     const Hit& h, int* hits) {
+  Hit one;
+  const bool oneFound = accel.intersect(rays[size_t(i)], &one);
+  EXPECT_EQ(found, oneFound) << name << " ray " << i << " of " << rays.size();
+  if (!found || !oneFound) return;
+  ++*hits;
+  EXPECT_EQ(h.geomId, one.geomId) << name << " ray " << i;
+  EXPECT_EQ(h.primId, one.primId) << name << " ray " << i;
+  EXPECT_NEAR(h.t, one.t, 4e-7f * one.t) << name << " ray " << i;
+  EXPECT_EQ(std::memcmp(&h.u, &one.u, sizeof(float)), 0) << name << " ray " << i;
+  EXPECT_EQ(std::memcmp(&h.v, &one.v, sizeof(float)), 0) << name << " ray " << i;
+}
+
 }  // namespace
 
 TEST(EmbreeAccel, PacketsGiveTheOneRayHits) {
@@ -53,18 +69,7 @@ TEST(EmbreeAccel, PacketsGiveTheOneRayHits) {
                                 ASSERT_GE(i, 0);
                                 ASSERT_LT(i, n);
                                 ++seen[size_t(i)];
-                                Hit one;
-                                const bool oneFound = accel.intersect(rays[size_t(i)], &one);
-                                EXPECT_EQ(found, oneFound) << name << " ray " << i << " of " << n;
-                                if (!found || !oneFound) return;
-                                ++hits;
-                                EXPECT_EQ(h.geomId, one.geomId) << name << " ray " << i;
-                                EXPECT_EQ(h.primId, one.primId) << name << " ray " << i;
-                                // Embree's packet kernels divide for t in their own way: the same to
-                                // an ulp or two, u and v to the bit.
-                                EXPECT_NEAR(h.t, one.t, 4e-7f * one.t) << name << " ray " << i;
-                                EXPECT_EQ(std::memcmp(&h.u, &one.u, sizeof(float)), 0) << name << " ray " << i;
-                                EXPECT_EQ(std::memcmp(&h.v, &one.v, sizeof(float)), 0) << name << " ray " << i;
+                                expectOneRayHit(accel, rays, name, i, found, h, &hits);
                               });
       for (int i = 0; i < n; ++i) EXPECT_EQ(seen[size_t(i)], 1) << name << ": each ray answered once, ray " << i;
       if (n >= 37) {
@@ -112,16 +117,7 @@ TEST(EmbreeAccel, StreamsGiveTheOneRayAnswers) {
                             ASSERT_GE(i, 0);
                             ASSERT_LT(i, n);
                             ++seen[size_t(i)];
-                            Hit one;
-                            const bool oneFound = accel.intersect(rays[size_t(i)], &one);
-                            EXPECT_EQ(found, oneFound) << name << " ray " << i << " of " << n;
-                            if (!found || !oneFound) return;
-                            ++hits;
-                            EXPECT_EQ(h.geomId, one.geomId) << name << " ray " << i;
-                            EXPECT_EQ(h.primId, one.primId) << name << " ray " << i;
-                            EXPECT_NEAR(h.t, one.t, 4e-7f * one.t) << name << " ray " << i;
-                            EXPECT_NEAR(h.u, one.u, 1e-6f) << name << " ray " << i;
-                            EXPECT_NEAR(h.v, one.v, 1e-6f) << name << " ray " << i;
+                            expectOneRayHit(accel, rays, name, i, found, h, &hits);
                           });
       // Shadow rays: the same rays, and each cut short of its first hit, which must then pass.
       accel.occludedMany(n, [&](int i) -> const Ray& { return rays[size_t(i)]; },
