@@ -108,21 +108,6 @@ uint64_t renderEnvgi(Fixture& f, int threads) {
   return st.rays;
 }
 
-// Writes the recorded ray into Embree's, field by field in place: building it apart and copying
-// it whole made the streams' loop 15-20% slower (its rays are read at once, while the copy's
-// wide stores are still on their way).
-void fillRtcRay(const Ray& q, RTCRay& ray) {
-  ray.org_x = q.o.x, ray.org_y = q.o.y, ray.org_z = q.o.z;
-  ray.dir_x = q.d.x, ray.dir_y = q.d.y, ray.dir_z = q.d.z;
-  ray.tnear = 0.f, ray.tfar = q.tMax, ray.mask = 0xFFFFFFFFu;
-  ray.time = 0.f, ray.id = 0u, ray.flags = 0u;
-}
-void fillRtcRayHit(const Ray& q, RTCRayHit& rh) {
-  fillRtcRay(q, rh.ray);
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-}
-
 // The recorded rays through Embree's stream calls (rtcIntersect1M, rtcOccluded1M) in chunks of
 // 256, as envgi's by-bounce loop traces a round's bounce and shadow rays: plain Embree at its
 // best on these rays, for comparison with the one-ray loop below.
@@ -139,7 +124,7 @@ void tracePlainStreams(Fixture& f, tbb::task_arena& arena) {
       uint64_t h = 0;
       for (size_t i0 = r.begin(); i0 < r.end(); i0 += 256) {
         const size_t n = std::min<size_t>(256, r.end() - i0);
-        for (size_t k = 0; k < n; ++k) fillRtcRayHit(is[i0 + k], rh[k]);
+        for (size_t k = 0; k < n; ++k) EmbreeAccel::fillRayHit(is[i0 + k], rh[k]);
         rtcIntersect1M(scene, &ctx, rh.data(), unsigned(n), sizeof(RTCRayHit));
         for (size_t k = 0; k < n; ++k) h += rh[k].hit.geomID != RTC_INVALID_GEOMETRY_ID;
       }
@@ -151,7 +136,7 @@ void tracePlainStreams(Fixture& f, tbb::task_arena& arena) {
       std::vector<RTCRay> ray(256);
       for (size_t i0 = r.begin(); i0 < r.end(); i0 += 256) {
         const size_t n = std::min<size_t>(256, r.end() - i0);
-        for (size_t k = 0; k < n; ++k) fillRtcRay(os[i0 + k], ray[k]);
+        for (size_t k = 0; k < n; ++k) EmbreeAccel::fillRay(os[i0 + k], ray[k]);
         rtcOccluded1M(scene, &ctx, ray.data(), unsigned(n), sizeof(RTCRay));
       }
     });
@@ -173,7 +158,7 @@ void tracePlain(Fixture& f, tbb::task_arena& arena) {
       uint64_t h = 0;
       for (size_t i = r.begin(); i < r.end(); ++i) {
         RTCRayHit rh{};
-        fillRtcRayHit(is[i], rh);
+        EmbreeAccel::fillRayHit(is[i], rh);
         rtcIntersect1(scene, &ctx, &rh);
         h += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
       }
@@ -184,7 +169,7 @@ void tracePlain(Fixture& f, tbb::task_arena& arena) {
       rtcInitIntersectContext(&ctx);
       for (size_t i = r.begin(); i < r.end(); ++i) {
         RTCRay ray{};
-        fillRtcRay(os[i], ray);
+        EmbreeAccel::fillRay(os[i], ray);
         rtcOccluded1(scene, &ctx, &ray);
       }
     });

@@ -52,17 +52,9 @@ class EmbreeAccel {
     ctx.throughMasks = throughMasks;
     ctx.rays = &ray;
     RTCRayHit rh;
-    fillRay(ray, rh.ray);
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    fillRayHit(ray, rh);
     rtcIntersect1(scene_, &ctx.rtc, &rh);
-    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-    hit->t = rh.ray.tfar;
-    hit->geomId = geometryOf(rh.hit.geomID, rh.hit.instID[0]);
-    hit->primId = int(rh.hit.primID);
-    hit->u = rh.hit.u;
-    hit->v = rh.hit.v;
-    return true;
+    return hitOf(rh, hit);
   }
 
   // intersect() for n coherent rays (rays(i) the i-th, out(i, found, hit) its answer) in
@@ -120,22 +112,13 @@ class EmbreeAccel {
     streamChunks(
         n, rays, given,
         [&](int k, const Ray& r) {
-          fillRay(r, rh[k].ray);
+          fillRayHit(r, rh[k]);
           rh[k].ray.id = unsigned(k);
-          rh[k].hit.geomID = RTC_INVALID_GEOMETRY_ID;
-          rh[k].hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
         },
         [&](int k) { rtcIntersect1M(scene_, &ctx.rtc, rh, unsigned(k), sizeof(RTCRayHit)); },
         [&](int i, int q) {
           Hit h;
-          const bool found = q >= 0 && rh[q].hit.geomID != RTC_INVALID_GEOMETRY_ID;  // -1: misses
-          if (found) {
-            h.t = rh[q].ray.tfar;
-            h.geomId = geometryOf(rh[q].hit.geomID, rh[q].hit.instID[0]);
-            h.primId = int(rh[q].hit.primID);
-            h.u = rh[q].hit.u;
-            h.v = rh[q].hit.v;
-          }
+          const bool found = q >= 0 && hitOf(rh[q], &h);  // -1: misses
           out(i, found, h);
         });
   }
@@ -169,6 +152,30 @@ class EmbreeAccel {
     fillRay(ray, r);
     rtcOccluded1(scene_, &ctx.rtc, &r);
     return r.tfar < 0.f;  // Embree sets tfar to -inf on a hit
+  }
+
+  // Embree's ray for envgi's, written in place field by field (the benchmarks' plain loops use
+  // it too: building one apart and copying it whole into a stream made Embree's loop over that
+  // stream 15-20% slower, docs/performance.md, stop 65).
+  static void fillRay(const Ray& ray, RTCRay& r) {
+    r.org_x = ray.o.x;
+    r.org_y = ray.o.y;
+    r.org_z = ray.o.z;
+    r.dir_x = ray.d.x;
+    r.dir_y = ray.d.y;
+    r.dir_z = ray.d.z;
+    r.tnear = 0.f;
+    r.tfar = ray.tMax;
+    r.mask = 0xFFFFFFFFu;
+    r.time = 0.f;
+    r.flags = 0;
+    r.id = 0;
+  }
+  // The same with its hit cleared, for an intersection.
+  static void fillRayHit(const Ray& ray, RTCRayHit& rh) {
+    fillRay(ray, rh.ray);
+    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   }
 
   // For tracing with Embree's own calls (the benchmarks' plain loop): a scene with masks needs an
@@ -220,19 +227,15 @@ class EmbreeAccel {
     }
   }
 
-  static void fillRay(const Ray& ray, RTCRay& r) {
-    r.org_x = ray.o.x;
-    r.org_y = ray.o.y;
-    r.org_z = ray.o.z;
-    r.dir_x = ray.d.x;
-    r.dir_y = ray.d.y;
-    r.dir_z = ray.d.z;
-    r.tnear = 0.f;
-    r.tfar = ray.tMax;
-    r.mask = 0xFFFFFFFFu;
-    r.time = 0.f;
-    r.flags = 0;
-    r.id = 0;
+  // An intersection's answer: false where it found nothing, else its hit in envgi's terms.
+  static bool hitOf(const RTCRayHit& rh, Hit* hit) {
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
+    hit->t = rh.ray.tfar;
+    hit->geomId = geometryOf(rh.hit.geomID, rh.hit.instID[0]);
+    hit->primId = int(rh.hit.primID);
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    return true;
   }
 
   static bool countBytes(void* accel, ssize_t bytes, bool) {

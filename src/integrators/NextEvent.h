@@ -64,6 +64,15 @@ ENVGI_HD inline Color resolvedLd(const LightSampleLd& ld, bool occluded) {
   return ld.needsRay && !occluded ? ld.value : Color(0.f);
 }
 
+// A bounce's BSDF draw as path and direct take it: uc only where bsdfSample reads it beside ub
+// (skipped, not drawn, elsewhere, so later draws keep their dimensions), and the lobe from ub
+// where the BSDF can take it from there (bsdfLobeFromU).
+ENVGI_HD inline bool drawBsdfSample(const Bsdf& bsdf, Vec3f woLocal, Sampler& smp, BsdfSample* bs) {
+  float uc = smp.get1DIf(bsdfReadsUcBesideU(bsdf));
+  Vec2f ub = smp.get2D();
+  return bsdfSample(bsdf, woLocal, uc, ub, bs, true);
+}
+
 // Traces the sample's shadow ray, if it has one (counted in *rayCount): whether it is blocked.
 template <class Tracer>
 ENVGI_HD bool shadowRayBlocked(const Tracer& tracer, const LightSampleLd& ld, uint64_t* rayCount) {

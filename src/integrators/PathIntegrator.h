@@ -87,9 +87,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, partner), st);
 
   BsdfSample bs;
-  float uc = smp.get1DIf(bsdfReadsUcBesideU(bsdf));  // skipped where ub picks the lobe or there is one
-  Vec2f ub = smp.get2D();
-  if (!bsdfSample(bsdf, woLocal, uc, ub, &bs, true)) return false;
+  if (!drawBsdfSample(bsdf, woLocal, smp, &bs)) return false;
   if (partner) bsdfMixReweight(*partner, si.partnerWeight, woLocal, &bs);
   Vec3f wi = si.shading.toWorld(bs.wi);
   st->beta *= bs.weight;
