@@ -48,6 +48,15 @@ ENVGI_INLINE float insidePixel(int p, float r, int n) {
   return f;
 }
 
+// sample()'s chain of dependent loads walked one level at a time across a batch of draws
+// (CPU only): each level's address comes from the one before, so a batch that asks every draw
+// for a level before reading any of them overlaps the misses that sample() takes in a row.
+struct ProductDrawAhead {
+  int k = -1, c = -1;  // the bucket; the cell, once known
+  int lo = 0, hi = 0;  // the guide's bracket at the level being asked for
+  Vec2f u;
+};
+
 struct CosineProductView {
   const float* bucketCdf = nullptr;   // buckets x (cells + 1), over cell power times the cosine bound
   const float* bucketInt = nullptr;   // buckets: the mean cell power times the bound (0: no light)
@@ -121,6 +130,49 @@ struct CosineProductView {
     *uv = {insidePixel(px, r1, width), insidePixel(py, r2, height)};
     *pdfOut = densityOfSteps(w1, w2);  // pdfUV(k, c, j), from the values at hand
     return *pdfOut > 0.f;
+  }
+
+  // The levels of sample(u, nLocal)'s loads, asked for in order: level 0 the bucket's guide
+  // entry, 1 its cdf bracket, 2 the cell's guide entry, 3 the cell's cdf bracket; level 4
+  // returns the pixel sample() will draw (false where it draws none).
+  void aheadLevel0(Vec2f u, Vec3f nLocal, ProductDrawAhead* a) const {
+    a->u = u;
+    a->k = bucket(nLocal);
+    if (!(bucketInt[a->k] > 0.f)) { a->k = -1; return; }
+    prefetchLine(bucketGuide + size_t(a->k) * (bucketGuideSize + 1) + guideSlot(u.x, bucketGuideSize));
+  }
+  void aheadLevel1(ProductDrawAhead* a) const {
+    if (a->k < 0) return;
+    const int* g = bucketGuide + size_t(a->k) * (bucketGuideSize + 1) + guideSlot(a->u.x, bucketGuideSize);
+    const float* cdf = bucketCdf + size_t(a->k) * (cells() + 1);
+    a->lo = g[0], a->hi = g[1];
+    prefetchLine(cdf + a->lo);
+    prefetchLine(cdf + a->hi);
+  }
+  void aheadLevel2(ProductDrawAhead* a) const {
+    if (a->k < 0) return;
+    const float* cdf = bucketCdf + size_t(a->k) * (cells() + 1);
+    a->c = findIntervalBetweenNoBranch(cdf, a->lo, a->hi, a->u.x);
+    prefetchLine(cellGuide + size_t(a->c) * (cellGuideSize + 1) + guideSlot(a->u.y, cellGuideSize));
+    prefetchLine(cellCdfStart + a->c);
+  }
+  void aheadLevel3(ProductDrawAhead* a) const {
+    if (a->k < 0) return;
+    const int* g = cellGuide + size_t(a->c) * (cellGuideSize + 1) + guideSlot(a->u.y, cellGuideSize);
+    const float* pc = cellCdf + cellCdfStart[a->c];
+    a->lo = g[0], a->hi = g[1];
+    prefetchLine(pc + a->lo);
+    prefetchLine(pc + a->hi);
+  }
+  bool aheadLevel4(const ProductDrawAhead& a, int* px, int* py) const {
+    if (a.k < 0) return false;
+    const float* pc = cellCdf + cellCdfStart[a.c];
+    int j = findIntervalBetweenNoBranch(pc, a.lo, a.hi, a.u.y);
+    int cy = a.c / cellsX, cx = a.c - cy * cellsX;
+    int x0 = cellStartX[cx], cw = cellStartX[cx + 1] - x0;
+    int jy = j / cw;
+    *px = x0 + (j - jy * cw), *py = cellStartY[cy] + jy;
+    return true;
   }
 
   // Where pdf() reads for (uv, nLocal): the bucket, the cell and the pixel inside the cell.

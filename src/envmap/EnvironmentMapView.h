@@ -270,6 +270,18 @@ struct EnvironmentMapView {
     if (strategyFor(s, normal) == EnvStrategy::Product) product.prefetchPdf(uv, toLocalUnnormalized(normal));
   }
 
+  // Asks for the texel rows that drawing inside pixel (px, py) reads (warpInPixel's lattice,
+  // the lookup) and its warp bit (CPU only).
+  void prefetchPixel(int px, int py) const {
+    int xs[3], ys[3];
+    neighbourhood(px, py, xs, ys);
+    for (int j = 0; j < 3; ++j) {
+      prefetchLine(texels + (size_t(ys[j]) * width + xs[0]) * 4);
+      prefetchLine(texels + (size_t(ys[j]) * width + xs[2]) * 4);
+    }
+    if (warpBits) prefetchLine(warpBits + ((size_t(py) * size_t(width) + size_t(px)) >> 5));
+  }
+
   ENVGI_HD float importancePdfUV(Vec2f uv) const { return solidAnglePdf(dist.pdf(uv), uv.y); }
 
   // The strategy that draws for this normal: a zero normal (a BSDF that also transmits) means

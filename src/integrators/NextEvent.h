@@ -25,14 +25,19 @@ struct LightSampleLd {
 // `partner` is a blend's other material (sc.partnerAt(si)), evaluated beside bsdf at
 // si.partnerWeight (materials/BsdfMix.h). The kind of light is picked by uL.x (sampleLight), so
 // the dimension a choice of its own once took is skipped, as is the area light's second pair
-// where the map is the only light (the image stays the same there).
+// where the map is the only light (the image stays the same there). uLDrawn: the light's 2D
+// draw where the caller took it ahead from a copy of smp (lightDrawOf), stepped over here.
 ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
                                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
-                                        Sampler& smp, const Bsdf* partner = nullptr) {
+                                        Sampler& smp, const Bsdf* partner = nullptr,
+                                        const Vec2f* uLDrawn = nullptr) {
   LightSampleLd out;
   const bool mapOnly = sc.envSelectProb() == 1.f;  // sampleLight then takes the map for any uL
   smp.skip1D();
-  Vec2f uL = smp.get2D(), uL2 = smp.get2DIf(!mapOnly);
+  Vec2f uL;
+  if (uLDrawn) uL = *uLDrawn, smp.skip2D();
+  else uL = smp.get2D();
+  Vec2f uL2 = smp.get2DIf(!mapOnly);
   LightSample ls;
   if (bsdfMixIsDelta(bsdf, partner) || !sampleLight(sc, si, axis, strategy, uL, uL2, &ls)) return out;
   Vec3f wiLocal = si.shading.toLocal(ls.dir);
@@ -57,6 +62,13 @@ ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceIntera
   out.value = f * ls.radiance * (w / (ls.pdf * nE));
   out.needsRay = true;
   return out;
+}
+
+// The light's 2D draw prepareLd will take from smp as it stands, taken from a copy.
+ENVGI_HD inline Vec2f lightDrawOf(const Sampler& smp) {
+  Sampler peek = smp;
+  peek.skip1D();
+  return peek.get2D();
 }
 
 // The sample's contribution once its shadow ray's answer is known.

@@ -34,6 +34,15 @@ ENVGI_HD inline PathState pathBegin(const Ray& ray) {
   return {ray, Color(0.f), Color(1.f), 1.f, 0.f, true, ray.o, Vec3f(0.f, 0.f, 1.f), 1};
 }
 
+// What an executor works out for a hit before shading it (CPU: renderTileByBounce, which walks
+// a round's map draws level by level first): the interaction, and the light's 2D draw where
+// the path goes on to next-event estimation. pathShade then takes them instead of redoing them.
+struct ShadeAhead {
+  SurfaceInteraction si;
+  Vec2f uL;
+  bool drawn = false;  // uL holds prepareLd's draw
+};
+
 // Next-event estimation's shadow ray traced at once, its contribution added to the path
 // (pathStep's way; an executor that traces many paths' shadow rays together keeps ld and the
 // path's beta instead, and adds beta * resolvedLd(ld, blocked) before the path goes on).
@@ -50,9 +59,10 @@ struct ShadowRayNow {
 // what it sees to st->L, hand next-event estimation's sample to shadow (ShadowRayNow or an
 // executor's batch), sample the BSDF for the next ray. Returns false once the path has ended.
 // Apart from pathStep, so that an executor can trace many paths' rays together, then shade them.
+// ahead: pathShadeAhead's work for this hit, or none.
 template <class Shadow>
 ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hit& h, Sampler& smp,
-                        const PathParams& pp, const Shadow& shadow) {
+                        const PathParams& pp, const Shadow& shadow, const ShadeAhead* ahead = nullptr) {
   const int depth = st->depth;
   const Ray& ray = st->ray;
   if (!found) {
@@ -65,7 +75,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
     }
     return false;
   }
-  SurfaceInteraction si = sc.interaction(ray, h);
+  const SurfaceInteraction si = ahead ? ahead->si : sc.interaction(ray, h);
   Vec3f wo = -ray.d;
   if (si.light >= 0 && !(depth == 1 && pp.hideEmitters)) {
     Color Le = sc.emitted(si, wo);
@@ -84,7 +94,8 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   Vec3f axis = envSamplingAxis(si, wo, bsdf);
 
   // Next-event estimation, weighted against this bounce's BSDF sample.
-  shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, partner), st);
+  shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, partner,
+                   ahead && ahead->drawn ? &ahead->uL : nullptr), st);
 
   BsdfSample bs;
   if (!drawBsdfSample(bsdf, woLocal, smp, &bs)) return false;
@@ -109,6 +120,28 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
 inline void pathPrefetchEscape(const SceneView& sc, const PathState& st, const PathParams& pp) {
   if (sc.hasEnvironment && !st.prevDelta && envSeenByBsdfSampling(pp.envStrategy, false))
     sc.env.prefetchEvalWithPdf(pp.envStrategy, st.ray.d, st.prevAxis);
+}
+
+// pathShade's first steps for a path whose ray hit, done ahead into *ahead (CPU only): its
+// interaction and, where it goes on to next-event estimation, its light draw. Where that draw
+// is the product's, *draw gets the first level of its loads (CosineProductView::aheadLevel0)
+// and it returns true.
+inline bool pathShadeAhead(const SceneView& sc, const PathState& st, const Hit& h, const Sampler& smp,
+                           const PathParams& pp, ShadeAhead* ahead, ProductDrawAhead* draw) {
+  ahead->si = sc.interaction(st.ray, h);
+  ahead->drawn = !(pp.maxDepth >= 0 && st.depth >= pp.maxDepth);
+  if (!ahead->drawn) return false;
+  ahead->uL = lightDrawOf(smp);
+  // The material's own entry, untextured: its type is all that is asked of it here.
+  const Bsdf& bsdf = sc.bsdfs[ahead->si.bsdf];
+  Vec2f u = ahead->uL;
+  const float pe = sc.envSelectProb();
+  if (!sc.hasEnvironment || bsdfIsDelta(bsdf) || !(u.x < pe)) return false;
+  const Vec3f axis = envSamplingAxis(ahead->si, -st.ray.d, bsdf);
+  if (sc.env.strategyFor(pp.envStrategy, axis) != EnvStrategy::Product) return false;
+  if (pe < 1.f) u.x = stretchedDraw(u.x, 0.f, pe);
+  sc.env.product.aheadLevel0(u, sc.env.toLocalUnnormalized(axis), draw);
+  return draw->k >= 0;
 }
 
 // One bounce of the path: trace st->ray, then pathShade.

@@ -47,11 +47,17 @@ struct SampleIntegrator {
   // (renderTileByBounce): only path runs this way, since direct traces inside its one step.
   ENVGI_HD bool shadesAfterTrace() const { return type == SampleIntegratorType::Path; }
   template <class Shadow>
-  ENVGI_HD bool shade(PathState* st, bool found, const Hit& h, Sampler& smp, const Shadow& shadow) const {
-    return pathShade(*scene, st, found, h, smp, path, shadow);
+  ENVGI_HD bool shade(PathState* st, bool found, const Hit& h, Sampler& smp, const Shadow& shadow,
+                      const ShadeAhead* ahead = nullptr) const {
+    return pathShade(*scene, st, found, h, smp, path, shadow, ahead);
   }
   // What shade() will read for a path whose ray escaped, asked for ahead (CPU only).
   void prefetchEscape(const PathState& st) const { pathPrefetchEscape(*scene, st, path); }
+  // shade()'s first steps for a hit, done ahead (pathShadeAhead; CPU only).
+  bool shadeAhead(const PathState& st, const Hit& h, const Sampler& smp, ShadeAhead* ahead,
+                  ProductDrawAhead* draw) const {
+    return pathShadeAhead(*scene, st, h, smp, path, ahead, draw);
+  }
 };
 
 // Integrators that run one bounce a call, so regeneratePaths and renderTileByBounce can drive
@@ -191,11 +197,15 @@ struct TileBatch {
   std::vector<Color> acc;
   std::vector<double> accSq;
   std::vector<float> accW;
+  std::vector<ShadeAhead> ahead;        // each hit's interaction and light draw, worked out ahead
+  std::vector<ProductDrawAhead> draw;   // the round's product draws, walked level by level
+  std::vector<int> drawing;             // the round's paths with such a draw
   void resize(size_t n) {
     if (state.size() >= n) return;
     state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), blocked.resize(n);
     active.resize(n), shadow.resize(n);
     ld.resize(n), ldBeta.resize(n), weight.resize(n), acc.resize(n), accSq.resize(n), accW.resize(n);
+    ahead.resize(n), draw.resize(n), drawing.resize(n);
   }
 };
 
@@ -284,10 +294,28 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       if (!cameraRays)
         for (int i = 0; i < live; ++i)
           if (!b->found[b->active[i]]) integ.prefetchEscape(b->state[b->active[i]]);
+      // Each hit's interaction and light draw, then the product draws' dependent loads a level
+      // at a time across the round (CosineProductView::aheadLevel0-4), then the texels of the
+      // pixels they land in: shading then finds them in cache.
+      int draws = 0;
+      for (int i = 0; i < live; ++i) {
+        const int k = b->active[i];
+        if (b->found[k] && integ.shadeAhead(b->state[k], b->hit[k], b->sampler[k], &b->ahead[k], &b->draw[k]))
+          b->drawing[draws++] = k;
+      }
+      const EnvironmentMapView& env = integ.scene->env;
+      for (int i = 0; i < draws; ++i) env.product.aheadLevel1(&b->draw[b->drawing[i]]);
+      for (int i = 0; i < draws; ++i) env.product.aheadLevel2(&b->draw[b->drawing[i]]);
+      for (int i = 0; i < draws; ++i) env.product.aheadLevel3(&b->draw[b->drawing[i]]);
+      for (int i = 0; i < draws; ++i) {
+        int px, py;
+        if (env.product.aheadLevel4(b->draw[b->drawing[i]], &px, &py)) env.prefetchPixel(px, py);
+      }
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];
         b->ld[k].needsRay = false;
-        b->going[k] = integ.shade(&b->state[k], b->found[k] != 0, b->hit[k], b->sampler[k], ShadowRayLater{b});
+        b->going[k] = integ.shade(&b->state[k], b->found[k] != 0, b->hit[k], b->sampler[k], ShadowRayLater{b},
+                                  b->found[k] ? &b->ahead[k] : nullptr);
       }
       int shadows = 0;
       for (int i = 0; i < live; ++i)

@@ -39,9 +39,13 @@ ENVGI_INLINE int findInterval(const float* cdf, int size, float u) { return find
 // u = g / G, g in [0, G], with G a power of two so that g / G and u * G are exact in float.
 // The index is non-decreasing in u, so the answer for u lies in [guide[g], guide[g + 1]] with
 // g = floor(u G): the same index as the plain search, from a few loads instead of log2(size).
-ENVGI_INLINE int findIntervalGuided(const float* cdf, float u, const int* guide, int G) {
+// guideSlot(u, G) is that g.
+ENVGI_INLINE int guideSlot(float u, int G) {
   int g = int(u * float(G));
-  g = g < 0 ? 0 : (g > G - 1 ? G - 1 : g);
+  return g < 0 ? 0 : (g > G - 1 ? G - 1 : g);
+}
+ENVGI_INLINE int findIntervalGuided(const float* cdf, float u, const int* guide, int G) {
+  const int g = guideSlot(u, G);
   return findIntervalBetweenNoBranch(cdf, guide[g], guide[g + 1], u);
 }
 

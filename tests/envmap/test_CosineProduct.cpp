@@ -249,3 +249,40 @@ TEST(CosineProduct, PrefetchingAnEscapeReadsInsideTheTables) {
         }
       }
 }
+
+// The draw walked a level at a time across a batch (renderTileByBounce's prefetching) reaches
+// the pixel sample() draws for the same u and normal, in odd-sized maps too; it gives up only
+// where sample() draws nothing (a bucket that sees no light).
+TEST(CosineProduct, ADrawWalkedLevelByLevelReachesTheDrawnPixel) {
+  Image below(64, 32);  // lit from below the horizon only
+  for (int y = 0; y < 32; ++y)
+    for (int x = 0; x < 64; ++x) below.set(x, y, Color(y < 16 ? 0.f : 1.f));
+  const Image maps[] = {skyWithSun(96, 48), skyWithSun(101, 47), below};
+  for (const Image& img : maps) {
+    EnvironmentMap env(img, {});
+    const CosineProductView& p = env.view().product;
+    ASSERT_TRUE(p.valid());
+    Pcg32 rng(31);
+    int reached = 0;
+    for (int i = 0; i < 20000; ++i) {
+      const Vec3f nl = sampleUniformSphere(Vec2f(rng.nextFloat(), rng.nextFloat()));
+      const Vec2f u(rng.nextFloat(), rng.nextFloat());
+      ProductDrawAhead a;
+      p.aheadLevel0(u, nl, &a);
+      p.aheadLevel1(&a);
+      p.aheadLevel2(&a);
+      p.aheadLevel3(&a);
+      int px = -1, py = -1;
+      const bool walked = p.aheadLevel4(a, &px, &py);
+      Vec2f uv;
+      float pdf;
+      const bool drawn = p.sample(u, nl, &uv, &pdf);
+      ASSERT_TRUE(walked || !drawn) << i;
+      if (!drawn) continue;
+      ++reached;
+      ASSERT_EQ(px, std::min(int(uv.x * float(img.width)), img.width - 1)) << i;
+      ASSERT_EQ(py, std::min(int(uv.y * float(img.height)), img.height - 1)) << i;
+    }
+    EXPECT_GT(reached, 9000) << img.width << " x " << img.height;
+  }
+}

@@ -1,0 +1,94 @@
+// pathShade given its first steps done ahead (pathShadeAhead: the interaction and the light's
+// 2D draw, which renderTileByBounce works out for a whole round before shading it) against
+// pathShade doing them itself: the same light sample, the same next ray and the same sampler
+// position, to the bit, at every bounce, on scenes that take each branch (the product's draw,
+// an area light's share, glass, a blend's partner, a textured material).
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "accel/Bvh.h"
+#include "integrators/PathIntegrator.h"
+#include "render/Renderer.h"
+#include "scene/SceneLoader.h"
+
+using namespace envgi;
+
+namespace {
+
+struct KeepLd {
+  LightSampleLd* out;
+  ENVGI_HD void operator()(const LightSampleLd& ld, PathState*) const { *out = ld; }
+};
+
+void expectSameLd(const LightSampleLd& a, const LightSampleLd& b, const std::string& where) {
+  ASSERT_EQ(a.needsRay, b.needsRay) << where;
+  if (!a.needsRay) return;
+  for (int c = 0; c < 3; ++c) {
+    ASSERT_EQ(a.value[c], b.value[c]) << where;
+    ASSERT_EQ(a.o[c], b.o[c]) << where;
+    ASSERT_EQ(a.d[c], b.d[c]) << where;
+  }
+  ASSERT_EQ(a.tMax, b.tMax) << where;
+}
+
+}  // namespace
+
+TEST(PathIntegrator, ShadingWithItsFirstStepsDoneAheadIsTheSame) {
+  for (std::string name : {"buddha", "cornell-box", "teapot-glass", "blend", "textured", "bunny-sunrise"}) {
+    Scene scene;
+    loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/" + name + ".xml", {{"res", "16"}}, scene);
+    scene.camera.width = scene.camera.height = 16;
+    scene.integrator.type = IntegratorType::Path;
+    scene.finalize();
+    RenderOptions o;
+    o.spp = 4;
+    const KernelSettings k = kernelSettings(scene, o);
+    Bvh bvh(scene);
+    BvhTracer tracer{bvh.view()};
+    const SceneView& sc = scene.view();
+    int shaded = 0, productDraws = 0;
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x)
+        for (int s = 0; s < 4; ++s) {
+          Sampler smp = sequenceSampler(k.sequence);
+          float w;
+          PathState st = pathBegin(startCameraSample(sc.camera, smp, x, y, s, &w));
+          for (bool going = true; going;) {
+            Hit h;
+            const bool found = tracer.intersect(st.ray, &h);
+            PathState a = st, b = st;
+            Sampler sa = smp, sb = smp;
+            LightSampleLd lda, ldb;
+            const bool ga = pathShade(sc, &a, found, h, sa, k.path, KeepLd{&lda});
+            ShadeAhead ahead;
+            ProductDrawAhead draw;
+            const ShadeAhead* pre = nullptr;
+            if (found) {
+              productDraws += pathShadeAhead(sc, st, h, smp, k.path, &ahead, &draw);
+              pre = &ahead;
+            }
+            const bool gb = pathShade(sc, &b, found, h, sb, k.path, KeepLd{&ldb}, pre);
+            const std::string where = name + " pixel " + std::to_string(x) + "," + std::to_string(y) + " depth " +
+                                      std::to_string(st.depth);
+            ASSERT_EQ(ga, gb) << where;
+            ASSERT_EQ(sa.dim, sb.dim) << where;
+            expectSameLd(lda, ldb, where);
+            for (int c = 0; c < 3; ++c) {
+              ASSERT_EQ(a.L[c], b.L[c]) << where;
+              ASSERT_EQ(a.beta[c], b.beta[c]) << where;
+              ASSERT_EQ(a.ray.o[c], b.ray.o[c]) << where;
+              ASSERT_EQ(a.ray.d[c], b.ray.d[c]) << where;
+            }
+            ASSERT_EQ(a.prevPdf, b.prevPdf) << where;
+            ASSERT_EQ(a.depth, b.depth) << where;
+            shaded += found;
+            st = a, smp = sa, going = ga;
+          }
+        }
+    EXPECT_GT(shaded, 100) << name;
+    if (name == "buddha") {
+      EXPECT_GT(productDraws, 100) << "buddha's map is drawn by the product strategy";
+    }
+  }
+}
