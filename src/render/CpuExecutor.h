@@ -1,5 +1,6 @@
 // Runs render passes on the CPU: oneTBB over image tiles, each tile a bounce at a time
-// (renderTileByBounce) for the path tracer, each pixel through renderPixel for the others; both
+// (renderTileByBounce) for the path tracer and for direct with one light and one BSDF sample
+// (a one-bounce path), each pixel through renderPixel for the others; both
 // run the integrator bodies the CUDA kernels run. Deterministic whatever the thread count (no
 // shared sums), and the same sums either way up to Embree's packets' rounding of camera hits.
 #pragma once

@@ -20,6 +20,21 @@ struct SampleSequence {
 
 enum class SampleIntegratorType : int { Path = 0, Direct = 1 };
 
+// direct with one light sample and one BSDF sample (the paper's figures' setting) is a path of
+// two segments without roulette: the same draws in the same order and the same MIS weights
+// (Eq. 6 with nE = nB = 1), so an executor may shade it a bounce at a time as that path.
+ENVGI_HD inline bool directIsOneBouncePath(const DirectParams& dp) {
+  return dp.emitterSamples == 1 && dp.bsdfSamples == 1;
+}
+ENVGI_HD inline PathParams directAsPath(const DirectParams& dp) {
+  PathParams p;
+  p.maxDepth = 2;
+  p.rrDepth = 2;  // roulette from depth 2 on, where the path has already ended
+  p.hideEmitters = dp.hideEmitters;
+  p.envStrategy = dp.envStrategy;
+  return p;
+}
+
 // path or direct over any tracer; the integrators themselves are the shared templates.
 template <class Tracer>
 struct SampleIntegrator {
@@ -44,19 +59,24 @@ struct SampleIntegrator {
     return pathStep(*scene, tracer, st, smp, path, rays);
   }
   // step() with the trace taken out, for an executor that traces many paths' rays together
-  // (renderTileByBounce): only path runs this way, since direct traces inside its one step.
-  ENVGI_HD bool shadesAfterTrace() const { return type == SampleIntegratorType::Path; }
+  // (renderTileByBounce): path, and direct where it is a one-bounce path (directAsPath);
+  // direct with other sample counts traces inside its one step.
+  ENVGI_HD bool shadesAfterTrace() const {
+    return type == SampleIntegratorType::Path || directIsOneBouncePath(direct);
+  }
+  // The path that shade() follows: path's own, or direct's as a one-bounce path.
+  ENVGI_HD PathParams shadedPath() const { return type == SampleIntegratorType::Path ? path : directAsPath(direct); }
   template <class Shadow>
   ENVGI_HD bool shade(PathState* st, bool found, const Hit& h, Sampler& smp, const Shadow& shadow,
                       const ShadeAhead* ahead = nullptr) const {
-    return pathShade(*scene, st, found, h, smp, path, shadow, ahead);
+    return pathShade(*scene, st, found, h, smp, shadedPath(), shadow, ahead);
   }
   // What shade() will read for a path whose ray escaped, asked for ahead (CPU only).
-  void prefetchEscape(const PathState& st) const { pathPrefetchEscape(*scene, st, path); }
+  void prefetchEscape(const PathState& st) const { pathPrefetchEscape(*scene, st, shadedPath()); }
   // shade()'s first steps for a hit, done ahead (pathShadeAhead; CPU only).
   bool shadeAhead(const PathState& st, const Hit& h, const Sampler& smp, ShadeAhead* ahead,
                   ProductDrawAhead* draw) const {
-    return pathShadeAhead(*scene, st, h, smp, path, ahead, draw);
+    return pathShadeAhead(*scene, st, h, smp, shadedPath(), ahead, draw);
   }
 };
 
