@@ -16,6 +16,10 @@ struct PathParams {
   int rrDepth = kRouletteDepth;
   bool hideEmitters = false;
   EnvStrategy envStrategy = EnvStrategy::Product;
+  // direct's sample counts as a path (directAsPath): without a light sample no next-event
+  // draw is made and what the BSDF sample finds takes weight 1; without a BSDF sample the path
+  // ends after next-event estimation, whose weight is then 1. path itself takes both.
+  bool lightSample = true, bsdfSample = true;
 };
 
 // A path between bounces: what pathStep carries from one bounce to the next. Plain data, so a
@@ -70,7 +74,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
       float lightPdf = 0.f;
       Color Le = st->prevDelta ? sc.env.eval(ray.d)
                                : envRadianceAndPdf(sc, pp.envStrategy, ray.d, st->prevAxis, &lightPdf);
-      float w = st->prevDelta ? 1.f : powerHeuristic(1.f, st->prevPdf, 1.f, lightPdf);
+      float w = st->prevDelta || !pp.lightSample ? 1.f : powerHeuristic(1.f, st->prevPdf, 1.f, lightPdf);
       st->L += st->beta * Le * w;
     }
     return false;
@@ -80,8 +84,9 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   if (si.light >= 0 && !(depth == 1 && pp.hideEmitters)) {
     Color Le = sc.emitted(si, wo);
     if (!isBlack(Le)) {
-      float w = st->prevDelta ? 1.f
-                              : powerHeuristic(1.f, st->prevPdf, 1.f, areaLightPdf(sc, si.light, st->prevP, si.p, si.ng));
+      float w = st->prevDelta || !pp.lightSample
+                    ? 1.f
+                    : powerHeuristic(1.f, st->prevPdf, 1.f, areaLightPdf(sc, si.light, st->prevP, si.p, si.ng));
       st->L += st->beta * Le * w;
     }
   }
@@ -94,8 +99,11 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   Vec3f axis = envSamplingAxis(si, wo, bsdf);
 
   // Next-event estimation, weighted against this bounce's BSDF sample.
-  shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, 1.f, smp, partner,
-                   ahead && ahead->drawn ? &ahead->uL : nullptr), st);
+  if (pp.lightSample)
+    shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, pp.bsdfSample ? 1.f : 0.f, smp, partner,
+                     ahead && ahead->drawn ? &ahead->uL : nullptr),
+           st);
+  if (!pp.bsdfSample) return false;
 
   BsdfSample bs;
   if (!drawBsdfSample(bsdf, woLocal, smp, &bs)) return false;
@@ -129,7 +137,7 @@ inline void pathPrefetchEscape(const SceneView& sc, const PathState& st, const P
 inline bool pathShadeAhead(const SceneView& sc, const PathState& st, const Hit& h, const Sampler& smp,
                            const PathParams& pp, ShadeAhead* ahead, ProductDrawAhead* draw) {
   ahead->si = sc.interaction(st.ray, h);
-  ahead->drawn = !(pp.maxDepth >= 0 && st.depth >= pp.maxDepth);
+  ahead->drawn = pp.lightSample && !(pp.maxDepth >= 0 && st.depth >= pp.maxDepth);
   if (!ahead->drawn) return false;
   ahead->uL = lightDrawOf(smp);
   // The material's own entry, untextured: its type is all that is asked of it here.

@@ -1,6 +1,6 @@
 // Runs render passes on the CPU: oneTBB over image tiles, each tile a bounce at a time
-// (renderTileByBounce) for the path tracer and for direct with one light and one BSDF sample
-// (a one-bounce path), each pixel through renderPixel for the others; both
+// (renderTileByBounce) for the path tracer and for direct with at most one light and one BSDF
+// sample (a one-bounce path), each pixel through renderPixel for the others; both
 // run the integrator bodies the CUDA kernels run. Deterministic whatever the thread count (no
 // shared sums), and the same sums either way up to Embree's packets' rounding of camera hits.
 #pragma once
@@ -42,7 +42,10 @@ class CpuExecutor final : public PassExecutor {
     }
   }
 
-  std::string deviceName() const override { return byBounce_ ? name_ + " (by bounce)" : name_; }
+  // The device alone: the study's results and report group runs by it, whichever body ran.
+  std::string deviceName() const override { return name_; }
+  // Whether passes run a tile a bounce at a time (renderTileByBounce) rather than per pixel.
+  bool runsByBounce() const { return byBounce_; }
 
   void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
     int W = cam_.width, H = cam_.height;

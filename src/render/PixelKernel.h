@@ -20,11 +20,13 @@ struct SampleSequence {
 
 enum class SampleIntegratorType : int { Path = 0, Direct = 1 };
 
-// direct with one light sample and one BSDF sample (the paper's figures' setting) is a path of
-// two segments without roulette: the same draws in the same order and the same MIS weights
-// (Eq. 6 with nE = nB = 1), so an executor may shade it a bounce at a time as that path.
+// direct with at most one light sample and one BSDF sample (the paper's figures' settings,
+// the study's strategies) is a path of at most two segments without roulette: the same draws
+// in the same order and the same MIS weights (Eq. 6 with nE, nB in {0, 1}; weight 1 where one
+// count is 0), so an executor may shade it a bounce at a time as that path.
 ENVGI_HD inline bool directIsOneBouncePath(const DirectParams& dp) {
-  return dp.emitterSamples == 1 && dp.bsdfSamples == 1;
+  return dp.emitterSamples >= 0 && dp.emitterSamples <= 1 && dp.bsdfSamples >= 0 && dp.bsdfSamples <= 1 &&
+         dp.emitterSamples + dp.bsdfSamples > 0;
 }
 ENVGI_HD inline PathParams directAsPath(const DirectParams& dp) {
   PathParams p;
@@ -32,6 +34,8 @@ ENVGI_HD inline PathParams directAsPath(const DirectParams& dp) {
   p.rrDepth = 2;  // roulette from depth 2 on, where the path has already ended
   p.hideEmitters = dp.hideEmitters;
   p.envStrategy = dp.envStrategy;
+  p.lightSample = dp.emitterSamples > 0;
+  p.bsdfSample = dp.bsdfSamples > 0;
   return p;
 }
 
@@ -60,7 +64,7 @@ struct SampleIntegrator {
   }
   // step() with the trace taken out, for an executor that traces many paths' rays together
   // (renderTileByBounce): path, and direct where it is a one-bounce path (directAsPath);
-  // direct with other sample counts traces inside its one step.
+  // direct with more samples traces several rays inside its one step.
   ENVGI_HD bool shadesAfterTrace() const {
     return type == SampleIntegratorType::Path || directIsOneBouncePath(direct);
   }

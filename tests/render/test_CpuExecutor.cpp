@@ -6,11 +6,14 @@
 #include <atomic>
 #include <chrono>
 #include <thread>
+#include <tuple>
 #if defined(__SANITIZE_ADDRESS__)
 #include <sanitizer/lsan_interface.h>
 #endif
 
 #include "accel/Bvh.h"
+#include "accel/EmbreeAccel.h"
+#include "render/CpuExecutor.h"
 #include "render/Progress.h"
 #include "scene/SceneLoader.h"
 #include "support/RegionZTest.h"
@@ -168,7 +171,8 @@ TEST(CpuExecutor, ALeakCheckDuringARenderFindsNothing) {
   o.spp = 4;
   o.threads = 2;
   PreparedRender pr = prepareRender(s, accel, o);
-  ASSERT_NE(pr.executor->deviceName().find("by bounce"), std::string::npos) << "the path that keeps tile batches";
+  auto* cpu = dynamic_cast<CpuExecutor<SampleIntegrator<EmbreeTracer>>*>(pr.executor.get());
+  ASSERT_TRUE(cpu && cpu->runsByBounce()) << "the path that keeps tile batches";
   Progress quiet(1, false);
   PassCounters counters;
   pr.executor->runPass(0, 4, quiet, &counters);
@@ -242,4 +246,26 @@ TEST(CpuExecutor, CtrlCCutsAPassBetweenTiles) {
   ex.watchCancel(nullptr);
   ex.runPass(65, 66, quiet, &counters);
   EXPECT_EQ(ex.cutPass(), nullptr);
+}
+
+// The executor a render gets runs direct by bounce where it is a one-bounce path (at most one
+// light and one BSDF sample) and per pixel with more, and names the device alone either way.
+TEST(CpuExecutor, DirectRunsByBounceWithAtMostOneSampleOfEach) {
+  for (auto [nE, nB, byBounce] : {std::tuple{1, 1, true}, std::tuple{1, 0, true}, std::tuple{0, 1, true},
+                                  std::tuple{2, 1, false}, std::tuple{1, 3, false}}) {
+    Scene s;
+    loadSmall("buddha", IntegratorType::Direct, &s);
+    s.integrator.direct.emitterSamples = nE;
+    s.integrator.direct.bsdfSamples = nB;
+    s.finalize();
+    EmbreeAccel accel(s);
+    RenderOptions o;
+    o.progress = false;
+    o.spp = 2;
+    PreparedRender pr = prepareRender(s, accel, o);
+    auto* cpu = dynamic_cast<CpuExecutor<SampleIntegrator<EmbreeTracer>>*>(pr.executor.get());
+    ASSERT_NE(cpu, nullptr);
+    EXPECT_EQ(cpu->runsByBounce(), byBounce) << nE << " + " << nB;
+    EXPECT_EQ(cpu->deviceName(), "cpu");
+  }
 }

@@ -131,10 +131,48 @@ TEST(PixelKernel, DirectRunsByBounceWithOneSampleOfEach) {
   EXPECT_EQ(p.maxDepth, 2);
   EXPECT_EQ(p.envStrategy, integ.direct.envStrategy);
   EXPECT_GE(p.rrDepth, p.maxDepth) << "no roulette before the path ends";
-  for (auto [nE, nB] : {std::pair{2, 1}, std::pair{1, 0}, std::pair{0, 1}, std::pair{4, 4}}) {
+  EXPECT_TRUE(p.lightSample && p.bsdfSample);
+  for (auto [nE, nB] : {std::pair{1, 0}, std::pair{0, 1}}) {
+    integ.direct.emitterSamples = nE, integ.direct.bsdfSamples = nB;
+    EXPECT_TRUE(integ.shadesAfterTrace()) << nE << " " << nB;
+    EXPECT_EQ(integ.shadedPath().lightSample, nE == 1);
+    EXPECT_EQ(integ.shadedPath().bsdfSample, nB == 1);
+  }
+  for (auto [nE, nB] : {std::pair{2, 1}, std::pair{1, 2}, std::pair{2, 0}, std::pair{4, 4}}) {
     integ.direct.emitterSamples = nE, integ.direct.bsdfSamples = nB;
     EXPECT_FALSE(integ.shadesAfterTrace()) << nE << " " << nB;
   }
+}
+
+// The same sums as renderPixel's directTrace, to the bit over the GPU's BVH, with light samples
+// only (the study's uniform, adaptive, importance, points) and with BSDF samples only (bsdf).
+TEST(PixelKernel, DirectWithOneKindOfSampleByBounceAddsTheSameSamples) {
+  for (std::string name : {"buddha", "cornell-box", "sun-and-sky", "teapot-glass"})
+    for (auto [nE, nB] : {std::pair{1, 0}, std::pair{0, 1}}) {
+      SmallScene small(name, IntegratorType::Direct);
+      SampleIntegrator<BvhTracer> integ = small.integrator();
+      integ.direct.emitterSamples = nE, integ.direct.bsdfSamples = nB;
+      ASSERT_TRUE(integ.shadesAfterTrace());
+      const KernelSettings& k = small.k;
+      const Camera& cam = small.scene.view().camera;
+      const size_t npix = size_t(cam.width) * cam.height;
+      Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
+      PixelCounters ca, cb;
+      TileBatch batch;
+      for (int y = 0; y < cam.height; ++y)
+        for (int x = 0; x < cam.width; ++x) renderPixel(cam, k.sequence, integ, x, y, 0, 8, a.view(cam), &ca);
+      for (int y0 = 0; y0 < cam.height; y0 += 16)
+        for (int x0 = 0; x0 < cam.width; x0 += 16)
+          renderTileByBounce(cam, k.sequence, integ, x0, y0, std::min(x0 + 16, cam.width),
+                             std::min(y0 + 16, cam.height), 0, 8, b.view(cam), &batch, &cb);
+      const std::string what = name + " " + std::to_string(nE) + "+" + std::to_string(nB);
+      EXPECT_LE(cb.rays, ca.rays) << what;
+      EXPECT_GE(double(cb.rays), 0.99 * double(ca.rays)) << what;
+      EXPECT_EQ(std::memcmp(a.sum.data(), b.sum.data(), npix * sizeof(Color)), 0) << what;
+      double mean = 0.0;
+      for (const Color& c : a.sum) mean += c.x + c.y + c.z;
+      EXPECT_GT(mean, 0.0) << what << ": an image, not a black film";
+    }
 }
 
 // The same over Embree, whose camera rays go through 16-wide packets in 4 x 4 blocks of pixels
