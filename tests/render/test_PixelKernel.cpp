@@ -26,6 +26,19 @@ struct Film {
   FilmView view(const Camera& cam) { return {sum.data(), sumSq.data(), cam.width, cam.height}; }
 };
 
+// Samples [s0, s1) of every pixel twice: through renderPixel into a, and through
+// renderTileByBounce in tiles of 16 (partial at the right and bottom) into b.
+template <class Integrator>
+void renderBothWays(const Camera& cam, const SampleSequence& seq, const Integrator& integ, int s0, int s1, Film* a,
+                    Film* b, PixelCounters* ca, PixelCounters* cb, TileBatch* batch) {
+  for (int y = 0; y < cam.height; ++y)
+    for (int x = 0; x < cam.width; ++x) renderPixel(cam, seq, integ, x, y, s0, s1, a->view(cam), ca);
+  for (int y0 = 0; y0 < cam.height; y0 += 16)
+    for (int x0 = 0; x0 < cam.width; x0 += 16)
+      renderTileByBounce(cam, seq, integ, x0, y0, std::min(x0 + 16, cam.width), std::min(y0 + 16, cam.height), s0, s1,
+                         b->view(cam), batch, cb);
+}
+
 // A bundled scene at 24 x 24 pixels, 8 spp, with the GPU's BVH over it.
 struct SmallScene {
   Scene scene;
@@ -85,43 +98,38 @@ TEST(PixelKernel, RegeneratedPathsAddTheSameSamplesAsRenderPixel) {
 TEST(PixelKernel, TileByBounceAddsTheSameSamplesAsRenderPixel) {
   for (std::string name : {"teapot-glass", "buddha", "cornell-box", "bunny-sunrise", "sun-and-sky"})
     for (IntegratorType type : {IntegratorType::Path, IntegratorType::Direct}) {
-    SmallScene small(name, type);
-    const KernelSettings& k = small.k;
-    SampleIntegrator<BvhTracer> integ = small.integrator();
-    ASSERT_TRUE(integ.shadesAfterTrace());
-    const Camera& cam = small.scene.view().camera;
-    size_t npix = size_t(cam.width) * cam.height;
-    Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
-    PixelCounters ca, cb;
-    TileBatch batch;
-    for (auto [s0, s1] : {std::pair{0, 3}, std::pair{3, 8}}) {
-      for (int y = 0; y < cam.height; ++y)
-        for (int x = 0; x < cam.width; ++x) renderPixel(cam, k.sequence, integ, x, y, s0, s1, a.view(cam), &ca);
-      for (int y0 = 0; y0 < cam.height; y0 += 16)
-        for (int x0 = 0; x0 < cam.width; x0 += 16)
-          renderTileByBounce(cam, k.sequence, integ, x0, y0, std::min(x0 + 16, cam.width),
-                             std::min(y0 + 16, cam.height), s0, s1, b.view(cam), &batch, &cb);
-      if (type == IntegratorType::Path) {
-        EXPECT_EQ(ca.rays, cb.rays) << name;
-      } else {
-        // direct as a path leaves out the BSDF ray of a sample whose weight is zero (a black
-        // emitter's), which directTrace traces for nothing.
-        EXPECT_LE(cb.rays, ca.rays) << name;
-        EXPECT_GE(double(cb.rays), 0.99 * double(ca.rays)) << name;
+      SmallScene small(name, type);
+      const KernelSettings& k = small.k;
+      SampleIntegrator<BvhTracer> integ = small.integrator();
+      ASSERT_TRUE(integ.shadesAfterTrace());
+      const Camera& cam = small.scene.view().camera;
+      size_t npix = size_t(cam.width) * cam.height;
+      Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
+      PixelCounters ca, cb;
+      TileBatch batch;
+      for (auto [s0, s1] : {std::pair{0, 3}, std::pair{3, 8}}) {
+        renderBothWays(cam, k.sequence, integ, s0, s1, &a, &b, &ca, &cb, &batch);
+        if (type == IntegratorType::Path) {
+          EXPECT_EQ(ca.rays, cb.rays) << name;
+        } else {
+          // direct as a path leaves out the BSDF ray of a sample whose weight is zero (a black
+          // emitter's), which directTrace traces for nothing.
+          EXPECT_LE(cb.rays, ca.rays) << name;
+          EXPECT_GE(double(cb.rays), 0.99 * double(ca.rays)) << name;
+        }
+        EXPECT_EQ(ca.dropped, cb.dropped) << name;
+        EXPECT_EQ(std::memcmp(a.sum.data(), b.sum.data(), npix * sizeof(Color)), 0) << name << " pass " << s0;
+        EXPECT_EQ(std::memcmp(a.sumSq.data(), b.sumSq.data(), npix * sizeof(double)), 0) << name << " pass " << s0;
       }
-      EXPECT_EQ(ca.dropped, cb.dropped) << name;
-      EXPECT_EQ(std::memcmp(a.sum.data(), b.sum.data(), npix * sizeof(Color)), 0) << name << " pass " << s0;
-      EXPECT_EQ(std::memcmp(a.sumSq.data(), b.sumSq.data(), npix * sizeof(double)), 0) << name << " pass " << s0;
+      double mean = 0.0;
+      for (const Color& c : a.sum) mean += c.x + c.y + c.z;
+      EXPECT_GT(mean, 0.0) << name << ": an image, not a black film";
     }
-    double mean = 0.0;
-    for (const Color& c : a.sum) mean += c.x + c.y + c.z;
-    EXPECT_GT(mean, 0.0) << name << ": an image, not a black film";
-  }
 }
 
-// direct runs by bounce where it is a one-bounce path (one light and one BSDF sample, the
-// bundled scenes' and the paper's setting), and per pixel with other counts, which trace
-// several rays from one shading point.
+// direct runs by bounce where it is a one-bounce path (at most one light and one BSDF sample:
+// the bundled scenes', the paper's and the study's settings), and per pixel with more, which
+// trace several rays from one shading point.
 TEST(PixelKernel, DirectRunsByBounceWithOneSampleOfEach) {
   SmallScene small("buddha", IntegratorType::Direct);
   SampleIntegrator<BvhTracer> integ = small.integrator();
@@ -159,12 +167,7 @@ TEST(PixelKernel, DirectWithOneKindOfSampleByBounceAddsTheSameSamples) {
       Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
       PixelCounters ca, cb;
       TileBatch batch;
-      for (int y = 0; y < cam.height; ++y)
-        for (int x = 0; x < cam.width; ++x) renderPixel(cam, k.sequence, integ, x, y, 0, 8, a.view(cam), &ca);
-      for (int y0 = 0; y0 < cam.height; y0 += 16)
-        for (int x0 = 0; x0 < cam.width; x0 += 16)
-          renderTileByBounce(cam, k.sequence, integ, x0, y0, std::min(x0 + 16, cam.width),
-                             std::min(y0 + 16, cam.height), 0, 8, b.view(cam), &batch, &cb);
+      renderBothWays(cam, k.sequence, integ, 0, 8, &a, &b, &ca, &cb, &batch);
       const std::string what = name + " " + std::to_string(nE) + "+" + std::to_string(nB);
       EXPECT_LE(cb.rays, ca.rays) << what;
       EXPECT_GE(double(cb.rays), 0.99 * double(ca.rays)) << what;
@@ -199,12 +202,7 @@ TEST(PixelKernel, TileByBounceOverEmbreePacketsAddsTheSameSamplesAsRenderPixel) 
       Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
       PixelCounters ca, cb;
       TileBatch batch;
-      for (int y = 0; y < cam.height; ++y)
-        for (int x = 0; x < cam.width; ++x) renderPixel(cam, k.sequence, integ, x, y, 0, 4, a.view(cam), &ca);
-      for (int y0 = 0; y0 < cam.height; y0 += 16)
-        for (int x0 = 0; x0 < cam.width; x0 += 16)
-          renderTileByBounce(cam, k.sequence, integ, x0, y0, std::min(x0 + 16, cam.width),
-                             std::min(y0 + 16, cam.height), 0, 4, b.view(cam), &batch, &cb);
+      renderBothWays(cam, k.sequence, integ, 0, 4, &a, &b, &ca, &cb, &batch);
       // The mask's pass-through may turn a path another way, and with it its count of rays.
       EXPECT_NEAR(double(ca.rays), double(cb.rays), (name == "mask" ? 5e-3 : 1e-3) * double(ca.rays)) << name << " " << res;
       size_t same = 0;
