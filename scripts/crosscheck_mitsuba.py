@@ -408,6 +408,15 @@ def main():
     variant('buddha, map rotated', 'buddha',
             lambda t: t.replace('<float name="scale" value="25"/>', '<float name="scale" value="25"/><transform '
                                 'name="to_world"><rotate y="1" angle="110"/><rotate x="1" angle="30"/></transform>'))
+    # direct with one kind of sample (stop 66 runs these as one-bounce paths): light samples
+    # only, by the product density, and BSDF samples only, against Mitsuba's direct with the
+    # same counts.
+    one_light = '<integer name="emitter_samples" value="1"/>'
+    variant('buddha, direct with light samples only', 'buddha',
+            lambda t: t.replace(one_light, one_light + '<integer name="bsdf_samples" value="0"/>'))
+    variant('buddha, direct with BSDF samples only', 'buddha',
+            lambda t: t.replace(one_light, '<integer name="emitter_samples" value="0"/>'
+                                '<integer name="bsdf_samples" value="1"/>'))
     configs = [c for c in configs if args.only in c[0]]
     total_regions = sum(c[3] * c[3] for c in configs)
     alpha = 1.0 - 0.99 ** (1.0 / total_regions)
