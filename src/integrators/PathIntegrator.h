@@ -69,12 +69,14 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
                         const PathParams& pp, const Shadow& shadow, const ShadeAhead* ahead = nullptr) {
   const int depth = st->depth;
   const Ray& ray = st->ray;
+  // What this ray finds of a light takes no MIS weight where no light sample could have drawn
+  // it: after a delta bounce, or without next-event estimation. Nor is its light density read.
+  const bool unweighted = st->prevDelta || !pp.lightSample;
   if (!found) {
     if (sc.hasEnvironment && !(depth == 1 && pp.hideEmitters) && envSeenByBsdfSampling(pp.envStrategy, st->prevDelta)) {
       float lightPdf = 0.f;
-      Color Le = st->prevDelta ? sc.env.eval(ray.d)
-                               : envRadianceAndPdf(sc, pp.envStrategy, ray.d, st->prevAxis, &lightPdf);
-      float w = st->prevDelta || !pp.lightSample ? 1.f : powerHeuristic(1.f, st->prevPdf, 1.f, lightPdf);
+      Color Le = unweighted ? sc.env.eval(ray.d) : envRadianceAndPdf(sc, pp.envStrategy, ray.d, st->prevAxis, &lightPdf);
+      float w = unweighted ? 1.f : powerHeuristic(1.f, st->prevPdf, 1.f, lightPdf);
       st->L += st->beta * Le * w;
     }
     return false;
@@ -84,9 +86,8 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   if (si.light >= 0 && !(depth == 1 && pp.hideEmitters)) {
     Color Le = sc.emitted(si, wo);
     if (!isBlack(Le)) {
-      float w = st->prevDelta || !pp.lightSample
-                    ? 1.f
-                    : powerHeuristic(1.f, st->prevPdf, 1.f, areaLightPdf(sc, si.light, st->prevP, si.p, si.ng));
+      float w = unweighted ? 1.f
+                           : powerHeuristic(1.f, st->prevPdf, 1.f, areaLightPdf(sc, si.light, st->prevP, si.p, si.ng));
       st->L += st->beta * Le * w;
     }
   }
