@@ -15,7 +15,10 @@ namespace envgi {
 ENVGI_INLINE float polyAtan2(float y, float x) {
   float ax = std::fabs(x), ay = std::fabs(y);
   float hi = ax > ay ? ax : ay, lo = ax > ay ? ay : ax;
-  float a = hi == 0.f ? 0.f : lo / hi;  // a NaN stays NaN
+  // Divided whatever hi is, then chosen: with no division under a condition, loops over many
+  // directions vectorise (CameraRound::mapUV).
+  const float q = lo / hi;
+  float a = hi == 0.f ? 0.f : q;  // a NaN stays NaN
   float s = a * a;
   float p = -0.004355488810688257f;
   p = p * s + 0.023040415719151497f;

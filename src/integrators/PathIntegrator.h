@@ -45,6 +45,10 @@ struct ShadeAhead {
   SurfaceInteraction si;
   Vec2f uL;
   bool drawn = false;  // uL holds prepareLd's draw
+  // For a ray that escaped: the map's radiance along it, where it was looked up ahead (the CPU's
+  // camera rounds, CameraRound::mapUV); pathShade then reads it in place of eval's.
+  bool seen = false;
+  Color Le;
 };
 
 // Next-event estimation's shadow ray traced at once, its contribution added to the path
@@ -63,7 +67,7 @@ struct ShadowRayNow {
 // what it sees to st->L, hand next-event estimation's sample to shadow (ShadowRayNow or an
 // executor's batch), sample the BSDF for the next ray. Returns false once the path has ended.
 // Apart from pathStep, so that an executor can trace many paths' rays together, then shade them.
-// ahead: pathShadeAhead's work for this hit, or none.
+// ahead: pathShadeAhead's work for this hit, or for an escaped ray its radiance; or none.
 template <class Shadow>
 ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hit& h, Sampler& smp,
                         const PathParams& pp, const Shadow& shadow, const ShadeAhead* ahead = nullptr) {
@@ -75,7 +79,8 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   if (!found) {
     if (sc.hasEnvironment && !(depth == 1 && pp.hideEmitters) && envSeenByBsdfSampling(pp.envStrategy, st->prevDelta)) {
       float lightPdf = 0.f;
-      Color Le = unweighted ? sc.env.eval(ray.d) : envRadianceAndPdf(sc, pp.envStrategy, ray.d, st->prevAxis, &lightPdf);
+      Color Le = unweighted ? (ahead && ahead->seen ? ahead->Le : sc.env.eval(ray.d))
+                            : envRadianceAndPdf(sc, pp.envStrategy, ray.d, st->prevAxis, &lightPdf);
       float w = unweighted ? 1.f : powerHeuristic(1.f, st->prevPdf, 1.f, lightPdf);
       st->L += st->beta * Le * w;
     }

@@ -7,6 +7,7 @@
 #include "core/Atomic.h"
 #include "integrators/DirectIntegrator.h"
 #include "integrators/PathIntegrator.h"
+#include "render/CameraRound.h"
 #include "sampling/Sampler.h"
 
 namespace envgi {
@@ -224,6 +225,7 @@ struct TileBatch {
   std::vector<ShadeAhead> ahead;        // each hit's interaction and light draw, worked out ahead
   std::vector<ProductDrawAhead> draw;   // the round's product draws, walked level by level
   std::vector<int> drawing;             // the round's paths with such a draw
+  CameraRound camera;                   // the camera round's samples, made lane by lane
   void resize(size_t n) {
     if (state.size() >= n) return;
     state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), blocked.resize(n);
@@ -274,13 +276,32 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
     // Every pixel's sampler starts from this one: sample s's share of start() is done once.
     Sampler first = sequenceSampler(seq);
     first.setIndex(uint32_t(s));
+    // With Sobol's draws, the round's camera samples are made lane by lane (CameraRound).
+    const bool lanes = CameraRound::handles(first);
+    CameraRound& cr = b->camera;
+    cr.resize(size_t(n));
     for (int k = 0, x = x0, y = y0; k < n; ++k, x = x + 1 < x1 ? x + 1 : x0, y += x == x0) {
       const uint64_t pixel = uint64_t(y) * uint64_t(cam.width) + uint64_t(x);
       if (!film.takesSamples(size_t(pixel))) continue;
-      b->sampler[k] = first;
-      b->sampler[k].startPixel(pixel);  // startCameraSample's start(), in its two halves
-      b->state[k] = integ.begin(sampleCameraRay(cam, b->sampler[k], x, y, &b->weight[k]));
+      if (lanes) {
+        cr.px[live] = x, cr.py[live] = y;
+      } else {
+        b->sampler[k] = first;
+        b->sampler[k].startPixel(pixel);  // startCameraSample's start(), in its two halves
+        b->state[k] = integ.begin(sampleCameraRay(cam, b->sampler[k], x, y, &b->weight[k]));
+      }
       b->active[live++] = k;
+    }
+    if (lanes) {
+      cr.make(cam, first, live);
+      const uint32_t dims = CameraRound::dimensions(cam);
+      for (int i = 0; i < live; ++i) {
+        const int k = b->active[i];
+        b->sampler[k] = first;
+        b->sampler[k].startPixelAt(cr.hash[i], dims);
+        b->weight[k] = cr.weight[i];
+        b->state[k] = integ.begin(cr.rayOf(i));
+      }
     }
     for (bool cameraRays = true; live > 0; cameraRays = false) {
       if (cameraRays) {
@@ -318,6 +339,17 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       if (!cameraRays)
         for (int i = 0; i < live; ++i)
           if (!b->found[b->active[i]]) integ.prefetchEscape(b->state[b->active[i]]);
+      // The camera rays that escaped see the map: where they meet it, lane by lane, then its
+      // texels, one ray at a time.
+      const bool seen = cameraRays && lanes && integ.scene->hasEnvironment;
+      if (seen) {
+        cr.mapUV(integ.scene->env, live);
+        for (int i = 0; i < live; ++i) {
+          ShadeAhead& a = b->ahead[b->active[i]];
+          a.seen = !b->found[b->active[i]];
+          if (a.seen) a.Le = integ.scene->env.lookupUV(cr.uvOf(i));
+        }
+      }
       // Each hit's interaction and light draw, then the product draws' dependent loads a level
       // at a time across the round (CosineProductView::aheadLevel0-4), then the texels of the
       // pixels they land in: shading then finds them in cache.
@@ -339,7 +371,7 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         int k = b->active[i];
         b->ld[k].needsRay = false;
         b->going[k] = integ.shade(&b->state[k], b->found[k] != 0, b->hit[k], b->sampler[k], ShadowRayLater{b},
-                                  b->found[k] ? &b->ahead[k] : nullptr);
+                                  b->found[k] || seen ? &b->ahead[k] : nullptr);
       }
       int shadows = 0;
       for (int i = 0; i < live; ++i)

@@ -101,6 +101,29 @@ ENVGI_INLINE uint32_t nestedShuffle(uint32_t i, uint32_t size, uint32_t seed) {
 // Salts that give each use of a pixel's hash its own stream.
 inline constexpr uint32_t kSobolShuffle1D = 0x5bd1e995u, kSobolShuffle2D = 0x68e31da4u;
 inline constexpr uint32_t kOwenSeedX = 0x1234567u, kOwenSeedY = 0x89abcdeu;
+
+// A pixel's hash under a sequence's seed, from which every draw of its samples is made.
+ENVGI_INLINE uint64_t pixelHashOf(uint64_t pixel, uint32_t seed) { return hashCombine(mixBits(pixel), seed); }
+
+// The Sobol point of a pixel's first spp that sample indexInPixel takes in a dimension with hash
+// h: a shuffle within the sample's power-of-two block (for a power of two, one shuffle of all spp);
+// hashed, the point's own scramble is seeded from the same h.
+ENVGI_INLINE uint32_t sobolShuffledIndex(uint32_t h, uint32_t indexInPixel, IndexBlock block, uint32_t blockSeed) {
+  return block.start + nestedShuffle(indexInPixel - block.start, block.size, uint32_t(mixBits(h ^ blockSeed)));
+}
+
+// Sampler::get2D's Sobol draw in dimensions (d, d + 1) as a pure function of the pixel's hash and
+// the sample, so that an executor can draw one dimension pair of many pixels in a loop the
+// compiler vectorises (CameraRound.h); get2D itself calls it. Independent shuffles per dimension
+// pair decorrelate the pairs (Burley 2020).
+ENVGI_INLINE Vec2f sobolDraw2D(uint64_t pixelHash, uint32_t d, uint32_t indexInPixel, IndexBlock block,
+                               uint32_t blockSeed) {
+  uint32_t h = uint32_t(hashCombine(pixelHash, d));
+  uint32_t i = sobolShuffledIndex(h ^ kSobolShuffle2D, indexInPixel, block, blockSeed);
+  uint32_t s0 = uint32_t(mixBits(h ^ kOwenSeedX)), s1 = uint32_t(mixBits(h ^ kOwenSeedY));
+  return {bitsToFloat01(owenScrambleReversed(sobolDim0Reversed(i), s0)),
+          bitsToFloat01(owenScrambleReversed(sobolDim1Reversed(i), s1))};
+}
 // Photon emission draws from its own streams of the scene's seed, never the camera's.
 inline constexpr uint32_t kPhotonMapStream = 0x9e3779b9u, kSppmPhotonStream = 0x85ebca6bu;
 inline constexpr uint32_t kGridGatherStream = 0xc2b2ae35u, kCausticPhotonStream = 0x27d4eb2fu;
@@ -120,12 +143,8 @@ struct Sampler {
   uint32_t dim = 0;
   Pcg32 rng;
 
-  // Sobol: the point of the pixel's first spp this sample takes in a dimension with hash h, a
-  // shuffle within its power-of-two block (for a power of two, one shuffle of all spp).
-  ENVGI_HD uint32_t shuffledIndex(uint32_t h) const {
-    // Hashed: the point's own scramble is seeded from the same h.
-    return block.start + nestedShuffle(indexInPixel - block.start, block.size, uint32_t(mixBits(h ^ blockSeed)));
-  }
+  // Sobol: the point of the pixel's first spp this sample takes in a dimension with hash h.
+  ENVGI_HD uint32_t shuffledIndex(uint32_t h) const { return sobolShuffledIndex(h, indexInPixel, block, blockSeed); }
 
   // Begin sample `sampleIndex` of a pixel (a pixel id, or any stream id for non-image work).
   ENVGI_HD void start(uint64_t pixel, uint32_t sampleIndex) {
@@ -141,10 +160,17 @@ struct Sampler {
     blockSeed = block.start == 0 ? 0u : uint32_t(mixBits(block.start));
   }
   ENVGI_HD void startPixel(uint64_t pixel) {
-    pixelHash = hashCombine(mixBits(pixel), seed);
+    pixelHash = pixelHashOf(pixel, seed);
     dim = 0;
     // Sobol never reads the generator (nor steps it in skip1D/skip2D).
     if (type != SamplerType::Sobol) rng.setSeed(pixelHash, uint64_t(index) + 1u);
+  }
+
+  // startPixel for Sobol, where the pixel's hash is known and its first `drawn` dimensions were
+  // drawn elsewhere, from sobolDraw2D (CameraRound): the next draw is the one after them.
+  ENVGI_HD void startPixelAt(uint64_t hash, uint32_t drawn) {
+    pixelHash = hash;
+    dim = drawn;
   }
 
   ENVGI_HD float get1D() {
@@ -203,14 +229,7 @@ struct Sampler {
         float jx = rng.nextFloat(), jy = rng.nextFloat();
         return {(float(s % nx) + jx) / float(nx) * kOneMinusEpsilon, (float(s / nx) + jy) / float(nx) * kOneMinusEpsilon};
       }
-      case SamplerType::Sobol: {
-        // Independent shuffles per dimension pair decorrelate the pairs (Burley 2020).
-        uint32_t h = uint32_t(hashCombine(pixelHash, d));
-        uint32_t i = shuffledIndex(h ^ kSobolShuffle2D);
-        uint32_t s0 = uint32_t(mixBits(h ^ kOwenSeedX)), s1 = uint32_t(mixBits(h ^ kOwenSeedY));
-        return {bitsToFloat01(owenScrambleReversed(sobolDim0Reversed(i), s0)),
-                bitsToFloat01(owenScrambleReversed(sobolDim1Reversed(i), s1))};
-      }
+      case SamplerType::Sobol: return sobolDraw2D(pixelHash, d, indexInPixel, block, blockSeed);
       case SamplerType::Independent: break;
     }
     float a = rng.nextFloat();

@@ -35,11 +35,9 @@ struct Camera {
   // the crop window, where there is one);
   // `lens` picks the point on the aperture (unused for a pinhole).
   ENVGI_HD Ray generateRay(float x, float y, Vec2f lens = Vec2f(0.5f, 0.5f)) const {
-    float sx = 2.f * (x + float(cropX)) / fullWidth() - 1.f, sy = 1.f - 2.f * (y + float(cropY)) / fullHeight();
-    // Camera-space +x is the image's left (lookat builds x = up x dir), so image right is -x.
     // On the plane z = 1: its length is 1 / cos of the angle to the axis, which turns the
     // near and far planes into distances along the ray without normalising twice.
-    Vec3f d(-sx * tanHalfX, sy * tanHalfY, 1.f);
+    const Vec3f d = imagePlanePoint(x, y);
     Ray r;
     if (orthographic) {
       // As Mitsuba's: the ray's length is far - near in world units, whatever to_world's scale.
@@ -58,11 +56,23 @@ struct Camera {
       r.tMax = (farClip - nearClip) * invZ;
       return r;
     }
+    return pinholeRay(d);
+  }
+
+  // generateRay's pinhole, through the point d of the plane z = 1 (camera space).
+  ENVGI_HD Ray pinholeRay(Vec3f d) const {
+    Ray r;
     float len = length(d);
     r.d = normalize(toWorld.vector(d));
     r.o = toWorld.translation() + r.d * (nearClip * len);
     r.tMax = (farClip - nearClip) * len;
     return r;
+  }
+  // The point of the plane z = 1 (camera space) that image position (x, y) looks through.
+  ENVGI_HD Vec3f imagePlanePoint(float x, float y) const {
+    float sx = 2.f * (x + float(cropX)) / fullWidth() - 1.f, sy = 1.f - 2.f * (y + float(cropY)) / fullHeight();
+    // Camera-space +x is the image's left (lookat builds x = up x dir), so image right is -x.
+    return {-sx * tanHalfX, sy * tanHalfY, 1.f};
   }
 };
 

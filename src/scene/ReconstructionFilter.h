@@ -74,10 +74,17 @@ ENVGI_HD inline float sampleTabulatedAxis(const ReconstructionFilter& f, float u
 
 // The offset and weight of a sample drawn from the filter. box, tent and gaussian are drawn
 // exactly (weight one); gaussian is not truncated (Mitsuba's is, at 4 sigma: 3e-4 of its mass).
+// The box's: the offset is the draw, centred.
+ENVGI_HD inline FilterSample sampleBoxFilter(Vec2f u) {
+  FilterSample s;
+  s.offset = {u.x - 0.5f, u.y - 0.5f};
+  return s;
+}
+
 ENVGI_HD inline FilterSample sampleFilter(const ReconstructionFilter& f, Vec2f u) {
   FilterSample s;
   switch (f.type) {
-    case FilterType::Box: s.offset = {u.x - 0.5f, u.y - 0.5f}; return s;
+    case FilterType::Box: return sampleBoxFilter(u);
     case FilterType::Tent: {
       auto tent = [](float x) { return x < 0.5f ? std::sqrt(2.f * x) - 1.f : 1.f - std::sqrt(2.f - 2.f * x); };
       s.offset = {f.radius * tent(u.x), f.radius * tent(u.y)};

@@ -1,0 +1,47 @@
+// The camera samples of a round of a tile (renderTileByBounce's first round), made a step at a
+// time across the round's pixels, each step a loop over plain arrays that the compiler
+// vectorises: the pixels' hashes, their Sobol draws, the filter's offsets, the rays, and for
+// the rays that escape, where they meet the map. One sample at a time, these were a third of
+// the time outside Embree on the buddha bench (docs/performance.md, stop 67).
+// Each step calls the function the one-sample path calls (sobolDraw2D, Camera::pinholeRay,
+// EnvironmentMapView::dirToUV), so rays and draws are the same to the bit: a lane does each
+// float operation as the scalar instruction does (no contraction into FMA: the AVX2 clones are
+// built without it).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "envmap/EnvironmentMapView.h"
+#include "sampling/Sampler.h"
+#include "scene/Camera.h"
+
+namespace envgi {
+
+struct CameraRound {
+  // In: each lane's pixel. Out: its hash (Sampler::pixelHash), the filter's weight, the ray.
+  std::vector<int> px, py;
+  std::vector<uint64_t> hash;
+  std::vector<float> ux, uy, lx, ly, weight;
+  std::vector<float> ox, oy, oz, dx, dy, dz, tMax;
+  std::vector<float> u, v;  // mapUV: where each ray meets the map
+
+  void resize(size_t n);
+
+  // Whether a round of this sequence can be made here: Sobol's draws are pure functions of the
+  // pixel's hash; the other samplers step a generator, one sample at a time.
+  static bool handles(const Sampler& first) { return first.type == SamplerType::Sobol; }
+  // The dimensions a camera sample draws (sampleCameraRay): the filter's pair, and the lens's.
+  static uint32_t dimensions(const Camera& cam) { return cam.hasLens() ? 4u : 2u; }
+
+  // Lanes [0, n) (px, py set): what Sampler::startPixel and sampleCameraRay give for sample
+  // first.index of each lane's pixel, first being sequenceSampler's with setIndex done.
+  void make(const Camera& cam, const Sampler& first, int n);
+  Ray rayOf(int i) const { return Ray{Vec3f(ox[i], oy[i], oz[i]), Vec3f(dx[i], dy[i], dz[i]), tMax[i]}; }
+
+  // Lanes [0, n): where each ray meets the map, as EnvironmentMapView::eval finds it.
+  void mapUV(const EnvironmentMapView& env, int n);
+  Vec2f uvOf(int i) const { return {u[i], v[i]}; }
+};
+
+}  // namespace envgi
