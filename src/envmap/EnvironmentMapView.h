@@ -258,8 +258,8 @@ struct EnvironmentMapView {
   // Asks for what evalWithPdf(s, worldDir, normal) reads from the map (CPU only: a round of
   // escaped rays prefetches them all before shading, so that their misses overlap): the texel
   // rows the lookup and the in-pixel density read and, for product, its two cdf steps.
-  void prefetchEvalWithPdf(EnvStrategy s, Vec3f worldDir, Vec3f normal) const {
-    const Vec2f uv = dirToUV(toLocalUnnormalized(worldDir));
+  // uv: where the direction meets the map (dirToUV's).
+  void prefetchEvalWithPdf(EnvStrategy s, Vec2f uv, Vec3f normal) const {
     const PixelPoint p = pixelPoint(uv);
     int xs[3], ys[3];
     neighbourhood(p.x, p.y, xs, ys);
@@ -376,7 +376,10 @@ struct EnvironmentMapView {
   // `normal`: one mapping to (u, v) serves both, which is what a BSDF-sampled ray that escapes
   // needs (two atan2 calls and a rotation fewer than eval() and pdf() apart).
   ENVGI_HD Color evalWithPdf(EnvStrategy s, Vec3f worldDir, Vec3f normal, float* pdfOut) const {
-    Vec2f uv = dirToUV(toLocalUnnormalized(worldDir));
+    return evalWithPdfAt(s, worldDir, dirToUV(toLocalUnnormalized(worldDir)), normal, pdfOut);
+  }
+  // evalWithPdf where worldDir's (u, v) is known (RoundLanes::mapUV).
+  ENVGI_HD Color evalWithPdfAt(EnvStrategy s, Vec3f worldDir, Vec2f uv, Vec3f normal, float* pdfOut) const {
     *pdfOut = pdfAt(strategyFor(s, normal), worldDir, uv, normal);
     return lookupUV(uv);
   }

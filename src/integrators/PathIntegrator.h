@@ -45,10 +45,10 @@ struct ShadeAhead {
   SurfaceInteraction si;
   Vec2f uL;
   bool drawn = false;  // uL holds prepareLd's draw
-  // For a ray that escaped: the map's radiance along it, where it was looked up ahead (the CPU's
-  // camera rounds, CameraRound::mapUV); pathShade then reads it in place of eval's.
-  bool seen = false;
-  Color Le;
+  // For a ray that escaped: where it meets the map, found ahead (RoundLanes::mapUV); pathShade
+  // then looks the map up there instead of finding (u, v) again.
+  bool escaped = false;
+  Vec2f uv;
 };
 
 // Next-event estimation's shadow ray traced at once, its contribution added to the path
@@ -79,8 +79,9 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   if (!found) {
     if (sc.hasEnvironment && !(depth == 1 && pp.hideEmitters) && envSeenByBsdfSampling(pp.envStrategy, st->prevDelta)) {
       float lightPdf = 0.f;
-      Color Le = unweighted ? (ahead && ahead->seen ? ahead->Le : sc.env.eval(ray.d))
-                            : envRadianceAndPdf(sc, pp.envStrategy, ray.d, st->prevAxis, &lightPdf);
+      const Vec2f* uv = ahead && ahead->escaped ? &ahead->uv : nullptr;
+      Color Le = unweighted ? (uv ? sc.env.lookupUV(*uv) : sc.env.eval(ray.d))
+                            : envRadianceAndPdf(sc, pp.envStrategy, ray.d, st->prevAxis, &lightPdf, uv);
       float w = unweighted ? 1.f : powerHeuristic(1.f, st->prevPdf, 1.f, lightPdf);
       st->L += st->beta * Le * w;
     }
@@ -129,11 +130,11 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   return depth < pp.rrDepth || russianRoulette(&st->beta, smp.get1D(), kRouletteMaxSurvival, st->etaScale);
 }
 
-// What pathShade will read from the map for a path whose ray escaped, asked for ahead (CPU
-// only: renderTileByBounce prefetches a round's escapes before shading it).
-inline void pathPrefetchEscape(const SceneView& sc, const PathState& st, const PathParams& pp) {
+// What pathShade will read from the map for a path whose ray escaped and meets the map at uv,
+// asked for ahead (CPU only: renderTileByBounce prefetches a round's escapes before shading it).
+inline void pathPrefetchEscape(const SceneView& sc, const PathState& st, const PathParams& pp, Vec2f uv) {
   if (sc.hasEnvironment && !st.prevDelta && envSeenByBsdfSampling(pp.envStrategy, false))
-    sc.env.prefetchEvalWithPdf(pp.envStrategy, st.ray.d, st.prevAxis);
+    sc.env.prefetchEvalWithPdf(pp.envStrategy, uv, st.prevAxis);
 }
 
 // pathShade's first steps for a path whose ray hit, done ahead into *ahead (CPU only): its

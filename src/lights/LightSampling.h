@@ -29,8 +29,9 @@ ENVGI_INLINE bool envSeenByBsdfSampling(EnvStrategy s, bool prevDelta) { return 
 
 // The map's radiance along an escaping BSDF-sampled direction and, through *lightPdf, the
 // density next-event estimation would have drawn it with (selection included).
-ENVGI_INLINE Color envRadianceAndPdf(const SceneView& sc, EnvStrategy s, Vec3f dir, Vec3f axis, float* lightPdf) {
-  Color Le = sc.env.evalWithPdf(s, dir, axis, lightPdf);
+ENVGI_INLINE Color envRadianceAndPdf(const SceneView& sc, EnvStrategy s, Vec3f dir, Vec3f axis, float* lightPdf,
+                                     const Vec2f* uv = nullptr) {
+  Color Le = uv ? sc.env.evalWithPdfAt(s, dir, *uv, axis, lightPdf) : sc.env.evalWithPdf(s, dir, axis, lightPdf);
   *lightPdf *= sc.envSelectProb();
   return Le;
 }

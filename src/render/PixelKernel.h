@@ -7,7 +7,7 @@
 #include "core/Atomic.h"
 #include "integrators/DirectIntegrator.h"
 #include "integrators/PathIntegrator.h"
-#include "render/CameraRound.h"
+#include "render/RoundLanes.h"
 #include "sampling/Sampler.h"
 
 namespace envgi {
@@ -77,7 +77,7 @@ struct SampleIntegrator {
     return pathShade(*scene, st, found, h, smp, shadedPath(), shadow, ahead);
   }
   // What shade() will read for a path whose ray escaped, asked for ahead (CPU only).
-  void prefetchEscape(const PathState& st) const { pathPrefetchEscape(*scene, st, shadedPath()); }
+  void prefetchEscape(const PathState& st, Vec2f uv) const { pathPrefetchEscape(*scene, st, shadedPath(), uv); }
   // shade()'s first steps for a hit, done ahead (pathShadeAhead; CPU only).
   bool shadeAhead(const PathState& st, const Hit& h, const Sampler& smp, ShadeAhead* ahead,
                   ProductDrawAhead* draw) const {
@@ -225,13 +225,15 @@ struct TileBatch {
   std::vector<ShadeAhead> ahead;        // each hit's interaction and light draw, worked out ahead
   std::vector<ProductDrawAhead> draw;   // the round's product draws, walked level by level
   std::vector<int> drawing;             // the round's paths with such a draw
-  CameraRound camera;                   // the camera round's samples, made lane by lane
+  std::vector<int> escaping;            // the round's paths whose ray escaped
+  RoundLanes lanes;                     // the round's work done lane by lane
   void resize(size_t n) {
     if (state.size() >= n) return;
     state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), blocked.resize(n);
     active.resize(n), shadow.resize(n);
     ld.resize(n), ldBeta.resize(n), weight.resize(n), acc.resize(n), accSq.resize(n), accW.resize(n);
-    ahead.resize(n), draw.resize(n), drawing.resize(n);
+    ahead.resize(n), draw.resize(n), drawing.resize(n), escaping.resize(n);
+    lanes.resize(n);
   }
 };
 
@@ -276,15 +278,14 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
     // Every pixel's sampler starts from this one: sample s's share of start() is done once.
     Sampler first = sequenceSampler(seq);
     first.setIndex(uint32_t(s));
-    // With Sobol's draws, the round's camera samples are made lane by lane (CameraRound).
-    const bool lanes = CameraRound::handles(first);
-    CameraRound& cr = b->camera;
-    cr.resize(size_t(n));
+    // With Sobol's draws, the round's camera samples are made lane by lane (RoundLanes).
+    const bool inLanes = RoundLanes::handles(first);
+    RoundLanes& lanes = b->lanes;
     for (int k = 0, x = x0, y = y0; k < n; ++k, x = x + 1 < x1 ? x + 1 : x0, y += x == x0) {
       const uint64_t pixel = uint64_t(y) * uint64_t(cam.width) + uint64_t(x);
       if (!film.takesSamples(size_t(pixel))) continue;
-      if (lanes) {
-        cr.px[live] = x, cr.py[live] = y;
+      if (inLanes) {
+        lanes.px[live] = x, lanes.py[live] = y;
       } else {
         b->sampler[k] = first;
         b->sampler[k].startPixel(pixel);  // startCameraSample's start(), in its two halves
@@ -292,15 +293,15 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       }
       b->active[live++] = k;
     }
-    if (lanes) {
-      cr.make(cam, first, live);
-      const uint32_t dims = CameraRound::dimensions(cam);
+    if (inLanes) {
+      lanes.make(cam, first, live);
+      const uint32_t dims = RoundLanes::dimensions(cam);
       for (int i = 0; i < live; ++i) {
         const int k = b->active[i];
         b->sampler[k] = first;
-        b->sampler[k].startPixelAt(cr.hash[i], dims);
-        b->weight[k] = cr.weight[i];
-        b->state[k] = integ.begin(cr.rayOf(i));
+        b->sampler[k].startPixelAt(lanes.hash[i], dims);
+        b->weight[k] = lanes.weight[i];
+        b->state[k] = integ.begin(lanes.rayOf(i));
       }
     }
     for (bool cameraRays = true; live > 0; cameraRays = false) {
@@ -336,18 +337,22 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         if (b->found[b->active[i]]) integ.scene->prefetchTriangle(b->hit[b->active[i]]);
       for (int i = 0; i < live; ++i)
         if (b->found[b->active[i]]) integ.scene->prefetchVertices(b->hit[b->active[i]]);
-      if (!cameraRays)
+      // The rays that escaped meet the map: where, lane by lane (RoundLanes::mapUV), then, past
+      // the camera's round, what their MIS weights read there, asked for ahead.
+      const bool seesMap = integ.scene->hasEnvironment;
+      if (seesMap) {
+        int escapes = 0;
         for (int i = 0; i < live; ++i)
-          if (!b->found[b->active[i]]) integ.prefetchEscape(b->state[b->active[i]]);
-      // The camera rays that escaped see the map: where they meet it, lane by lane, then its
-      // texels, one ray at a time.
-      const bool seen = cameraRays && lanes && integ.scene->hasEnvironment;
-      if (seen) {
-        cr.mapUV(integ.scene->env, live);
-        for (int i = 0; i < live; ++i) {
-          ShadeAhead& a = b->ahead[b->active[i]];
-          a.seen = !b->found[b->active[i]];
-          if (a.seen) a.Le = integ.scene->env.lookupUV(cr.uvOf(i));
+          if (!b->found[b->active[i]]) {
+            b->escaping[escapes] = b->active[i];
+            lanes.setDirection(escapes++, b->state[b->active[i]].ray.d);
+          }
+        lanes.mapUV(integ.scene->env, escapes);
+        for (int j = 0; j < escapes; ++j) {
+          ShadeAhead& a = b->ahead[b->escaping[j]];
+          a.escaped = true;
+          a.uv = lanes.uvOf(j);
+          if (!cameraRays) integ.prefetchEscape(b->state[b->escaping[j]], a.uv);
         }
       }
       // Each hit's interaction and light draw, then the product draws' dependent loads a level
@@ -371,7 +376,7 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         int k = b->active[i];
         b->ld[k].needsRay = false;
         b->going[k] = integ.shade(&b->state[k], b->found[k] != 0, b->hit[k], b->sampler[k], ShadowRayLater{b},
-                                  b->found[k] || seen ? &b->ahead[k] : nullptr);
+                                  b->found[k] || seesMap ? &b->ahead[k] : nullptr);
       }
       int shadows = 0;
       for (int i = 0; i < live; ++i)

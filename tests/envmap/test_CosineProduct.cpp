@@ -236,7 +236,7 @@ TEST(CosineProduct, PrefetchingAnEscapeReadsInsideTheTables) {
       for (EnvStrategy s : {EnvStrategy::Product, EnvStrategy::Importance}) {
         float before, after;
         Color a = v.evalWithPdf(s, d, n, &before);
-        v.prefetchEvalWithPdf(s, d, n);
+        v.prefetchEvalWithPdf(s, EnvironmentMapView::dirToUV(v.toLocalUnnormalized(d)), n);
         Color b = v.evalWithPdf(s, d, n, &after);
         ASSERT_EQ(before, after);
         ASSERT_EQ(a.x, b.x);

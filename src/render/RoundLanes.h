@@ -1,8 +1,8 @@
-// The camera samples of a round of a tile (renderTileByBounce's first round), made a step at a
-// time across the round's pixels, each step a loop over plain arrays that the compiler
-// vectorises: the pixels' hashes, their Sobol draws, the filter's offsets, the rays, and for
-// the rays that escape, where they meet the map. One sample at a time, these were a third of
-// the time outside Embree on the buddha bench (docs/performance.md, stop 67).
+// The lanes of a tile's round (renderTileByBounce): work done a step at a time across the
+// round's paths, each step a loop over plain arrays that the compiler vectorises. The camera
+// round's samples (the pixels' hashes, their Sobol draws, the filter's offsets, the rays), and
+// in every round, where the rays that escaped meet the map. One sample at a time, the camera's
+// share was a third of the time outside Embree on the buddha bench (docs/performance.md, stop 67).
 // Each step calls the function the one-sample path calls (sobolDraw2D, Camera::pinholeRay,
 // EnvironmentMapView::dirToUV), so rays and draws are the same to the bit: a lane does each
 // float operation as the scalar instruction does (no contraction into FMA: the AVX2 clones are
@@ -18,13 +18,13 @@
 
 namespace envgi {
 
-struct CameraRound {
+struct RoundLanes {
   // In: each lane's pixel. Out: its hash (Sampler::pixelHash), the filter's weight, the ray.
   std::vector<int> px, py;
   std::vector<uint64_t> hash;
   std::vector<float> ux, uy, lx, ly, weight;
   std::vector<float> ox, oy, oz, dx, dy, dz, tMax;
-  std::vector<float> u, v;  // mapUV: where each ray meets the map
+  std::vector<float> u, v;  // mapUV: where each direction (dx, dy, dz) meets the map
 
   void resize(size_t n);
 
@@ -37,9 +37,11 @@ struct CameraRound {
   // Lanes [0, n) (px, py set): what Sampler::startPixel and sampleCameraRay give for sample
   // first.index of each lane's pixel, first being sequenceSampler's with setIndex done.
   void make(const Camera& cam, const Sampler& first, int n);
+  void setDirection(int i, Vec3f d) { dx[i] = d.x, dy[i] = d.y, dz[i] = d.z; }
   Ray rayOf(int i) const { return Ray{Vec3f(ox[i], oy[i], oz[i]), Vec3f(dx[i], dy[i], dz[i]), tMax[i]}; }
 
-  // Lanes [0, n): where each ray meets the map, as EnvironmentMapView::eval finds it.
+  // Lanes [0, n): where each direction (dx, dy, dz) meets the map, as EnvironmentMapView::eval
+  // finds it. The camera round's rays, or a round's escaped rays gathered there.
   void mapUV(const EnvironmentMapView& env, int n);
   Vec2f uvOf(int i) const { return {u[i], v[i]}; }
 };

@@ -1,4 +1,4 @@
-#include "render/CameraRound.h"
+#include "render/RoundLanes.h"
 
 namespace envgi {
 
@@ -66,14 +66,14 @@ ENVGI_LANES void mapCoordinates(int n, const Transform& toWorld, const float* __
 
 }  // namespace
 
-void CameraRound::resize(size_t n) {
+void RoundLanes::resize(size_t n) {
   if (px.size() >= n) return;
   for (std::vector<float>* a : {&ux, &uy, &lx, &ly, &weight, &ox, &oy, &oz, &dx, &dy, &dz, &tMax, &u, &v})
     a->resize(n);
   px.resize(n), py.resize(n), hash.resize(n);
 }
 
-void CameraRound::make(const Camera& cam, const Sampler& first, int n) {
+void RoundLanes::make(const Camera& cam, const Sampler& first, int n) {
   resize(size_t(n));
   pixelHashes(n, px.data(), py.data(), uint64_t(cam.width), first.seed, hash.data());
   sobolDraws(n, hash.data(), 0, first.indexInPixel, first.block, first.blockSeed, ux.data(), uy.data());
@@ -97,7 +97,7 @@ void CameraRound::make(const Camera& cam, const Sampler& first, int n) {
   }
 }
 
-void CameraRound::mapUV(const EnvironmentMapView& env, int n) {
+void RoundLanes::mapUV(const EnvironmentMapView& env, int n) {
   mapCoordinates(n, env.toWorld, dx.data(), dy.data(), dz.data(), u.data(), v.data());
 }
 

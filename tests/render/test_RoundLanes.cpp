@@ -1,4 +1,4 @@
-// CameraRound makes a round's camera samples lane by lane: the rays, filter weights and sampler
+// RoundLanes makes a round's camera samples lane by lane: the rays, filter weights and sampler
 // positions must be the one-sample path's (Sampler::startPixel, then sampleCameraRay) to the
 // bit, whatever the camera, filter or sample count, and where the rays meet the map must be
 // EnvironmentMapView::eval's (u, v).
@@ -6,7 +6,7 @@
 
 #include <cstring>
 
-#include "render/CameraRound.h"
+#include "render/RoundLanes.h"
 #include "render/PixelKernel.h"
 #include "sampling/Pcg32.h"
 
@@ -30,7 +30,7 @@ Camera testCamera(int w, int h) {
 
 // Every sample of a 37 x 23 image (lanes not a multiple of any vector width) both ways.
 void expectSameSamples(const Camera& cam, uint32_t spp, uint32_t seed, const char* what) {
-  CameraRound cr;
+  RoundLanes cr;
   SampleSequence seq{SamplerType::Sobol, spp, seed};
   int mismatches = 0;
   for (uint32_t s = 0; s < spp; ++s) {
@@ -45,7 +45,7 @@ void expectSameSamples(const Camera& cam, uint32_t spp, uint32_t seed, const cha
       float w;
       const Ray r = startCameraSample(cam, one, cr.px[i], cr.py[i], int(s), &w);
       Sampler lanes = first;
-      lanes.startPixelAt(cr.hash[i], CameraRound::dimensions(cam));
+      lanes.startPixelAt(cr.hash[i], RoundLanes::dimensions(cam));
       const Ray q = cr.rayOf(i);
       const bool same = sameBits(r.o.x, q.o.x) && sameBits(r.o.y, q.o.y) && sameBits(r.o.z, q.o.z) &&
                         sameBits(r.d.x, q.d.x) && sameBits(r.d.y, q.d.y) && sameBits(r.d.z, q.d.z) &&
@@ -61,7 +61,7 @@ void expectSameSamples(const Camera& cam, uint32_t spp, uint32_t seed, const cha
 
 }  // namespace
 
-TEST(CameraRound, SamplesAreTheOneSamplePathsToTheBit) {
+TEST(RoundLanes, SamplesAreTheOneSamplePathsToTheBit) {
   for (uint32_t spp : {1u, 8u, 6u}) {
     Camera pinhole = testCamera(37, 23);
     pinhole.filter = makeFilter(FilterType::Box);
@@ -84,10 +84,10 @@ TEST(CameraRound, SamplesAreTheOneSamplePathsToTheBit) {
   }
 }
 
-TEST(CameraRound, RaysMeetTheMapWhereEvalLooksItUp) {
+TEST(RoundLanes, RaysMeetTheMapWhereEvalLooksItUp) {
   EnvironmentMapView env;
   env.toWorld = rotate(Vec3f(0.3f, 1.f, 0.2f), 25.f);
-  CameraRound cr;
+  RoundLanes cr;
   const int n = 1001;
   cr.resize(size_t(n));
   Pcg32 rng(5);
