@@ -71,6 +71,21 @@ ENVGI_HD inline Vec2f lightDrawOf(const Sampler& smp) {
   return peek.get2D();
 }
 
+// A 2D draw made ahead (the CPU's RoundLanes::drawAhead, a round's draws in vector lanes) for
+// the dimension pair that starts at dim; taken where the sampler stands there, drawn afresh
+// anywhere else, so an executor that guesses the dimension wrong loses time, never the image.
+struct Draw2DAhead {
+  Vec2f u;
+  uint32_t dim = ~0u;
+};
+ENVGI_HD inline Vec2f get2DOrAhead(Sampler& smp, const Draw2DAhead* ahead) {
+  if (ahead && ahead->dim == smp.dim) {
+    smp.skip2D();
+    return ahead->u;
+  }
+  return smp.get2D();
+}
+
 // The sample's contribution once its shadow ray's answer is known.
 ENVGI_HD inline Color resolvedLd(const LightSampleLd& ld, bool occluded) {
   return ld.needsRay && !occluded ? ld.value : Color(0.f);
@@ -79,9 +94,11 @@ ENVGI_HD inline Color resolvedLd(const LightSampleLd& ld, bool occluded) {
 // A bounce's BSDF draw as path and direct take it: uc only where bsdfSample reads it beside ub
 // (skipped, not drawn, elsewhere, so later draws keep their dimensions), and the lobe from ub
 // where the BSDF can take it from there (bsdfLobeFromU).
-ENVGI_HD inline bool drawBsdfSample(const Bsdf& bsdf, Vec3f woLocal, Sampler& smp, BsdfSample* bs) {
+// ubAhead: the pair's draw made ahead, if any (get2DOrAhead).
+ENVGI_HD inline bool drawBsdfSample(const Bsdf& bsdf, Vec3f woLocal, Sampler& smp, BsdfSample* bs,
+                                    const Draw2DAhead* ubAhead = nullptr) {
   float uc = smp.get1DIf(bsdfReadsUcBesideU(bsdf));
-  Vec2f ub = smp.get2D();
+  Vec2f ub = get2DOrAhead(smp, ubAhead);
   return bsdfSample(bsdf, woLocal, uc, ub, bs, true);
 }
 

@@ -45,6 +45,7 @@ struct ShadeAhead {
   SurfaceInteraction si;
   Vec2f uL;
   bool drawn = false;  // uL holds prepareLd's draw
+  Draw2DAhead ub;      // the BSDF's pair, where it was drawn ahead (pathBsdfDrawOffset)
   // For a ray that escaped: where it meets the map, found ahead (RoundLanes::mapUV); pathShade
   // then looks the map up there instead of finding (u, v) again.
   bool escaped = false;
@@ -113,7 +114,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   if (!pp.bsdfSample) return false;
 
   BsdfSample bs;
-  if (!drawBsdfSample(bsdf, woLocal, smp, &bs)) return false;
+  if (!drawBsdfSample(bsdf, woLocal, smp, &bs, ahead ? &ahead->ub : nullptr)) return false;
   if (partner) bsdfMixReweight(*partner, si.partnerWeight, woLocal, &bs);
   Vec3f wi = si.shading.toWorld(bs.wi);
   st->beta *= bs.weight;
@@ -137,16 +138,25 @@ inline void pathPrefetchEscape(const SceneView& sc, const PathState& st, const P
     sc.env.prefetchEvalWithPdf(pp.envStrategy, uv, st.prevAxis);
 }
 
+// Where pathShade's 2D draws at a hit start, in dimensions past the sampler's position there:
+// prepareLd skips one, then draws the light's pair (and the area light's, or skips it);
+// drawBsdfSample takes uc or skips it, then the BSDF's pair. For an executor that draws a
+// round's pairs ahead (RoundLanes::drawAhead): a pair drawn for the wrong dimension is not
+// taken (get2DOrAhead), so these cost time if they drift from pathShade, never the image.
+ENVGI_HD inline uint32_t pathLightDrawOffset() { return 1u; }
+ENVGI_HD inline uint32_t pathBsdfDrawOffset(const PathParams& pp) { return pp.lightSample ? 6u : 1u; }
+
 // pathShade's first steps for a path whose ray hit, done ahead into *ahead (CPU only): its
-// interaction and, where it goes on to next-event estimation, its light draw. Where that draw
-// is the product's, *draw gets the first level of its loads (CosineProductView::aheadLevel0)
-// and it returns true.
+// interaction and, where it goes on to next-event estimation, its light draw (uL: that draw made
+// ahead, if it was). Where that draw is the product's, *draw gets the first level of its loads
+// (CosineProductView::aheadLevel0) and it returns true.
 inline bool pathShadeAhead(const SceneView& sc, const PathState& st, const Hit& h, const Sampler& smp,
-                           const PathParams& pp, ShadeAhead* ahead, ProductDrawAhead* draw) {
+                           const PathParams& pp, ShadeAhead* ahead, ProductDrawAhead* draw,
+                           const Draw2DAhead* uL = nullptr) {
   ahead->si = sc.interaction(st.ray, h);
   ahead->drawn = pp.lightSample && !(pp.maxDepth >= 0 && st.depth >= pp.maxDepth);
   if (!ahead->drawn) return false;
-  ahead->uL = lightDrawOf(smp);
+  ahead->uL = uL && uL->dim == smp.dim + pathLightDrawOffset() ? uL->u : lightDrawOf(smp);
   // The material's own entry, untextured: its type is all that is asked of it here.
   const Bsdf& bsdf = sc.bsdfs[ahead->si.bsdf];
   Vec2f u = ahead->uL;

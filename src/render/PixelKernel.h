@@ -79,9 +79,9 @@ struct SampleIntegrator {
   // What shade() will read for a path whose ray escaped, asked for ahead (CPU only).
   void prefetchEscape(const PathState& st, Vec2f uv) const { pathPrefetchEscape(*scene, st, shadedPath(), uv); }
   // shade()'s first steps for a hit, done ahead (pathShadeAhead; CPU only).
-  bool shadeAhead(const PathState& st, const Hit& h, const Sampler& smp, ShadeAhead* ahead,
-                  ProductDrawAhead* draw) const {
-    return pathShadeAhead(*scene, st, h, smp, shadedPath(), ahead, draw);
+  bool shadeAhead(const PathState& st, const Hit& h, const Sampler& smp, ShadeAhead* ahead, ProductDrawAhead* draw,
+                  const Draw2DAhead* uL = nullptr) const {
+    return pathShadeAhead(*scene, st, h, smp, shadedPath(), ahead, draw, uL);
   }
 };
 
@@ -226,13 +226,14 @@ struct TileBatch {
   std::vector<ProductDrawAhead> draw;   // the round's product draws, walked level by level
   std::vector<int> drawing;             // the round's paths with such a draw
   std::vector<int> escaping;            // the round's paths whose ray escaped
+  std::vector<int> hitting;             // and those whose ray hit
   RoundLanes lanes;                     // the round's work done lane by lane
   void resize(size_t n) {
     if (state.size() >= n) return;
     state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), blocked.resize(n);
     active.resize(n), shadow.resize(n);
     ld.resize(n), ldBeta.resize(n), weight.resize(n), acc.resize(n), accSq.resize(n), accW.resize(n);
-    ahead.resize(n), draw.resize(n), drawing.resize(n), escaping.resize(n);
+    ahead.resize(n), draw.resize(n), drawing.resize(n), escaping.resize(n), hitting.resize(n);
     lanes.resize(n);
   }
 };
@@ -358,10 +359,23 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       // Each hit's interaction and light draw, then the product draws' dependent loads a level
       // at a time across the round (CosineProductView::aheadLevel0-4), then the texels of the
       // pixels they land in: shading then finds them in cache.
+      // With Sobol's draws, the hits' light and BSDF pairs are drawn first, lane by lane.
+      int hits = 0;
+      for (int i = 0; i < live; ++i)
+        if (b->found[b->active[i]]) b->hitting[hits++] = b->active[i];
+      const PathParams& pp = integ.shadedPath();
+      const uint32_t lightAt = pathLightDrawOffset(), bsdfAt = pathBsdfDrawOffset(pp);
+      if (inLanes) {
+        for (int j = 0; j < hits; ++j) lanes.setSampler(j, b->sampler[b->hitting[j]]);
+        lanes.drawAhead(first, hits, lightAt, bsdfAt);
+      }
       int draws = 0;
-      for (int i = 0; i < live; ++i) {
-        const int k = b->active[i];
-        if (b->found[k] && integ.shadeAhead(b->state[k], b->hit[k], b->sampler[k], &b->ahead[k], &b->draw[k]))
+      for (int j = 0; j < hits; ++j) {
+        const int k = b->hitting[j];
+        Draw2DAhead uL;
+        if (inLanes) uL = lanes.lightDraw(j, lightAt);
+        b->ahead[k].ub = inLanes ? lanes.bsdfDraw(j, bsdfAt) : Draw2DAhead{};
+        if (integ.shadeAhead(b->state[k], b->hit[k], b->sampler[k], &b->ahead[k], &b->draw[k], inLanes ? &uL : nullptr))
           b->drawing[draws++] = k;
       }
       const EnvironmentMapView& env = integ.scene->env;

@@ -27,6 +27,16 @@ ENVGI_LANES void sobolDraws(int n, const uint64_t* __restrict h, uint32_t d, uin
   }
 }
 
+// As sobolDraws, each lane at its own dimension pair: d[i] + at.
+ENVGI_LANES void sobolDrawsAt(int n, const uint64_t* __restrict h, const uint32_t* __restrict d, uint32_t at,
+                              uint32_t index, IndexBlock block, uint32_t blockSeed, float* __restrict u0,
+                              float* __restrict u1) {
+  for (int i = 0; i < n; ++i) {
+    const Vec2f u = sobolDraw2D(h[i], d[i] + at, index, block, blockSeed);
+    u0[i] = u.x, u1[i] = u.y;
+  }
+}
+
 // The box filter's offsets in place of the draws (sampleBoxFilter).
 ENVGI_LANES void boxOffsets(int n, float* __restrict u0, float* __restrict u1, float* __restrict w) {
   for (int i = 0; i < n; ++i) {
@@ -68,9 +78,10 @@ ENVGI_LANES void mapCoordinates(int n, const Transform& toWorld, const float* __
 
 void RoundLanes::resize(size_t n) {
   if (px.size() >= n) return;
-  for (std::vector<float>* a : {&ux, &uy, &lx, &ly, &weight, &ox, &oy, &oz, &dx, &dy, &dz, &tMax, &u, &v})
+  for (std::vector<float>* a : {&ux, &uy, &lx, &ly, &weight, &ox, &oy, &oz, &dx, &dy, &dz, &tMax, &u, &v, &lightU0,
+                                &lightU1, &bsdfU0, &bsdfU1})
     a->resize(n);
-  px.resize(n), py.resize(n), hash.resize(n);
+  px.resize(n), py.resize(n), hash.resize(n), dims.resize(n);
 }
 
 void RoundLanes::make(const Camera& cam, const Sampler& first, int n) {
@@ -95,6 +106,13 @@ void RoundLanes::make(const Camera& cam, const Sampler& first, int n) {
   } else {
     pinholeRays(n, cam, px.data(), py.data(), ux.data(), uy.data(), out);
   }
+}
+
+void RoundLanes::drawAhead(const Sampler& first, int n, uint32_t lightAt, uint32_t bsdfAt) {
+  sobolDrawsAt(n, hash.data(), dims.data(), lightAt, first.indexInPixel, first.block, first.blockSeed, lightU0.data(),
+               lightU1.data());
+  sobolDrawsAt(n, hash.data(), dims.data(), bsdfAt, first.indexInPixel, first.block, first.blockSeed, bsdfU0.data(),
+               bsdfU1.data());
 }
 
 void RoundLanes::mapUV(const EnvironmentMapView& env, int n) {

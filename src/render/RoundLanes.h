@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "envmap/EnvironmentMapView.h"
+#include "integrators/NextEvent.h"
 #include "sampling/Sampler.h"
 #include "scene/Camera.h"
 
@@ -25,6 +26,9 @@ struct RoundLanes {
   std::vector<float> ux, uy, lx, ly, weight;
   std::vector<float> ox, oy, oz, dx, dy, dz, tMax;
   std::vector<float> u, v;  // mapUV: where each direction (dx, dy, dz) meets the map
+  // drawAhead: in, each lane's sampler (its pixel's hash, its position); out, two pairs of it.
+  std::vector<uint32_t> dims;
+  std::vector<float> lightU0, lightU1, bsdfU0, bsdfU1;
 
   void resize(size_t n);
 
@@ -39,6 +43,14 @@ struct RoundLanes {
   void make(const Camera& cam, const Sampler& first, int n);
   void setDirection(int i, Vec3f d) { dx[i] = d.x, dy[i] = d.y, dz[i] = d.z; }
   Ray rayOf(int i) const { return Ray{Vec3f(ox[i], oy[i], oz[i]), Vec3f(dx[i], dy[i], dz[i]), tMax[i]}; }
+
+  // A round's hits: lane j's sampler, and the two 2D draws pathShade will make there, at
+  // lightAt and bsdfAt dimensions past its position (pathLightDrawOffset, pathBsdfDrawOffset),
+  // for sample first.index (first as in make()).
+  void setSampler(int j, const Sampler& smp) { hash[j] = smp.pixelHash, dims[j] = smp.dim; }
+  void drawAhead(const Sampler& first, int n, uint32_t lightAt, uint32_t bsdfAt);
+  Draw2DAhead lightDraw(int j, uint32_t lightAt) const { return {{lightU0[j], lightU1[j]}, dims[j] + lightAt}; }
+  Draw2DAhead bsdfDraw(int j, uint32_t bsdfAt) const { return {{bsdfU0[j], bsdfU1[j]}, dims[j] + bsdfAt}; }
 
   // Lanes [0, n): where each direction (dx, dy, dz) meets the map, as EnvironmentMapView::eval
   // finds it. The camera round's rays, or a round's escaped rays gathered there.

@@ -2,7 +2,10 @@
 // 2D draw, which renderTileByBounce works out for a whole round before shading it) against
 // pathShade doing them itself: the same light sample, the same next ray and the same sampler
 // position, to the bit, at every bounce, on scenes that take each branch (the product's draw,
-// an area light's share, glass, a blend's partner, a textured material).
+// an area light's share, glass, a blend's partner, a textured material). With Sobol's draws,
+// the light's and the BSDF's pairs are drawn ahead too, at pathLightDrawOffset and
+// pathBsdfDrawOffset past the sampler (RoundLanes::drawAhead); on the buddha, a wrong pair put
+// there changes the path: the offsets are where pathShade draws.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -32,6 +35,13 @@ void expectSameLd(const LightSampleLd& a, const LightSampleLd& b, const std::str
   ASSERT_EQ(a.tMax, b.tMax) << where;
 }
 
+// smp's 2D draw at dimension dim.
+Draw2DAhead drawAt(const Sampler& smp, uint32_t dim) {
+  Sampler at = smp;
+  at.dim = dim;
+  return {at.get2D(), dim};
+}
+
 }  // namespace
 
 TEST(PathIntegrator, ShadingWithItsFirstStepsDoneAheadIsTheSame) {
@@ -47,7 +57,8 @@ TEST(PathIntegrator, ShadingWithItsFirstStepsDoneAheadIsTheSame) {
     Bvh bvh(scene);
     BvhTracer tracer{bvh.view()};
     const SceneView& sc = scene.view();
-    int shaded = 0, productDraws = 0;
+    int shaded = 0, productDraws = 0, bsdfDrawsTaken = 0;
+    const bool sobol = k.sequence.type == SamplerType::Sobol;
     for (int y = 0; y < 16; ++y)
       for (int x = 0; x < 16; ++x)
         for (int s = 0; s < 4; ++s) {
@@ -64,9 +75,27 @@ TEST(PathIntegrator, ShadingWithItsFirstStepsDoneAheadIsTheSame) {
             ShadeAhead ahead;
             ProductDrawAhead draw;
             const ShadeAhead* pre = nullptr;
+            Draw2DAhead uL;
+            if (found && sobol) {
+              uL = drawAt(smp, smp.dim + pathLightDrawOffset());
+              ahead.ub = drawAt(smp, smp.dim + pathBsdfDrawOffset(k.path));
+            }
             if (found) {
-              productDraws += pathShadeAhead(sc, st, h, smp, k.path, &ahead, &draw);
+              productDraws += pathShadeAhead(sc, st, h, smp, k.path, &ahead, &draw, sobol ? &uL : nullptr);
               pre = &ahead;
+            }
+            if (found && sobol) {
+              // A pair that is not the draw, where the BSDF's should be: taken, it moves the path.
+              PathState c = st;
+              Sampler sc2 = smp;
+              ShadeAhead wrong = ahead;
+              wrong.ub.u = Vec2f(0.5f * (ahead.ub.u.x + 0.37f), 1.f - ahead.ub.u.y);
+              LightSampleLd ldc;
+              const bool gc = pathShade(sc, &c, found, h, sc2, k.path, KeepLd{&ldc}, &wrong);
+              Sampler sa2 = smp;
+              PathState a2 = st;
+              const bool ga2 = pathShade(sc, &a2, found, h, sa2, k.path, KeepLd{&ldc});
+              bsdfDrawsTaken += gc != ga2 || c.ray.d.x != a2.ray.d.x || c.ray.d.y != a2.ray.d.y;
             }
             const bool gb = pathShade(sc, &b, found, h, sb, k.path, KeepLd{&ldb}, pre);
             const std::string where = name + " pixel " + std::to_string(x) + "," + std::to_string(y) + " depth " +
@@ -89,6 +118,8 @@ TEST(PathIntegrator, ShadingWithItsFirstStepsDoneAheadIsTheSame) {
     EXPECT_GT(shaded, 100) << name;
     if (name == "buddha") {
       EXPECT_GT(productDraws, 100) << "buddha's map is drawn by the product strategy";
+      ASSERT_TRUE(sobol) << "buddha's ldsampler is Sobol's";
+      EXPECT_GT(bsdfDrawsTaken, shaded / 2) << "the BSDF's pair drawn ahead is the one pathShade takes";
     }
   }
 }
