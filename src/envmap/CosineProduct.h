@@ -54,7 +54,23 @@ ENVGI_INLINE float insidePixel(int p, float r, int n) {
 struct ProductDrawAhead {
   int k = -1, c = -1;  // the bucket; the cell, once known
   int lo = 0, hi = 0;  // the guide's bracket at the level being asked for
+  int j = -1;          // the pixel inside the cell, once known (level 4)
   Vec2f u;
+  Vec3f nLocal;
+};
+
+// A product draw made ahead to its end (CosineProductView::aheadDraw): what sample() returns for
+// u and nLocal, which EnvironmentMapView::sample takes where it draws for the very same u and
+// normal (and draws afresh for any other).
+struct ProductDraw {
+  Vec2f u;
+  Vec3f nLocal;
+  Vec2f uv;
+  float pdfUV = 0.f;
+  bool drawn = false;  // sample()'s answer: false where it draws nothing
+  ENVGI_HD bool isFor(Vec2f u2, Vec3f n2) const {
+    return u.x == u2.x && u.y == u2.y && nLocal.x == n2.x && nLocal.y == n2.y && nLocal.z == n2.z;
+  }
 };
 
 struct CosineProductView {
@@ -117,13 +133,19 @@ struct CosineProductView {
     if (!(bucketInt[k] > 0.f)) return false;
     const float* cdf = bucketCdf + size_t(k) * (n + 1);
     int c = findIntervalGuided(cdf, u.x, bucketGuide + size_t(k) * (bucketGuideSize + 1), bucketGuideSize);
+    const float* pc = cellCdf + cellCdfStart[c];
+    int j = findIntervalGuided(pc, u.y, cellGuide + size_t(c) * (cellGuideSize + 1), cellGuideSize);
+    return drawIn(u, k, c, j, uv, pdfOut);
+  }
+  // sample()'s end, once its searches found cell c (in bucket k's cdf) and pixel j of the cell.
+  ENVGI_HD bool drawIn(Vec2f u, int k, int c, int j, Vec2f* uv, float* pdfOut) const {
+    const float* cdf = bucketCdf + size_t(k) * (cells() + 1);
     float w1 = cdf[c + 1] - cdf[c];
     float r1 = w1 > 0.f ? (u.x - cdf[c]) / w1 : 0.5f;
     int cy = c / cellsX, cx = c - cy * cellsX;
     int x0 = cellStartX[cx], x1 = cellStartX[cx + 1], y0 = cellStartY[cy];
     int cw = x1 - x0;
     const float* pc = cellCdf + cellCdfStart[c];
-    int j = findIntervalGuided(pc, u.y, cellGuide + size_t(c) * (cellGuideSize + 1), cellGuideSize);
     float w2 = pc[j + 1] - pc[j];
     float r2 = w2 > 0.f ? (u.y - pc[j]) / w2 : 0.5f;
     int jy = j / cw, px = x0 + (j - jy * cw), py = y0 + jy;
@@ -134,9 +156,11 @@ struct CosineProductView {
 
   // The levels of sample(u, nLocal)'s loads, asked for in order: level 0 the bucket's guide
   // entry, 1 its cdf bracket, 2 the cell's guide entry, 3 the cell's cdf bracket; level 4
-  // returns the pixel sample() will draw (false where it draws none).
+  // returns the pixel sample() will draw (false where it draws none); aheadDraw then ends the
+  // draw as sample() would, from the loads the levels made.
   void aheadLevel0(Vec2f u, Vec3f nLocal, ProductDrawAhead* a) const {
     a->u = u;
+    a->nLocal = nLocal;
     a->k = bucket(nLocal);
     if (!(bucketInt[a->k] > 0.f)) { a->k = -1; return; }
     prefetchLine(bucketGuide + size_t(a->k) * (bucketGuideSize + 1) + guideSlot(u.x, bucketGuideSize));
@@ -164,15 +188,21 @@ struct CosineProductView {
     prefetchLine(pc + a->lo);
     prefetchLine(pc + a->hi);
   }
-  bool aheadLevel4(const ProductDrawAhead& a, int* px, int* py) const {
-    if (a.k < 0) return false;
-    const float* pc = cellCdf + cellCdfStart[a.c];
-    int j = findIntervalBetweenNoBranch(pc, a.lo, a.hi, a.u.y);
-    int cy = a.c / cellsX, cx = a.c - cy * cellsX;
+  bool aheadLevel4(ProductDrawAhead* a, int* px, int* py) const {
+    if (a->k < 0) return false;
+    const float* pc = cellCdf + cellCdfStart[a->c];
+    const int j = a->j = findIntervalBetweenNoBranch(pc, a->lo, a->hi, a->u.y);
+    int cy = a->c / cellsX, cx = a->c - cy * cellsX;
     int x0 = cellStartX[cx], cw = cellStartX[cx + 1] - x0;
     int jy = j / cw;
     *px = x0 + (j - jy * cw), *py = cellStartY[cy] + jy;
     return true;
+  }
+  ProductDraw aheadDraw(const ProductDrawAhead& a) const {
+    ProductDraw d;
+    d.u = a.u, d.nLocal = a.nLocal;
+    if (a.k >= 0) d.drawn = drawIn(a.u, a.k, a.c, a.j, &d.uv, &d.pdfUV);
+    return d;
   }
 
   // Where pdf() reads for (uv, nLocal): the bucket, the cell and the pixel inside the cell.

@@ -296,8 +296,10 @@ struct EnvironmentMapView {
 
   // Draws a direction; `normal` (world space) is used by the cosine and product strategies
   // only. A zero normal (a BSDF that also transmits) means the whole sphere: the cosine strategy
-  // then samples uniformly and the product strategy by Algorithm 1's density.
-  ENVGI_HD EnvSample sample(EnvStrategy s, Vec2f u, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
+  // then samples uniformly and the product strategy by Algorithm 1's density. drawn: a product
+  // draw made ahead (CPU: renderTileByBounce's walk), taken where it is for this u and normal.
+  ENVGI_HD EnvSample sample(EnvStrategy s, Vec2f u, Vec3f normal = Vec3f(0.f, 1.f, 0.f),
+                            const ProductDraw* drawn = nullptr) const {
     EnvSample out;
     Vec3f local;
     switch (strategyFor(s, normal)) {
@@ -337,7 +339,13 @@ struct EnvironmentMapView {
       }
       case EnvStrategy::Product: {
         float pdfUV;
-        if (!product.sample(u, toLocalUnnormalized(normal), &out.uv, &pdfUV)) return out;
+        const Vec3f nLocal = toLocalUnnormalized(normal);
+        if (drawn && drawn->isFor(u, nLocal)) {
+          if (!drawn->drawn) return out;
+          out.uv = drawn->uv, pdfUV = drawn->pdfUV;
+        } else if (!product.sample(u, nLocal, &out.uv, &pdfUV)) {
+          return out;
+        }
         out.uv = placeInPixel(out.uv, &pdfUV);
         local = uvToDir(out.uv);
         out.pdf = solidAnglePdf(pdfUV, out.uv.y);

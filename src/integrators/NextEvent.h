@@ -26,11 +26,12 @@ struct LightSampleLd {
 // si.partnerWeight (materials/BsdfMix.h). The kind of light is picked by uL.x (sampleLight), so
 // the dimension a choice of its own once took is skipped, as is the area light's second pair
 // where the map is the only light (the image stays the same there). uLDrawn: the light's 2D
-// draw where the caller took it ahead from a copy of smp (lightDrawOf), stepped over here.
+// draw where the caller took it ahead from a copy of smp (lightDrawOf), stepped over here;
+// productDrawn: the map's product draw for it, made ahead (sampleLight's).
 ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
                                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
                                         Sampler& smp, const Bsdf* partner = nullptr,
-                                        const Vec2f* uLDrawn = nullptr) {
+                                        const Vec2f* uLDrawn = nullptr, const ProductDraw* productDrawn = nullptr) {
   LightSampleLd out;
   const bool mapOnly = sc.envSelectProb() == 1.f;  // sampleLight then takes the map for any uL
   smp.skip1D();
@@ -39,7 +40,7 @@ ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceIntera
   else uL = smp.get2D();
   Vec2f uL2 = smp.get2DIf(!mapOnly);
   LightSample ls;
-  if (bsdfMixIsDelta(bsdf, partner) || !sampleLight(sc, si, axis, strategy, uL, uL2, &ls)) return out;
+  if (bsdfMixIsDelta(bsdf, partner) || !sampleLight(sc, si, axis, strategy, uL, uL2, &ls, productDrawn)) return out;
   Vec3f wiLocal = si.shading.toLocal(ls.dir);
   float bsdfPdfOfLight;
   Color f = bsdfMixEvalPdf(bsdf, partner, si.partnerWeight, woLocal, wiLocal, &bsdfPdfOfLight);

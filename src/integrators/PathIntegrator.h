@@ -46,6 +46,9 @@ struct ShadeAhead {
   Vec2f uL;
   bool drawn = false;  // uL holds prepareLd's draw
   Draw2DAhead ub;      // the BSDF's pair, where it was drawn ahead (pathBsdfDrawOffset)
+  // The map's product draw for uL, where the executor walked it to its end (aheadDraw).
+  bool productAhead = false;
+  ProductDraw product;
   // For a ray that escaped: where it meets the map, found ahead (RoundLanes::mapUV); pathShade
   // then looks the map up there instead of finding (u, v) again.
   bool escaped = false;
@@ -109,7 +112,8 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   // Next-event estimation, weighted against this bounce's BSDF sample.
   if (pp.lightSample)
     shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, pp.bsdfSample ? 1.f : 0.f, smp, partner,
-                     ahead && ahead->drawn ? &ahead->uL : nullptr),
+                     ahead && ahead->drawn ? &ahead->uL : nullptr,
+                     ahead && ahead->productAhead ? &ahead->product : nullptr),
            st);
   if (!pp.bsdfSample) return false;
 
@@ -154,6 +158,7 @@ inline bool pathShadeAhead(const SceneView& sc, const PathState& st, const Hit& 
                            const PathParams& pp, ShadeAhead* ahead, ProductDrawAhead* draw,
                            const Draw2DAhead* uL = nullptr) {
   ahead->si = sc.interaction(st.ray, h);
+  ahead->productAhead = false;
   ahead->drawn = pp.lightSample && !(pp.maxDepth >= 0 && st.depth >= pp.maxDepth);
   if (!ahead->drawn) return false;
   ahead->uL = uL && uL->dim == smp.dim + pathLightDrawOffset() ? uL->u : lightDrawOf(smp);

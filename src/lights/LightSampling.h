@@ -89,12 +89,13 @@ inline ENVGI_HD_NOINLINE bool sampleDeltaOrAreaLight(const SceneView& sc, const 
 // that light's own draw (sample reuse, as Mitsuba's emitter selection does): the draws that land
 // on one kind keep the sequence's strata, where a draw of their own handed each kind a random
 // subset of the points. With the map the only light, u is the map's draw as it is.
+// productDrawn: the map's product draw made ahead (EnvironmentMapView::sample's drawn).
 ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si, Vec3f axis, EnvStrategy strategy,
-                              Vec2f u, Vec2f u2, LightSample* ls) {
+                              Vec2f u, Vec2f u2, LightSample* ls, const ProductDraw* productDrawn = nullptr) {
   float pe = sc.envSelectProb();
   if (!(u.x < pe)) return sampleDeltaOrAreaLight(sc, si, pe, u, u2, ls);
   if (pe < 1.f) u.x = stretchedDraw(u.x, 0.f, pe);
-  EnvSample es = sc.env.sample(strategy, u, axis);
+  EnvSample es = sc.env.sample(strategy, u, axis, productDrawn);
   if (!(es.pdf > 0.f)) return false;
   ls->dir = es.dir;
   ls->dist = INFINITY;

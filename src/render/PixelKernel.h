@@ -384,7 +384,13 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       for (int i = 0; i < draws; ++i) env.product.aheadLevel3(&b->draw[b->drawing[i]]);
       for (int i = 0; i < draws; ++i) {
         int px, py;
-        if (env.product.aheadLevel4(b->draw[b->drawing[i]], &px, &py)) env.prefetchPixel(px, py);
+        if (env.product.aheadLevel4(&b->draw[b->drawing[i]], &px, &py)) env.prefetchPixel(px, py);
+      }
+      // Each draw's end, from what the levels loaded: prepareLd takes it instead of drawing again.
+      for (int i = 0; i < draws; ++i) {
+        ShadeAhead& a = b->ahead[b->drawing[i]];
+        a.product = env.product.aheadDraw(b->draw[b->drawing[i]]);
+        a.productAhead = true;
       }
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];

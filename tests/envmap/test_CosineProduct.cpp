@@ -253,6 +253,7 @@ TEST(CosineProduct, PrefetchingAnEscapeReadsInsideTheTables) {
 // The draw walked a level at a time across a batch (renderTileByBounce's prefetching) reaches
 // the pixel sample() draws for the same u and normal, in odd-sized maps too; it gives up only
 // where sample() draws nothing (a bucket that sees no light).
+// Ended there (aheadDraw), it is sample()'s draw to the bit, and says which u and normal it is for.
 TEST(CosineProduct, ADrawWalkedLevelByLevelReachesTheDrawnPixel) {
   Image below(64, 32);  // lit from below the horizon only
   for (int y = 0; y < 32; ++y)
@@ -273,12 +274,20 @@ TEST(CosineProduct, ADrawWalkedLevelByLevelReachesTheDrawnPixel) {
       p.aheadLevel2(&a);
       p.aheadLevel3(&a);
       int px = -1, py = -1;
-      const bool walked = p.aheadLevel4(a, &px, &py);
+      const bool walked = p.aheadLevel4(&a, &px, &py);
       Vec2f uv;
       float pdf;
       const bool drawn = p.sample(u, nl, &uv, &pdf);
       ASSERT_TRUE(walked || !drawn) << i;
+      // Walked to its end, the draw is sample()'s to the bit (prepareLd then takes it).
+      const ProductDraw ended = p.aheadDraw(a);
+      ASSERT_EQ(ended.drawn, drawn) << i;
+      ASSERT_TRUE(ended.isFor(u, nl)) << i;
+      ASSERT_FALSE(ended.isFor(Vec2f(u.x, 1.f - u.y), nl)) << i;
       if (!drawn) continue;
+      ASSERT_EQ(ended.uv.x, uv.x) << i;
+      ASSERT_EQ(ended.uv.y, uv.y) << i;
+      ASSERT_EQ(ended.pdfUV, pdf) << i;
       ++reached;
       ASSERT_EQ(px, std::min(int(uv.x * float(img.width)), img.width - 1)) << i;
       ASSERT_EQ(py, std::min(int(uv.y * float(img.height)), img.height - 1)) << i;
