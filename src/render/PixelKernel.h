@@ -251,12 +251,21 @@ struct ShadowRayLater {
   }
 };
 
-// The i-th pixel of a tile tw wide (a multiple of 4) taken in 4 x 4 blocks, row by row of
-// blocks: its index in the tile's row-major order.
-inline int blockOrderSlot(int i, int tw) {
-  const int block = i >> 4, lane = i & 15, blocksAcross = tw >> 2;
-  const int x = (block % blocksAcross) * 4 + (lane & 3), y = (block / blocksAcross) * 4 + (lane >> 2);
-  return y * tw + x;
+// The pixels of a tile tw x th, in 4 x 4 blocks, row by row of blocks, where both sides are
+// multiples of 4 (16 pixels in a row are then a square, for the camera's packets), else row by
+// row: f(k, dx, dy) with k the pixel's index in the tile's row-major order, at (dx, dy) in it.
+// Loops, not an index turned into a pixel: that took two integer divisions a camera ray.
+template <class F>
+inline void forEachTilePixel(int tw, int th, F f) {
+  if (tw % 4 == 0 && th % 4 == 0) {
+    for (int by = 0; by < th; by += 4)
+      for (int bx = 0; bx < tw; bx += 4)
+        for (int ly = by; ly < by + 4; ++ly)
+          for (int lx = bx; lx < bx + 4; ++lx) f(ly * tw + lx, lx, ly);
+  } else {
+    for (int dy = 0; dy < th; ++dy)
+      for (int dx = 0; dx < tw; ++dx) f(dy * tw + dx, dx, dy);
+  }
 }
 
 // Samples [s0, s1) of the tile [x0, x1) x [y0, y1) a bounce at a time (CPU): sample s of every
@@ -282,9 +291,11 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
     // With Sobol's draws, the round's camera samples are made lane by lane (RoundLanes).
     const bool inLanes = RoundLanes::handles(first);
     RoundLanes& lanes = b->lanes;
-    for (int k = 0, x = x0, y = y0; k < n; ++k, x = x + 1 < x1 ? x + 1 : x0, y += x == x0) {
+    // The tile's pixels in 4 x 4 blocks, so that the camera's packets of 16 are squares.
+    forEachTilePixel(tw, y1 - y0, [&](int k, int dx, int dy) {
+      const int x = x0 + dx, y = y0 + dy;
       const uint64_t pixel = uint64_t(y) * uint64_t(cam.width) + uint64_t(x);
-      if (!film.takesSamples(size_t(pixel))) continue;
+      if (!film.takesSamples(size_t(pixel))) return;
       if (inLanes) {
         lanes.px[live] = x, lanes.py[live] = y;
       } else {
@@ -293,7 +304,7 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         b->state[k] = integ.begin(sampleCameraRay(cam, b->sampler[k], x, y, &b->weight[k]));
       }
       b->active[live++] = k;
-    }
+    });
     if (inLanes) {
       lanes.make(cam, first, live);
       const uint32_t dims = RoundLanes::dimensions(cam);
@@ -307,14 +318,12 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
     }
     for (bool cameraRays = true; live > 0; cameraRays = false) {
       if (cameraRays) {
-        // Coherent: the tracer may trace them together, the tile's pixels in 4 x 4 blocks
-        // where every pixel takes the sample and the tile's sides are multiples of 4.
-        const bool blocks = live == n && tw % 4 == 0 && (y1 - y0) % 4 == 0;
-        auto slot = [&](int i) { return blocks ? blockOrderSlot(i, tw) : b->active[i]; };
+        // Coherent: the tracer may trace them together, in the order of b->active, which
+        // takes the tile's pixels in 4 x 4 blocks (forEachTilePixel).
         integ.tracer.intersectCoherent(
-            live, [&](int i) -> const Ray& { return b->state[slot(i)].ray; },
+            live, [&](int i) -> const Ray& { return b->state[b->active[i]].ray; },
             [&](int i, bool found, const Hit& h) {
-              const int k = slot(i);
+              const int k = b->active[i];
               b->found[k] = found;
               if (found) b->hit[k] = h;
             });

@@ -222,22 +222,32 @@ TEST(PixelKernel, TileByBounceOverEmbreePacketsAddsTheSameSamplesAsRenderPixel) 
 }
 
 // The 4 x 4 block order visits each pixel of a tile once, and its first 16 are a 4 x 4 block.
-TEST(PixelKernel, BlockOrderIsAPermutationOfTheTile) {
-  for (int tw : {4, 8, 16}) {
-    const int n = tw * 12;
-    std::vector<int> count(size_t(n), 0);
-    for (int i = 0; i < n; ++i) {
-      const int k = blockOrderSlot(i, tw);
-      ASSERT_GE(k, 0);
-      ASSERT_LT(k, n);
-      ++count[size_t(k)];
+// Every pixel of a tile once, with its place; with both sides multiples of 4, each 16 in a row
+// are a 4 x 4 square, else the tile goes row by row.
+TEST(PixelKernel, TilePixelsGoInBlocksOfFourByFour) {
+  for (int tw : {4, 8, 16, 6})
+    for (int th : {12, 4, 7}) {
+      const int n = tw * th;
+      const bool blocks = tw % 4 == 0 && th % 4 == 0;
+      std::vector<int> count(size_t(n), 0), order;
+      forEachTilePixel(tw, th, [&](int k, int dx, int dy) {
+        ASSERT_EQ(k, dy * tw + dx);
+        ASSERT_GE(k, 0);
+        ASSERT_LT(k, n);
+        ++count[size_t(k)];
+        order.push_back(k);
+      });
+      for (int k = 0; k < n; ++k) EXPECT_EQ(count[size_t(k)], 1) << tw << " x " << th << ", pixel " << k;
+      for (size_t i = 0; i < order.size(); ++i) {
+        if (blocks) {
+          const int first = order[i - i % 16];
+          EXPECT_EQ(order[i] % tw - first % tw, int(i % 4)) << tw << " x " << th;
+          EXPECT_EQ(order[i] / tw - first / tw, int(i % 16 / 4)) << tw << " x " << th;
+        } else {
+          EXPECT_EQ(order[i], int(i)) << tw << " x " << th;
+        }
+      }
     }
-    for (int k = 0; k < n; ++k) EXPECT_EQ(count[size_t(k)], 1) << tw << " wide, pixel " << k;
-    for (int i = 0; i < 16; ++i) {
-      EXPECT_LT(blockOrderSlot(i, tw) % tw, 4) << tw;
-      EXPECT_LT(blockOrderSlot(i, tw) / tw, 4) << tw;
-    }
-  }
 }
 
 // With a filter with negative lobes (Lanczos), the three bodies add the same weighted sums and
