@@ -67,6 +67,39 @@ struct ShadowRayNow {
   }
 };
 
+// What a path's ray that escaped sees of the map: radiance Le, whose MIS weight is w (the
+// path adds beta * Le * w). uv: where the ray meets the map, found ahead (or none).
+struct EscapedLight {
+  Color Le;
+  float w = 0.f;
+  bool seen = false;  // false: the ray adds nothing (no map, a hidden one, or one drawn only)
+};
+ENVGI_HD inline EscapedLight pathEscape(const SceneView& sc, const PathState& st, const PathParams& pp,
+                                        const Vec2f* uv) {
+  EscapedLight e;
+  if (!(sc.hasEnvironment && !(st.depth == 1 && pp.hideEmitters) && envSeenByBsdfSampling(pp.envStrategy, st.prevDelta)))
+    return e;
+  // What this ray finds takes no MIS weight where no light sample could have drawn it: after a
+  // delta bounce, or without next-event estimation. Nor is the map's light density read then.
+  const bool unweighted = st.prevDelta || !pp.lightSample;
+  float lightPdf = 0.f;
+  e.Le = unweighted ? (uv ? sc.env.lookupUV(*uv) : sc.env.eval(st.ray.d))
+                    : envRadianceAndPdf(sc, pp.envStrategy, st.ray.d, st.prevAxis, &lightPdf, uv);
+  e.w = unweighted ? 1.f : powerHeuristic(1.f, st.prevPdf, 1.f, lightPdf);
+  e.seen = true;
+  return e;
+}
+
+// What a camera ray that escaped adds: pathShade's sum for it, begun at pathBegin (beta 1, no
+// delta before it), without a PathState (the CPU's camera rounds: RoundLanes).
+ENVGI_HD inline Color cameraEscape(const SceneView& sc, const Ray& ray, const PathParams& pp, const Vec2f* uv) {
+  const PathState st = pathBegin(ray);
+  const EscapedLight e = pathEscape(sc, st, pp, uv);
+  Color L = st.L;
+  if (e.seen) L += st.beta * e.Le * e.w;
+  return L;
+}
+
 // One bounce of the path after st->ray has been traced (found: whether it hit, h: where): add
 // what it sees to st->L, hand next-event estimation's sample to shadow (ShadowRayNow or an
 // executor's batch), sample the BSDF for the next ray. Returns false once the path has ended.
@@ -77,20 +110,14 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
                         const PathParams& pp, const Shadow& shadow, const ShadeAhead* ahead = nullptr) {
   const int depth = st->depth;
   const Ray& ray = st->ray;
-  // What this ray finds of a light takes no MIS weight where no light sample could have drawn
-  // it: after a delta bounce, or without next-event estimation. Nor is its light density read.
-  const bool unweighted = st->prevDelta || !pp.lightSample;
   if (!found) {
-    if (sc.hasEnvironment && !(depth == 1 && pp.hideEmitters) && envSeenByBsdfSampling(pp.envStrategy, st->prevDelta)) {
-      float lightPdf = 0.f;
-      const Vec2f* uv = ahead && ahead->escaped ? &ahead->uv : nullptr;
-      Color Le = unweighted ? (uv ? sc.env.lookupUV(*uv) : sc.env.eval(ray.d))
-                            : envRadianceAndPdf(sc, pp.envStrategy, ray.d, st->prevAxis, &lightPdf, uv);
-      float w = unweighted ? 1.f : powerHeuristic(1.f, st->prevPdf, 1.f, lightPdf);
-      st->L += st->beta * Le * w;
-    }
+    const EscapedLight e = pathEscape(sc, *st, pp, ahead && ahead->escaped ? &ahead->uv : nullptr);
+    if (e.seen) st->L += st->beta * e.Le * e.w;
     return false;
   }
+  // As for an escaped ray (pathEscape), an emitter hit takes no MIS weight where no light
+  // sample could have drawn it.
+  const bool unweighted = st->prevDelta || !pp.lightSample;
   const SurfaceInteraction si = ahead ? ahead->si : sc.interaction(ray, h);
   Vec3f wo = -ray.d;
   if (si.light >= 0 && !(depth == 1 && pp.hideEmitters)) {

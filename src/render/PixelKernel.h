@@ -305,19 +305,52 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       }
       b->active[live++] = k;
     });
-    if (inLanes) {
+    // A path's end: its radiance, times its filter weight, into its pixel's sums.
+    auto finish = [&](int k, const Color& Lpath) {
+      if (!acceptedSample(Lpath, counters)) return;
+      const Color L = Lpath * b->weight[k];
+      b->acc[k] += L;
+      b->accSq[k] += double(luminance(L)) * double(luminance(L));
+      b->accW[k] += b->weight[k];
+    };
+    // Made in lanes, the camera round is traced from the lanes' arrays; a ray that escapes adds
+    // what it sees (cameraEscape, where the map is looked up from mapUV's coordinates) and ends
+    // there, and only the rays that hit become paths (a sampler and a PathState each).
+    const bool laneRound = inLanes && live > 0;
+    if (laneRound) {
       lanes.make(cam, first, live);
+      integ.tracer.intersectCoherent(
+          live, [&](int i) { return lanes.rayOf(i); },
+          [&](int i, bool found, const Hit& h) {
+            const int k = b->active[i];
+            b->found[k] = found;
+            if (found) b->hit[k] = h;
+          });
+      counters->rays += uint64_t(live);
+      const SceneView& sc = *integ.scene;
+      if (sc.hasEnvironment) lanes.mapUV(sc.env, live);
+      const PathParams pp = integ.shadedPath();
       const uint32_t dims = RoundLanes::dimensions(cam);
+      int hits = 0;
       for (int i = 0; i < live; ++i) {
         const int k = b->active[i];
+        b->weight[k] = lanes.weight[i];
+        if (!b->found[k]) {
+          const Vec2f uv = lanes.uvOf(i);
+          finish(k, cameraEscape(sc, lanes.rayOf(i), pp, sc.hasEnvironment ? &uv : nullptr));
+          continue;
+        }
         b->sampler[k] = first;
         b->sampler[k].startPixelAt(lanes.hash[i], dims);
-        b->weight[k] = lanes.weight[i];
         b->state[k] = integ.begin(lanes.rayOf(i));
+        b->active[hits++] = k;
       }
+      live = hits;
     }
     for (bool cameraRays = true; live > 0; cameraRays = false) {
-      if (cameraRays) {
+      if (cameraRays && laneRound) {
+        // Traced above: every path left is a hit.
+      } else if (cameraRays) {
         // Coherent: the tracer may trace them together, in the order of b->active, which
         // takes the tile's pixels in 4 x 4 blocks (forEachTilePixel).
         integ.tracer.intersectCoherent(
@@ -337,7 +370,7 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
               if (found) b->hit[k] = h;
             });
       }
-      counters->rays += uint64_t(live);
+      if (!(cameraRays && laneRound)) counters->rays += uint64_t(live);
       // Ask for the hit triangles' indices, then their vertices, for the whole round before
       // shading it, so that interaction()'s misses overlap instead of following one another;
       // likewise the map's texels and cdf steps that the escaped rays' MIS weights read.
@@ -421,11 +454,8 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         if (ld.needsRay) b->state[k].L += b->ldBeta[k] * resolvedLd(ld, b->blocked[k] != 0);
         if (b->going[k]) {
           b->active[next++] = k;
-        } else if (acceptedSample(b->state[k].L, counters)) {
-          const Color L = b->state[k].L * b->weight[k];
-          b->acc[k] += L;
-          b->accSq[k] += double(luminance(L)) * double(luminance(L));
-          b->accW[k] += b->weight[k];
+        } else {
+          finish(k, b->state[k].L);
         }
       }
       live = next;

@@ -127,6 +127,29 @@ TEST(PixelKernel, TileByBounceAddsTheSameSamplesAsRenderPixel) {
     }
 }
 
+// With the map hidden from the camera (hide_emitters), the camera rays that escape add nothing,
+// whether they end in the camera round's lanes (cameraEscape) or in renderPixel's pathShade;
+// what the rays that hit see of the map is there, and the same to the bit.
+TEST(PixelKernel, HiddenEmittersEscapeTheSameWayByBounce) {
+  SmallScene small("buddha", IntegratorType::Path);
+  small.k.path.hideEmitters = true;
+  SampleIntegrator<BvhTracer> integ = small.integrator();
+  ASSERT_EQ(small.k.sequence.type, SamplerType::Sobol) << "the camera round runs in lanes";
+  const Camera& cam = small.scene.view().camera;
+  const size_t npix = size_t(cam.width) * cam.height;
+  Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
+  PixelCounters ca, cb;
+  TileBatch batch;
+  renderBothWays(cam, small.k.sequence, integ, 0, 4, &a, &b, &ca, &cb, &batch);
+  EXPECT_EQ(ca.rays, cb.rays);
+  EXPECT_EQ(std::memcmp(a.sum.data(), b.sum.data(), npix * sizeof(Color)), 0);
+  EXPECT_EQ(std::memcmp(a.sumSq.data(), b.sumSq.data(), npix * sizeof(double)), 0);
+  int black = 0, lit = 0;
+  for (const Color& c : a.sum) (c.x + c.y + c.z == 0.f ? black : lit)++;
+  EXPECT_GT(black, int(npix / 4)) << "the background is hidden";
+  EXPECT_GT(lit, 20) << "the buddha is lit by the map";
+}
+
 // direct runs by bounce where it is a one-bounce path (at most one light and one BSDF sample:
 // the bundled scenes', the paper's and the study's settings), and per pixel with more, which
 // trace several rays from one shading point.
