@@ -65,13 +65,6 @@ ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceIntera
   return out;
 }
 
-// The light's 2D draw prepareLd will take from smp as it stands, taken from a copy.
-ENVGI_HD inline Vec2f lightDrawOf(const Sampler& smp) {
-  Sampler peek = smp;
-  peek.skip1D();
-  return peek.get2D();
-}
-
 // A 2D draw made ahead (the CPU's RoundLanes::drawAhead, a round's draws in vector lanes) for
 // the dimension pair that starts at dim; taken where the sampler stands there, drawn afresh
 // anywhere else, so an executor that guesses the dimension wrong loses time, never the image.
@@ -85,6 +78,14 @@ ENVGI_HD inline Vec2f get2DOrAhead(Sampler& smp, const Draw2DAhead* ahead) {
     return ahead->u;
   }
   return smp.get2D();
+}
+
+// The light's 2D draw prepareLd will take from smp as it stands, taken from a copy (or the
+// draw made ahead for that dimension, if it is one: get2DOrAhead).
+ENVGI_HD inline Vec2f lightDrawOf(const Sampler& smp, const Draw2DAhead* ahead = nullptr) {
+  Sampler peek = smp;
+  peek.skip1D();
+  return get2DOrAhead(peek, ahead);
 }
 
 // The sample's contribution once its shadow ray's answer is known.

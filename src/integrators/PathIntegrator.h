@@ -188,7 +188,7 @@ inline bool pathShadeAhead(const SceneView& sc, const PathState& st, const Hit& 
   ahead->productAhead = false;
   ahead->drawn = pp.lightSample && !(pp.maxDepth >= 0 && st.depth >= pp.maxDepth);
   if (!ahead->drawn) return false;
-  ahead->uL = uL && uL->dim == smp.dim + pathLightDrawOffset() ? uL->u : lightDrawOf(smp);
+  ahead->uL = lightDrawOf(smp, uL);
   // The material's own entry, untextured: its type is all that is asked of it here.
   const Bsdf& bsdf = sc.bsdfs[ahead->si.bsdf];
   Vec2f u = ahead->uL;

@@ -305,6 +305,12 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       }
       b->active[live++] = k;
     });
+    // A traced ray's answer for the round's i-th path.
+    auto keepHit = [&](int i, bool found, const Hit& h) {
+      const int k = b->active[i];
+      b->found[k] = found;
+      if (found) b->hit[k] = h;
+    };
     // A path's end: its radiance, times its filter weight, into its pixel's sums.
     auto finish = [&](int k, const Color& Lpath) {
       if (!acceptedSample(Lpath, counters)) return;
@@ -319,13 +325,7 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
     const bool laneRound = inLanes && live > 0;
     if (laneRound) {
       lanes.make(cam, first, live);
-      integ.tracer.intersectCoherent(
-          live, [&](int i) { return lanes.rayOf(i); },
-          [&](int i, bool found, const Hit& h) {
-            const int k = b->active[i];
-            b->found[k] = found;
-            if (found) b->hit[k] = h;
-          });
+      integ.tracer.intersectCoherent(live, [&](int i) { return lanes.rayOf(i); }, keepHit);
       counters->rays += uint64_t(live);
       const SceneView& sc = *integ.scene;
       if (sc.hasEnvironment) lanes.mapUV(sc.env, live);
@@ -348,29 +348,16 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       live = hits;
     }
     for (bool cameraRays = true; live > 0; cameraRays = false) {
-      if (cameraRays && laneRound) {
-        // Traced above: every path left is a hit.
-      } else if (cameraRays) {
-        // Coherent: the tracer may trace them together, in the order of b->active, which
-        // takes the tile's pixels in 4 x 4 blocks (forEachTilePixel).
-        integ.tracer.intersectCoherent(
-            live, [&](int i) -> const Ray& { return b->state[b->active[i]].ray; },
-            [&](int i, bool found, const Hit& h) {
-              const int k = b->active[i];
-              b->found[k] = found;
-              if (found) b->hit[k] = h;
-            });
-      } else {
-        // Incoherent: the tracer may trace them as one stream.
-        integ.tracer.intersectMany(
-            live, [&](int i) -> const Ray& { return b->state[b->active[i]].ray; },
-            [&](int i, bool found, const Hit& h) {
-              const int k = b->active[i];
-              b->found[k] = found;
-              if (found) b->hit[k] = h;
-            });
+      // A camera round made in lanes was traced above: every path left is a hit.
+      if (!(cameraRays && laneRound)) {
+        auto rayOfPath = [&](int i) -> const Ray& { return b->state[b->active[i]].ray; };
+        // Coherent camera rays: the tracer may trace them together, in the order of b->active,
+        // which takes the tile's pixels in 4 x 4 blocks (forEachTilePixel). Incoherent bounce
+        // rays: the tracer may trace them as one stream.
+        if (cameraRays) integ.tracer.intersectCoherent(live, rayOfPath, keepHit);
+        else integ.tracer.intersectMany(live, rayOfPath, keepHit);
+        counters->rays += uint64_t(live);
       }
-      if (!(cameraRays && laneRound)) counters->rays += uint64_t(live);
       // Ask for the hit triangles' indices, then their vertices, for the whole round before
       // shading it, so that interaction()'s misses overlap instead of following one another;
       // likewise the map's texels and cdf steps that the escaped rays' MIS weights read.

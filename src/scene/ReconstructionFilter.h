@@ -72,15 +72,15 @@ ENVGI_HD inline float sampleTabulatedAxis(const ReconstructionFilter& f, float u
   return left ? -ax : ax;
 }
 
-// The offset and weight of a sample drawn from the filter. box, tent and gaussian are drawn
-// exactly (weight one); gaussian is not truncated (Mitsuba's is, at 4 sigma: 3e-4 of its mass).
-// The box's: the offset is the draw, centred.
+// The box's sample: the offset is the draw, centred.
 ENVGI_HD inline FilterSample sampleBoxFilter(Vec2f u) {
   FilterSample s;
   s.offset = {u.x - 0.5f, u.y - 0.5f};
   return s;
 }
 
+// The offset and weight of a sample drawn from the filter. box, tent and gaussian are drawn
+// exactly (weight one); gaussian is not truncated (Mitsuba's is, at 4 sigma: 3e-4 of its mass).
 ENVGI_HD inline FilterSample sampleFilter(const ReconstructionFilter& f, Vec2f u) {
   FilterSample s;
   switch (f.type) {
