@@ -84,16 +84,26 @@ struct EnvironmentMapView {
     return {st * std::sin(phi), std::cos(theta), -st * std::cos(phi)};
   }
 
-  ENVGI_HD Color texel(int x, int y) const {
-    const float* p = texels + (size_t(y) * width + x) * 4;
-    return {p[0], p[1], p[2]};
+  ENVGI_HD Color texel(int x, int y) const { return texelIn(texels, width, x, y); }
+  // Index: what the texel's offset is counted in. 32 bits unsigned lets a loop of lookups gather
+  // (RoundLanes::mapRadiance), for a map of at most 2^30 pixels (fitsUnsignedIndex).
+  template <class Index = size_t>
+  ENVGI_HD static Color texelIn(const float* texels, int width, int x, int y) {
+    const Index i = (Index(y) * Index(width) + Index(x)) * Index(4);
+    return {texels[i], texels[i + 1], texels[i + 2]};
   }
+  ENVGI_HD bool fitsUnsignedIndex() const { return size_t(width) * size_t(height) <= (size_t(1) << 30); }
 
   // Bilinear between pixel centres, wrapping across the phi seam and clamping at the poles.
-  ENVGI_HD Color lookupUV(Vec2f uv) const {
+  ENVGI_HD Color lookupUV(Vec2f uv) const { return lookupIn(texels, width, height, rowsFromPoles, scale, bilinear, uv); }
+  // lookupUV from the members it reads, passed one by one: a loop over many lookups
+  // (RoundLanes::mapRadiance) holds them in registers and vectorises.
+  template <class Index = size_t>
+  ENVGI_HD static Color lookupIn(const float* texels, int width, int height, bool rowsFromPoles, float scale,
+                                 bool bilinear, Vec2f uv) {
     if (!bilinear) {
       int x = clampi(int(uv.x * width), 0, width - 1), y = clampi(int(uv.y * height), 0, height - 1);
-      return texel(x, y) * scale;
+      return texelIn<Index>(texels, width, x, y) * scale;
     }
     float fx = uv.x * width - 0.5f, fy = rowsFromPoles ? uv.y * float(height - 1) : uv.y * height - 0.5f;
     float x0f = std::floor(fx), y0f = std::floor(fy);
@@ -103,8 +113,9 @@ struct EnvironmentMapView {
     int xa = x0 < 0 ? x0 + width : (x0 >= width ? x0 - width : x0);
     int xb = xa + 1 < width ? xa + 1 : 0;
     int ya = clampi(y0, 0, height - 1), yb = clampi(y0 + 1, 0, height - 1);
-    Color c = (texel(xa, ya) * (1.f - tx) + texel(xb, ya) * tx) * (1.f - ty) +
-              (texel(xa, yb) * (1.f - tx) + texel(xb, yb) * tx) * ty;
+    Color c = (texelIn<Index>(texels, width, xa, ya) * (1.f - tx) + texelIn<Index>(texels, width, xb, ya) * tx) *
+                  (1.f - ty) +
+              (texelIn<Index>(texels, width, xa, yb) * (1.f - tx) + texelIn<Index>(texels, width, xb, yb) * tx) * ty;
     return c * scale;
   }
 

@@ -74,8 +74,9 @@ struct EscapedLight {
   float w = 0.f;
   bool seen = false;  // false: the ray adds nothing (no map, a hidden one, or one drawn only)
 };
+// radiance: the map's radiance at uv, looked up ahead (RoundLanes::mapRadiance), if it was.
 ENVGI_HD inline EscapedLight pathEscape(const SceneView& sc, const PathState& st, const PathParams& pp,
-                                        const Vec2f* uv) {
+                                        const Vec2f* uv, const Color* radiance = nullptr) {
   EscapedLight e;
   if (!(sc.hasEnvironment && !(st.depth == 1 && pp.hideEmitters) && envSeenByBsdfSampling(pp.envStrategy, st.prevDelta)))
     return e;
@@ -83,7 +84,7 @@ ENVGI_HD inline EscapedLight pathEscape(const SceneView& sc, const PathState& st
   // delta bounce, or without next-event estimation. Nor is the map's light density read then.
   const bool unweighted = st.prevDelta || !pp.lightSample;
   float lightPdf = 0.f;
-  e.Le = unweighted ? (uv ? sc.env.lookupUV(*uv) : sc.env.eval(st.ray.d))
+  e.Le = unweighted ? (radiance ? *radiance : uv ? sc.env.lookupUV(*uv) : sc.env.eval(st.ray.d))
                     : envRadianceAndPdf(sc, pp.envStrategy, st.ray.d, st.prevAxis, &lightPdf, uv);
   e.w = unweighted ? 1.f : powerHeuristic(1.f, st.prevPdf, 1.f, lightPdf);
   e.seen = true;
@@ -91,10 +92,12 @@ ENVGI_HD inline EscapedLight pathEscape(const SceneView& sc, const PathState& st
 }
 
 // What a camera ray that escaped adds: pathShade's sum for it, begun at pathBegin (beta 1, no
-// delta before it), without a PathState (the CPU's camera rounds: RoundLanes).
-ENVGI_HD inline Color cameraEscape(const SceneView& sc, const Ray& ray, const PathParams& pp, const Vec2f* uv) {
+// delta before it), without a PathState (the CPU's camera rounds: RoundLanes). radiance: the
+// map's radiance at uv, looked up ahead, if it was.
+ENVGI_HD inline Color cameraEscape(const SceneView& sc, const Ray& ray, const PathParams& pp, const Vec2f* uv,
+                                   const Color* radiance = nullptr) {
   const PathState st = pathBegin(ray);
-  const EscapedLight e = pathEscape(sc, st, pp, uv);
+  const EscapedLight e = pathEscape(sc, st, pp, uv, radiance);
   Color L = st.L;
   if (e.seen) L += st.beta * e.Le * e.w;
   return L;

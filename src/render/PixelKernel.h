@@ -328,16 +328,25 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       integ.tracer.intersectCoherent(live, [&](int i) { return lanes.rayOf(i); }, keepHit);
       counters->rays += uint64_t(live);
       const SceneView& sc = *integ.scene;
-      if (sc.hasEnvironment) lanes.mapUV(sc.env, live);
+      // The escaped rays' radiance, lane by lane, where they meet the map.
+      int escapes = 0;
+      if (sc.hasEnvironment) {
+        lanes.mapUV(sc.env, live);
+        for (int i = 0; i < live; ++i)
+          if (!b->found[b->active[i]]) lanes.picked[escapes++] = i;
+        lanes.mapRadiance(sc.env, escapes);
+      }
       const PathParams pp = integ.shadedPath();
       const uint32_t dims = RoundLanes::dimensions(cam);
       int hits = 0;
-      for (int i = 0; i < live; ++i) {
+      for (int i = 0, e = 0; i < live; ++i) {
         const int k = b->active[i];
         b->weight[k] = lanes.weight[i];
         if (!b->found[k]) {
           const Vec2f uv = lanes.uvOf(i);
-          finish(k, cameraEscape(sc, lanes.rayOf(i), pp, sc.hasEnvironment ? &uv : nullptr));
+          const Color Le = sc.hasEnvironment ? lanes.radianceOf(e++) : Color(0.f);
+          finish(k, cameraEscape(sc, lanes.rayOf(i), pp, sc.hasEnvironment ? &uv : nullptr,
+                                 sc.hasEnvironment ? &Le : nullptr));
           continue;
         }
         b->sampler[k] = first;

@@ -78,14 +78,28 @@ ENVGI_LANES void mapCoordinates(int n, const Transform& toWorld, const float* __
   }
 }
 
+// EnvironmentMapView::lookupUV, its texels gathered. The members it reads are passed apart, the
+// texels as restrict, so that the arrays written cannot alias them; its two flags are constants
+// of each instance, since GCC vectorises neither a select on a flag nor both of its branches.
+template <bool Bilinear, bool RowsFromPoles>
+ENVGI_LANES void mapLookups(int n, const float* __restrict texels, int width, int height, float scale,
+                            const int* __restrict at, const float* __restrict us, const float* __restrict vs,
+                            float* __restrict r, float* __restrict g, float* __restrict b) {
+  for (int j = 0; j < n; ++j) {
+    const Color c = EnvironmentMapView::lookupIn<uint32_t>(texels, width, height, RowsFromPoles, scale, Bilinear,
+                                                           Vec2f(us[at[j]], vs[at[j]]));
+    r[j] = c.x, g[j] = c.y, b[j] = c.z;
+  }
+}
+
 }  // namespace
 
 void RoundLanes::resize(size_t n) {
   if (px.size() >= n) return;
   for (std::vector<float>* a : {&ux, &uy, &lx, &ly, &weight, &ox, &oy, &oz, &dx, &dy, &dz, &tMax, &u, &v, &lightU0,
-                                &lightU1, &bsdfU0, &bsdfU1})
+                                &lightU1, &bsdfU0, &bsdfU1, &red, &green, &blue})
     a->resize(n);
-  px.resize(n), py.resize(n), hash.resize(n), dims.resize(n);
+  px.resize(n), py.resize(n), hash.resize(n), dims.resize(n), picked.resize(n);
 }
 
 void RoundLanes::make(const Camera& cam, const Sampler& first, int n) {
@@ -121,6 +135,21 @@ void RoundLanes::drawAhead(const Sampler& first, int n, uint32_t lightAt, uint32
 
 void RoundLanes::mapUV(const EnvironmentMapView& env, int n) {
   mapCoordinates(n, env.toWorld, dx.data(), dy.data(), dz.data(), u.data(), v.data());
+}
+
+void RoundLanes::mapRadiance(const EnvironmentMapView& env, int n) {
+  if (env.fitsUnsignedIndex()) {
+    auto lookups = !env.bilinear       ? mapLookups<false, false>
+                   : env.rowsFromPoles ? mapLookups<true, true>
+                                       : mapLookups<true, false>;
+    lookups(n, env.texels, env.width, env.height, env.scale, picked.data(), u.data(), v.data(), red.data(),
+            green.data(), blue.data());
+    return;
+  }
+  for (int j = 0; j < n; ++j) {
+    const Color c = env.lookupUV(uvOf(picked[j]));
+    red[j] = c.x, green[j] = c.y, blue[j] = c.z;
+  }
 }
 
 }  // namespace envgi

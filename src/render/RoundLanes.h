@@ -26,6 +26,8 @@ struct RoundLanes {
   std::vector<float> ux, uy, lx, ly, weight;
   std::vector<float> ox, oy, oz, dx, dy, dz, tMax;
   std::vector<float> u, v;  // mapUV: where each direction (dx, dy, dz) meets the map
+  std::vector<int> picked;            // mapRadiance: in, the lanes it looks up
+  std::vector<float> red, green, blue;  // and out, the map's radiance there, by place in picked
   // drawAhead: in, each lane's sampler (its pixel's hash, its position); out, two pairs of it.
   std::vector<uint32_t> dims;
   std::vector<float> lightU0, lightU1, bsdfU0, bsdfU1;
@@ -56,6 +58,10 @@ struct RoundLanes {
   // finds it. The camera round's rays, or a round's escaped rays gathered there.
   void mapUV(const EnvironmentMapView& env, int n);
   Vec2f uvOf(int i) const { return {u[i], v[i]}; }
+  // Places [0, n) of picked (lanes whose u and v mapUV found): the map's radiance at each, as
+  // EnvironmentMapView::lookupUV gives it there.
+  void mapRadiance(const EnvironmentMapView& env, int n);
+  Color radianceOf(int j) const { return Color(red[j], green[j], blue[j]); }
 };
 
 }  // namespace envgi
