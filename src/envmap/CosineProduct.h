@@ -40,11 +40,15 @@ ENVGI_INLINE Vec3f octahedralDecode(Vec2f uv) {
 // (p + r) / n for r in [0, 1], as a coordinate that pdf() maps back to pixel p (int(f n) == p):
 // near r = 1 the sum, the division or pdf()'s product may round onto the next pixel's edge,
 // which would give a draw the neighbour's density.
+// Settle false: without the steps onto pixel p (EnvironmentMapView::warpInPixelIn).
+template <bool Settle = true>
 ENVGI_INLINE float insidePixel(int p, float r, int n) {
   float f = (float(p) + (r < kOneMinusEpsilon ? r : kOneMinusEpsilon)) / float(n);
   f = f < kOneMinusEpsilon ? f : kOneMinusEpsilon;
-  while (int(f * float(n)) > p) f = nextafterf(f, 0.f);
-  while (int(f * float(n)) < p) f = nextafterf(f, 1.f);
+  if (Settle) {
+    while (int(f * float(n)) > p) f = nextafterf(f, 0.f);
+    while (int(f * float(n)) < p) f = nextafterf(f, 1.f);
+  }
   return f;
 }
 
@@ -68,6 +72,10 @@ struct ProductDraw {
   Vec2f uv;
   float pdfUV = 0.f;
   bool drawn = false;  // sample()'s answer: false where it draws nothing
+  // uv and pdfUV already placed inside the pixel (EnvironmentMapView::placeInPixel), and the
+  // map's radiance there looked up (RoundLanes::placeDraws).
+  bool placed = false;
+  Color radiance;
   ENVGI_HD bool isFor(Vec2f u2, Vec3f n2) const {
     return u.x == u2.x && u.y == u2.y && nLocal.x == n2.x && nLocal.y == n2.y && nLocal.z == n2.z;
   }

@@ -121,24 +121,35 @@ struct EnvironmentMapView {
 
   // The columns xs and rows ys of pixel (px, py) and its eight neighbours, wrapping in u and
   // clamping at the poles as lookupUV does; and their luminance, l[j][i] at (xs[i], ys[j]).
-  ENVGI_HD void neighbourhood(int px, int py, int xs[3], int ys[3]) const {
+  ENVGI_HD void neighbourhood(int px, int py, int xs[3], int ys[3]) const { neighbourhoodIn(width, height, px, py, xs, ys); }
+  ENVGI_HD static void neighbourhoodIn(int width, int height, int px, int py, int xs[3], int ys[3]) {
     xs[0] = px > 0 ? px - 1 : width - 1, xs[1] = px, xs[2] = px + 1 < width ? px + 1 : 0;
     ys[0] = py > 0 ? py - 1 : 0, ys[1] = py, ys[2] = py + 1 < height ? py + 1 : height - 1;
   }
   ENVGI_HD void neighbourhoodLuminance(int px, int py, float l[3][3]) const {
+    neighbourhoodLuminanceIn(texels, width, height, px, py, l);
+  }
+  // The members' forms of these functions take what they read as arguments (the static ...In
+  // forms), so that a loop over many draws (RoundLanes::placeDraws) holds it in registers; Index
+  // as in texelIn.
+  template <class Index = size_t>
+  ENVGI_HD static void neighbourhoodLuminanceIn(const float* texels, int width, int height, int px, int py,
+                                                float l[3][3]) {
     int xs[3], ys[3];
-    neighbourhood(px, py, xs, ys);
+    neighbourhoodIn(width, height, px, py, xs, ys);
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i)
-        l[j][i] = texels[(size_t(ys[j]) * width + xs[i]) * 4 + 3];
+        l[j][i] = texels[(Index(ys[j]) * Index(width) + Index(xs[i])) * Index(4) + Index(3)];
   }
   // The bilinear lookup's luminance over pixel (px, py) is four bilinear patches meeting on a
   // 3 x 3 lattice: v[j][i] at x = i / 2, y = j / 2 across the pixel (its corners, the midpoints
   // of its edges, its centre), each the mean of the pixels around that point, wrapping in u and
   // clamping at the poles as lookupUV does.
-  ENVGI_HD void pixelLattice(int px, int py, float v[3][3]) const {
+  ENVGI_HD void pixelLattice(int px, int py, float v[3][3]) const { pixelLatticeIn(texels, width, height, px, py, v); }
+  template <class Index = size_t>
+  ENVGI_HD static void pixelLatticeIn(const float* texels, int width, int height, int px, int py, float v[3][3]) {
     float l[3][3];
-    neighbourhoodLuminance(px, py, l);
+    neighbourhoodLuminanceIn<Index>(texels, width, height, px, py, l);
     for (int j = 0; j < 3; ++j)
       for (int i = 0; i < 3; ++i) {
         // The pixels around lattice point (i, j): the centre one, and the neighbour on the
@@ -153,7 +164,8 @@ struct EnvironmentMapView {
     int x, y;
     Vec2f f;
   };
-  ENVGI_HD PixelPoint pixelPoint(Vec2f uv) const {
+  ENVGI_HD PixelPoint pixelPoint(Vec2f uv) const { return pixelPointIn(width, height, uv); }
+  ENVGI_HD static PixelPoint pixelPointIn(int width, int height, Vec2f uv) {
     PixelPoint p;
     p.x = clampi(int(uv.x * float(width)), 0, width - 1);
     p.y = clampi(int(uv.y * float(height)), 0, height - 1);
@@ -169,15 +181,22 @@ struct EnvironmentMapView {
   // not, next to a small sun (docs/performance.md, "A low sun").
   // *rel: its density at the point, as densityInPixel gives it, from the same lattice.
   ENVGI_HD Vec2f warpInPixel(const PixelPoint& p, float* rel) const {
+    return warpInPixelIn(texels, width, height, p, rel);
+  }
+  // Settle false leaves out insidePixel's last steps, which a loop over many draws cannot
+  // vectorise: its answer is warpInPixel's where each coordinate lands in pixel p (insidePixel's
+  // steps then take none), and is redone by warpInPixel elsewhere (RoundLanes::placeDraws).
+  template <class Index = size_t, bool Settle = true>
+  ENVGI_HD static Vec2f warpInPixelIn(const float* texels, int width, int height, const PixelPoint& p, float* rel) {
     float v[3][3];
-    pixelLattice(p.x, p.y, v);
+    pixelLatticeIn<Index>(texels, width, height, p.x, p.y, v);
     float x = sampleTwoLinearPieces(p.f.x, v[0][0] + 2.f * v[1][0] + v[2][0], v[0][1] + 2.f * v[1][1] + v[2][1],
                                     v[0][2] + 2.f * v[1][2] + v[2][2]);
     float y = sampleTwoLinearPieces(p.f.y, twoLinearPieces(x, v[0][0], v[0][1], v[0][2]),
                                     twoLinearPieces(x, v[1][0], v[1][1], v[1][2]),
                                     twoLinearPieces(x, v[2][0], v[2][1], v[2][2]));
-    Vec2f w(insidePixel(p.x, x, width), insidePixel(p.y, y, height));
-    *rel = latticeDensity(v, pixelPoint(w).f);  // the same pixel: insidePixel keeps it there
+    Vec2f w(insidePixel<Settle>(p.x, x, width), insidePixel<Settle>(p.y, y, height));
+    *rel = latticeDensity(v, pixelPointIn(width, height, w).f);  // the same pixel: insidePixel keeps it there
     return w;
   }
 
@@ -202,9 +221,11 @@ struct EnvironmentMapView {
   // For the strategies that pick a pixel from a table (importance, alias, product): with
   // bilinear lookup, the point inside the pixel follows the lookup where the pixel is marked,
   // and *pdfUV takes its factor.
-  ENVGI_HD bool warps(const PixelPoint& p) const {
-    if (!warpBits) return false;
-    size_t i = size_t(p.y) * size_t(width) + size_t(p.x);
+  ENVGI_HD bool warps(const PixelPoint& p) const { return warpBits && warpBitIn(warpBits, width, p) == 1u; }
+  // The bit as a number: its conversion to bool is one that GCC does not vectorise.
+  template <class Index = size_t>
+  ENVGI_HD static uint32_t warpBitIn(const uint32_t* warpBits, int width, const PixelPoint& p) {
+    const Index i = Index(p.y) * Index(width) + Index(p.x);
     return (warpBits[i >> 5] >> (i & 31)) & 1u;
   }
   ENVGI_HD bool warpsAt(Vec2f uv) const { return warps(pixelPoint(uv)); }
@@ -351,16 +372,21 @@ struct EnvironmentMapView {
       case EnvStrategy::Product: {
         float pdfUV;
         const Vec3f nLocal = toLocalUnnormalized(normal);
-        if (drawn && drawn->isFor(u, nLocal)) {
+        const bool ahead = drawn && drawn->isFor(u, nLocal);
+        if (ahead) {
           if (!drawn->drawn) return out;
           out.uv = drawn->uv, pdfUV = drawn->pdfUV;
         } else if (!product.sample(u, nLocal, &out.uv, &pdfUV)) {
           return out;
         }
-        out.uv = placeInPixel(out.uv, &pdfUV);
+        const bool placed = ahead && drawn->placed;
+        if (!placed) out.uv = placeInPixel(out.uv, &pdfUV);
         local = uvToDir(out.uv);
         out.pdf = solidAnglePdf(pdfUV, out.uv.y);
-        break;
+        if (!placed) break;
+        out.dir = fromLocal(local);
+        out.radiance = out.pdf > 0.f ? drawn->radiance : Color(0.f);
+        return out;
       }
       case EnvStrategy::Points: {
         // One light chosen by its share of the irradiance: radiance / pmf estimates sum_i f E_i.

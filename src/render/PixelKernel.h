@@ -425,10 +425,22 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         if (env.product.aheadLevel4(&b->draw[b->drawing[i]], &px, &py)) env.prefetchPixel(px, py);
       }
       // Each draw's end, from what the levels loaded: prepareLd takes it instead of drawing again.
+      // With the lanes, each draw is then placed inside its pixel and the map looked up there.
+      int placing = 0;
       for (int i = 0; i < draws; ++i) {
         ShadeAhead& a = b->ahead[b->drawing[i]];
         a.product = env.product.aheadDraw(b->draw[b->drawing[i]]);
         a.productAhead = true;
+        if (inLanes && a.product.drawn) lanes.setDraw(placing++, a.product.uv, a.product.pdfUV);
+      }
+      if (placing > 0) {
+        lanes.placeDraws(env, placing);
+        for (int i = 0, j = 0; i < draws; ++i) {
+          ProductDraw& d = b->ahead[b->drawing[i]].product;
+          if (!d.drawn) continue;
+          lanes.placedDraw(j++, &d.uv, &d.pdfUV, &d.radiance);
+          d.placed = true;
+        }
       }
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];

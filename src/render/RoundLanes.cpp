@@ -92,14 +92,41 @@ ENVGI_LANES void mapLookups(int n, const float* __restrict texels, int width, in
   }
 }
 
+// EnvironmentMapView::placeInPixel without insidePixel's last steps (warpInPixelIn's Settle),
+// into ou, ov, opdf; redo marks the lanes whose point is not yet in its pixel, which
+// placeInPixel itself then places. Its offsets in 32 bits, as mapLookups'. Flattened: GCC left
+// the warp as a call, which no loop around it vectorises.
+#if defined(__GNUC__) && !defined(__clang__)
+__attribute__((flatten))
+#endif
+ENVGI_LANES void placeInPixels(int n, const float* __restrict texels, const uint32_t* __restrict warpBits, int width,
+                               int height, const float* __restrict us, const float* __restrict vs,
+                               const float* __restrict pdfs, float* __restrict ou, float* __restrict ov,
+                               float* __restrict opdf, unsigned char* __restrict redo) {
+  using View = EnvironmentMapView;
+  for (int j = 0; j < n; ++j) {
+    const View::PixelPoint p = View::pixelPointIn(width, height, Vec2f(us[j], vs[j]));
+    float rel;
+    const Vec2f w = View::warpInPixelIn<uint32_t, false>(texels, width, height, p, &rel);
+    // Compared as a float: GCC turns the bit's comparison into a conversion to bool, which it
+    // does not vectorise.
+    const bool warp = float(View::warpBitIn<uint32_t>(warpBits, width, p)) > 0.5f;
+    const bool settled = int(w.x * float(width)) == p.x && int(w.y * float(height)) == p.y;
+    redo[j] = warp && !settled;
+    ou[j] = warp ? w.x : us[j];
+    ov[j] = warp ? w.y : vs[j];
+    opdf[j] = warp ? pdfs[j] * rel : pdfs[j];
+  }
+}
+
 }  // namespace
 
 void RoundLanes::resize(size_t n) {
   if (px.size() >= n) return;
   for (std::vector<float>* a : {&ux, &uy, &lx, &ly, &weight, &ox, &oy, &oz, &dx, &dy, &dz, &tMax, &u, &v, &lightU0,
-                                &lightU1, &bsdfU0, &bsdfU1, &red, &green, &blue})
+                                &lightU1, &bsdfU0, &bsdfU1, &red, &green, &blue, &drawU, &drawV, &drawPdf, &placedPdf})
     a->resize(n);
-  px.resize(n), py.resize(n), hash.resize(n), dims.resize(n), picked.resize(n);
+  px.resize(n), py.resize(n), hash.resize(n), dims.resize(n), picked.resize(n), redo.resize(n);
 }
 
 void RoundLanes::make(const Camera& cam, const Sampler& first, int n) {
@@ -150,6 +177,29 @@ void RoundLanes::mapRadiance(const EnvironmentMapView& env, int n) {
     const Color c = env.lookupUV(uvOf(picked[j]));
     red[j] = c.x, green[j] = c.y, blue[j] = c.z;
   }
+}
+
+void RoundLanes::placeDraws(const EnvironmentMapView& env, int n) {
+  // Placed into u, v and placedPdf (u and v are free once a round's escapes have taken theirs),
+  // so that mapRadiance then looks the map up there.
+  if (env.warpBits && env.fitsUnsignedIndex()) {
+    placeInPixels(n, env.texels, env.warpBits, env.width, env.height, drawU.data(), drawV.data(), drawPdf.data(),
+                  u.data(), v.data(), placedPdf.data(), redo.data());
+    for (int j = 0; j < n; ++j)
+      if (redo[j]) {
+        placedPdf[j] = drawPdf[j];
+        const Vec2f uv = env.placeInPixel(Vec2f(drawU[j], drawV[j]), &placedPdf[j]);
+        u[j] = uv.x, v[j] = uv.y;
+      }
+  } else {
+    for (int j = 0; j < n; ++j) {
+      placedPdf[j] = drawPdf[j];
+      const Vec2f uv = env.placeInPixel(Vec2f(drawU[j], drawV[j]), &placedPdf[j]);
+      u[j] = uv.x, v[j] = uv.y;
+    }
+  }
+  for (int j = 0; j < n; ++j) picked[j] = j;
+  mapRadiance(env, n);
 }
 
 }  // namespace envgi

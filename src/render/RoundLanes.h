@@ -28,6 +28,11 @@ struct RoundLanes {
   std::vector<float> u, v;  // mapUV: where each direction (dx, dy, dz) meets the map
   std::vector<int> picked;            // mapRadiance: in, the lanes it looks up
   std::vector<float> red, green, blue;  // and out, the map's radiance there, by place in picked
+  // placeDraws: in, the round's product draws (CosineProductView::aheadDraw's uv and pdfUV);
+  // out, the same placed inside their pixels (u, v, placedPdf), with the radiance there in red,
+  // green, blue.
+  std::vector<float> drawU, drawV, drawPdf, placedPdf;
+  std::vector<unsigned char> redo;
   // drawAhead: in, each lane's sampler (its pixel's hash, its position); out, two pairs of it.
   std::vector<uint32_t> dims;
   std::vector<float> lightU0, lightU1, bsdfU0, bsdfU1;
@@ -62,6 +67,14 @@ struct RoundLanes {
   // EnvironmentMapView::lookupUV gives it there.
   void mapRadiance(const EnvironmentMapView& env, int n);
   Color radianceOf(int j) const { return Color(red[j], green[j], blue[j]); }
+  // Lanes [0, n) of drawU, drawV, drawPdf: each draw placed inside its pixel as
+  // EnvironmentMapView::placeInPixel places it, and the map's radiance there (lookupUV's).
+  void placeDraws(const EnvironmentMapView& env, int n);
+  void setDraw(int j, Vec2f uv, float pdfUV) { drawU[j] = uv.x, drawV[j] = uv.y, drawPdf[j] = pdfUV; }
+  // Lane j's draw as placeDraws left it, for ProductDraw: placed, with its radiance.
+  void placedDraw(int j, Vec2f* uv, float* pdfUV, Color* radiance) const {
+    *uv = uvOf(j), *pdfUV = placedPdf[j], *radiance = radianceOf(j);
+  }
 };
 
 }  // namespace envgi

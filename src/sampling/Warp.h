@@ -75,11 +75,15 @@ ENVGI_INLINE float twoLinearPieces(float x, float n0, float n1, float n2) {
 
 // A point of [0, 1) with density proportional to twoLinearPieces(x, n0, n1, n2): a piece by its
 // area, then sampleLinear inside it. Uniform where the function is zero throughout.
+// (x < k ? x : k is fminf's answer for every x, NaN included, and a loop over many draws
+// vectorises it: RoundLanes::placeDraws.)
 ENVGI_INLINE float sampleTwoLinearPieces(float u, float n0, float n1, float n2) {
   float left = n0 + n1, right = n1 + n2, t = u * (left + right);
   if (!(left + right > 0.f)) return u;
-  if (t < left || !(right > 0.f)) return 0.5f * sampleLinear(fminf(t / left, kOneMinusEpsilon), n0, n1);
-  return 0.5f + 0.5f * sampleLinear(fminf((t - left) / right, kOneMinusEpsilon), n1, n2);
+  const float inLeft = t / left, inRight = (t - left) / right;
+  if (t < left || !(right > 0.f))
+    return 0.5f * sampleLinear(inLeft < kOneMinusEpsilon ? inLeft : kOneMinusEpsilon, n0, n1);
+  return 0.5f + 0.5f * sampleLinear(inRight < kOneMinusEpsilon ? inRight : kOneMinusEpsilon, n1, n2);
 }
 
 ENVGI_INLINE Vec2f sampleUniformTriangle(Vec2f u) {

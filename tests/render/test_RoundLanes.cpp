@@ -150,3 +150,60 @@ TEST(RoundLanes, LookupsInLanesAreLookupUVToTheBit) {
     EXPECT_EQ(mismatches, 0) << "variant " << variant;
   }
 }
+
+// A round's product draws placed inside their pixels in lanes (placeDraws) land where
+// EnvironmentMapView::placeInPixel places them, with its density factor and lookupUV's radiance
+// there, to the bit: in pixels that warp and pixels that do not, and at pixels' far edges, where
+// insidePixel steps the point back (the lanes redo those one at a time).
+TEST(RoundLanes, DrawsPlacedInLanesAreThePlacedDrawsToTheBit) {
+  const int w = 29, h = 15;
+  std::vector<float> texels(size_t(w) * h * 4);
+  Pcg32 rng(23);
+  for (size_t i = 0; i < texels.size(); ++i) {
+    // Bright spots beside dark ones (the warp's case), and some black pixels.
+    const float t = rng.nextFloat();
+    texels[i] = t < 0.1f ? 0.f : (t > 0.9f ? 50.f * t : t);
+  }
+  for (size_t i = 0; i < size_t(w) * h; ++i)
+    texels[i * 4 + 3] = luminance(texels[i * 4], texels[i * 4 + 1], texels[i * 4 + 2]);
+  std::vector<uint32_t> bits((size_t(w) * h + 31) / 32);
+  for (uint32_t& b : bits) b = rng.nextUInt() | 0x11111111u;  // most pixels warp, some do not
+  EnvironmentMapView env;
+  env.texels = texels.data();
+  env.width = w, env.height = h;
+  env.scale = 2.5f;
+  env.warpBits = bits.data();
+  RoundLanes cr;
+  const int n = 777;
+  cr.resize(size_t(n));
+  std::vector<Vec2f> uvs(n);
+  std::vector<float> pdfs(n);
+  for (int j = 0; j < n; ++j) {
+    Vec2f uv(rng.nextFloat(), rng.nextFloat());
+    if (j % 3 == 0) {  // a pixel's far edge, across or down or both
+      const int px = int(rng.nextFloat() * w), py = int(rng.nextFloat() * h);
+      const float ex = nextafterf(float(px + 1) / float(w), 0.f), ey = nextafterf(float(py + 1) / float(h), 0.f);
+      uv = Vec2f(j % 2 ? ex : uv.x, j % 5 ? ey : uv.y);
+    }
+    uvs[j] = uv;
+    pdfs[j] = 0.1f + 3.f * rng.nextFloat();
+    cr.setDraw(j, uv, pdfs[j]);
+  }
+  cr.placeDraws(env, n);
+  int mismatches = 0, redone = 0;
+  for (int j = 0; j < n; ++j) {
+    float pdf = pdfs[j];
+    const Vec2f placed = env.placeInPixel(uvs[j], &pdf);
+    const Color L = env.lookupUV(placed);
+    Vec2f luv;
+    float lpdf;
+    Color lL;
+    cr.placedDraw(j, &luv, &lpdf, &lL);
+    if (!sameBits(placed.x, luv.x) || !sameBits(placed.y, luv.y) || !sameBits(pdf, lpdf) || !sameBits(L.x, lL.x) ||
+        !sameBits(L.y, lL.y) || !sameBits(L.z, lL.z))
+      ++mismatches;
+    redone += cr.redo[j];
+  }
+  EXPECT_EQ(mismatches, 0);
+  EXPECT_GT(redone, 0) << "no draw took insidePixel's steps: the edge cases no longer reach them";
+}
