@@ -84,8 +84,7 @@ struct EnvironmentMapView {
     return {st * std::sin(phi), std::cos(theta), -st * std::cos(phi)};
   }
 
-  ENVGI_HD Color texel(int x, int y) const { return texelIn(texels, width, x, y); }
-  // Index: what the texel's offset is counted in. 32 bits unsigned lets a loop of lookups gather
+  // A texel's radiance. Index: what the texel's offset is counted in. 32 bits unsigned lets a loop of lookups gather
   // (RoundLanes::mapRadiance), for a map of at most 2^30 pixels (fitsUnsignedIndex).
   template <class Index = size_t>
   ENVGI_HD static Color texelIn(const float* texels, int width, int x, int y) {
@@ -334,6 +333,7 @@ struct EnvironmentMapView {
                             const ProductDraw* drawn = nullptr) const {
     EnvSample out;
     Vec3f local;
+    const Color* lookedUp = nullptr;  // the radiance at out.uv, where a draw made ahead looked it up
     switch (strategyFor(s, normal)) {
       case EnvStrategy::Uniform: {
         local = sampleUniformSphere(u);
@@ -379,14 +379,11 @@ struct EnvironmentMapView {
         } else if (!product.sample(u, nLocal, &out.uv, &pdfUV)) {
           return out;
         }
-        const bool placed = ahead && drawn->placed;
-        if (!placed) out.uv = placeInPixel(out.uv, &pdfUV);
+        if (ahead && drawn->placed) lookedUp = &drawn->radiance;
+        else out.uv = placeInPixel(out.uv, &pdfUV);
         local = uvToDir(out.uv);
         out.pdf = solidAnglePdf(pdfUV, out.uv.y);
-        if (!placed) break;
-        out.dir = fromLocal(local);
-        out.radiance = out.pdf > 0.f ? drawn->radiance : Color(0.f);
-        return out;
+        break;
       }
       case EnvStrategy::Points: {
         // One light chosen by its share of the irradiance: radiance / pmf estimates sum_i f E_i.
@@ -407,7 +404,7 @@ struct EnvironmentMapView {
       }
     }
     out.dir = fromLocal(local);
-    out.radiance = out.pdf > 0.f ? lookupUV(out.uv) : Color(0.f);
+    out.radiance = out.pdf > 0.f ? (lookedUp ? *lookedUp : lookupUV(out.uv)) : Color(0.f);
     return out;
   }
 

@@ -182,22 +182,17 @@ void RoundLanes::mapRadiance(const EnvironmentMapView& env, int n) {
 void RoundLanes::placeDraws(const EnvironmentMapView& env, int n) {
   // Placed into u, v and placedPdf (u and v are free once a round's escapes have taken theirs),
   // so that mapRadiance then looks the map up there.
-  if (env.warpBits && env.fitsUnsignedIndex()) {
+  auto placeOne = [&](int j) {
+    placedPdf[j] = drawPdf[j];
+    const Vec2f uv = env.placeInPixel(Vec2f(drawU[j], drawV[j]), &placedPdf[j]);
+    u[j] = uv.x, v[j] = uv.y;
+  };
+  const bool inLanes = env.warpBits && env.fitsUnsignedIndex();
+  if (inLanes)
     placeInPixels(n, env.texels, env.warpBits, env.width, env.height, drawU.data(), drawV.data(), drawPdf.data(),
                   u.data(), v.data(), placedPdf.data(), redo.data());
-    for (int j = 0; j < n; ++j)
-      if (redo[j]) {
-        placedPdf[j] = drawPdf[j];
-        const Vec2f uv = env.placeInPixel(Vec2f(drawU[j], drawV[j]), &placedPdf[j]);
-        u[j] = uv.x, v[j] = uv.y;
-      }
-  } else {
-    for (int j = 0; j < n; ++j) {
-      placedPdf[j] = drawPdf[j];
-      const Vec2f uv = env.placeInPixel(Vec2f(drawU[j], drawV[j]), &placedPdf[j]);
-      u[j] = uv.x, v[j] = uv.y;
-    }
-  }
+  for (int j = 0; j < n; ++j)
+    if (!inLanes || redo[j]) placeOne(j);
   for (int j = 0; j < n; ++j) picked[j] = j;
   mapRadiance(env, n);
 }
