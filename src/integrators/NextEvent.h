@@ -93,13 +93,27 @@ ENVGI_HD inline Color resolvedLd(const LightSampleLd& ld, bool occluded) {
   return ld.needsRay && !occluded ? ld.value : Color(0.f);
 }
 
+// bsdfSample's answer for a draw made ahead, worked out ahead too (the CPU's
+// RoundLanes::sampleRoughPlastic, a round's rough plastic samples in vector lanes).
+struct BsdfSampleAhead {
+  BsdfSample s;
+  bool ok = false;    // bsdfSample's return
+  bool made = false;  // s and ok hold bsdfSample's answer for the draw ahead (Draw2DAhead)
+};
+
 // A bounce's BSDF draw as path and direct take it: uc only where bsdfSample reads it beside ub
 // (skipped, not drawn, elsewhere, so later draws keep their dimensions), and the lobe from ub
 // where the BSDF can take it from there (bsdfLobeFromU).
-// ubAhead: the pair's draw made ahead, if any (get2DOrAhead).
+// ubAhead: the pair's draw made ahead, if any (get2DOrAhead); sampled: bsdfSample's answer for
+// it, if that was worked out ahead, taken where the draw is (it is uc-free: sampleRoughPlastic's).
 ENVGI_HD inline bool drawBsdfSample(const Bsdf& bsdf, Vec3f woLocal, Sampler& smp, BsdfSample* bs,
-                                    const Draw2DAhead* ubAhead = nullptr) {
+                                    const Draw2DAhead* ubAhead = nullptr, const BsdfSampleAhead* sampled = nullptr) {
   float uc = smp.get1DIf(bsdfReadsUcBesideU(bsdf));
+  if (sampled && sampled->made && ubAhead && ubAhead->dim == smp.dim) {
+    smp.skip2D();
+    *bs = sampled->s;
+    return sampled->ok;
+  }
   Vec2f ub = get2DOrAhead(smp, ubAhead);
   return bsdfSample(bsdf, woLocal, uc, ub, bs, true);
 }

@@ -46,6 +46,7 @@ struct ShadeAhead {
   Vec2f uL;
   bool drawn = false;  // uL holds prepareLd's draw
   Draw2DAhead ub;      // the BSDF's pair, where it was drawn ahead (pathBsdfDrawOffset)
+  BsdfSampleAhead bs;  // and the BSDF's sample for it, where that was worked out ahead
   // The map's product draw for uL, where the executor walked it to its end (aheadDraw).
   bool productAhead = false;
   ProductDraw product;
@@ -148,7 +149,8 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   if (!pp.bsdfSample) return false;
 
   BsdfSample bs;
-  if (!drawBsdfSample(bsdf, woLocal, smp, &bs, ahead ? &ahead->ub : nullptr)) return false;
+  if (!drawBsdfSample(bsdf, woLocal, smp, &bs, ahead ? &ahead->ub : nullptr, ahead ? &ahead->bs : nullptr))
+    return false;
   if (partner) bsdfMixReweight(*partner, si.partnerWeight, woLocal, &bs);
   Vec3f wi = si.shading.toWorld(bs.wi);
   st->beta *= bs.weight;
@@ -189,6 +191,7 @@ inline bool pathShadeAhead(const SceneView& sc, const PathState& st, const Hit& 
                            const Draw2DAhead* uL = nullptr) {
   ahead->si = sc.interaction(st.ray, h);
   ahead->productAhead = false;
+  ahead->bs.made = false;
   ahead->drawn = pp.lightSample && !(pp.maxDepth >= 0 && st.depth >= pp.maxDepth);
   if (!ahead->drawn) return false;
   ahead->uL = lightDrawOf(smp, uL);

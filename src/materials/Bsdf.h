@@ -206,39 +206,55 @@ ENVGI_INLINE CoatNode roughCoat(const Bsdf& b) { return coatNode(bsdfCoatTable(b
 // The share of light from wo (cos theta = c > 0) that the rough coat (n: roughCoat(b)) does not
 // let through to the base: the coat's lobe's share in sampling. The smooth coat's Fresnel
 // without tables.
+ENVGI_INLINE float roughCoatReflectanceAt(const CoatNode& n, CoatPlace p) { return 1.f - coatTransmittanceAt(n, p); }
 ENVGI_INLINE float roughCoatReflectance(const Bsdf& b, const CoatNode& n, float c) {
-  return b.coatNodes > 0 ? 1.f - coatTransmittance(n, c) : fresnelDielectric(c, b.ior);
+  return b.coatNodes > 0 ? roughCoatReflectanceAt(n, coatPlace(c)) : fresnelDielectric(c, b.ior);
 }
 
 // What rough plastic's eval and pdf share for one pair of directions (both above the surface):
 // the half vector, D there, wo's Smith lambda, the coat's tables at this roughness and its
 // reflectance at wo. bsdfEvalPdf computes them once for both.
+// d and coat: microfacet(b) and roughCoat(b), which RoundLanes::sampleRoughPlastic works out
+// once for a round's lanes of one material.
 struct RoughPlasticShared {
   Vec3f m;
   float D, lambdaO, fo;
   CoatNode coat;
 };
-ENVGI_INLINE RoughPlasticShared roughPlasticShared(const Bsdf& b, Vec3f wo, Vec3f wi) {
+ENVGI_INLINE RoughPlasticShared roughPlasticShared(const MicrofacetDistribution& d, const CoatNode& coat, float fo,
+                                                   Vec3f wo, Vec3f wi) {
   RoughPlasticShared r;
   r.m = normalize(wo + wi);
-  MicrofacetDistribution d = microfacet(b);
   r.D = d.D(r.m);
   r.lambdaO = d.lambda(wo);
-  r.coat = roughCoat(b);
-  r.fo = roughCoatReflectance(b, r.coat, wo.z);
+  r.coat = coat;
+  r.fo = fo;
   return r;
 }
-// The base seen through the rough coat: t(wi) t(wo) times plasticBase with the rough Fdr_int.
-ENVGI_INLINE Color roughPlasticDiffuse(const Bsdf& b, const RoughPlasticShared& r, Vec3f wi) {
-  if (b.coatNodes == 0) return plasticDiffuse(b, r.fo, wi);
-  float ti = coatTransmittance(r.coat, wi.z), to = 1.f - r.fo;
+ENVGI_INLINE RoughPlasticShared roughPlasticShared(const Bsdf& b, Vec3f wo, Vec3f wi) {
+  const CoatNode coat = roughCoat(b);
+  return roughPlasticShared(microfacet(b), coat, roughCoatReflectance(b, coat, wo.z), wo, wi);
+}
+// The base seen through the rough coat with its tables: t(wi) t(wo) times plasticBase with the
+// rough Fdr_int; ti is t(wi).
+ENVGI_INLINE Color roughPlasticThroughCoat(const Bsdf& b, const RoughPlasticShared& r, float ti, Vec3f wi) {
+  float to = 1.f - r.fo;
   return plasticBase(b, coatInternalReflectance(r.coat), kInvPi * wi.z * ti * to);
 }
-ENVGI_INLINE Color roughPlasticEval(const Bsdf& b, const RoughPlasticShared& r, Vec3f wo, Vec3f wi) {
+ENVGI_INLINE Color roughPlasticDiffuse(const Bsdf& b, const RoughPlasticShared& r, Vec3f wi) {
+  if (b.coatNodes == 0) return plasticDiffuse(b, r.fo, wi);
+  return roughPlasticThroughCoat(b, r, coatTransmittance(r.coat, wi.z), wi);
+}
+// The coat's own lobe: a microfacet reflection, with the height-correlated masking of G().
+ENVGI_INLINE Color roughPlasticSpecular(const Bsdf& b, const MicrofacetDistribution& d, const RoughPlasticShared& r,
+                                        Vec3f wo, Vec3f wi) {
   float F = fresnelDielectric(dot(wi, r.m), b.ior);
-  float G = 1.f / (1.f + r.lambdaO + microfacet(b).lambda(wi));  // height-correlated, as G()
-  Color spec = b.specularReflectance * (F * r.D * G / (4.f * wo.z));
-  return spec + roughPlasticDiffuse(b, r, wi);
+  float G = 1.f / (1.f + r.lambdaO + d.lambda(wi));
+  return b.specularReflectance * (F * r.D * G / (4.f * wo.z));
+}
+ENVGI_INLINE Color roughPlasticEval(const Bsdf& b, const MicrofacetDistribution& d, const RoughPlasticShared& r,
+                                    Vec3f wo, Vec3f wi) {
+  return roughPlasticSpecular(b, d, r, wo, wi) + roughPlasticDiffuse(b, r, wi);
 }
 ENVGI_INLINE float roughPlasticPdf(const Bsdf& b, const RoughPlasticShared& r, Vec3f wo, Vec3f wi) {
   float ps = plasticSpecularProb(b, r.fo);
@@ -249,6 +265,27 @@ ENVGI_INLINE float roughPlasticPdf(const Bsdf& b, const RoughPlasticShared& r, V
   return ps * (visible / (4.f * cosOM)) + (1.f - ps) * cosineHemispherePdf(wi.z);
 }
 
+// Rough plastic's sample with the lobe from u.x (bsdfLobeFromU, as path and direct draw it) in
+// the steps of sampleInFrame's that RoundLanes::sampleRoughPlastic runs in vector lanes around
+// libm's sine and cosine (fromPolar), one lane at a time: the lobe and its disk point in polar
+// form, then the direction from the point; then roughPlasticShared, roughPlasticPdf and the
+// eval's two terms. wo is above the surface (a two-sided one's seen from the front); d:
+// microfacet(b), GGX's; coat: roughCoat(b).
+// ps: the coat's share of the samples from wo (plasticSpecularProb); u.x < ps picks the coat,
+// and u.x is then stretched over the lobe's share: sampleInFrame's two stretchedDraw calls as one
+// (a choice between two masks does not vectorise).
+ENVGI_INLINE float roughPlasticLobeDraw(float ps, float ux) {
+  const bool coatLobe = ux < ps;
+  return stretchedDraw(ux, coatLobe ? 0.f : ps, coatLobe ? ps : 1.f - ps);
+}
+// u: the draw with u.x stretched (roughPlasticLobeDraw): the lobe's disk point in polar form.
+ENVGI_INLINE PolarPoint roughPlasticDisk(bool coatLobe, Vec2f u) {
+  const PolarPoint visible = MicrofacetDistribution::visibleDiskPolar(u), base = concentricDiskPolar(u);
+  return {coatLobe ? visible.r : base.r, coatLobe ? visible.angle : base.angle};
+}
+ENVGI_INLINE Vec3f roughPlasticDirection(const MicrofacetDistribution& d, Vec3f wo, Vec2f disk, bool coatLobe) {
+  return coatLobe ? reflect(wo, d.visibleGgxFromDisk(wo, disk)) : cosineHemisphereFromDisk(disk);
+}
 }  // namespace detail
 
 namespace detail {
@@ -282,7 +319,7 @@ ENVGI_INLINE Color evalInFrame(const Bsdf& b, Vec3f wo, Vec3f wi) {
       return detail::plasticDiffuse(b, wo, wi);
     case BsdfType::RoughPlastic:
       if (wo.z <= 0.f || wi.z <= 0.f) return Color(0.f);
-      return detail::roughPlasticEval(b, detail::roughPlasticShared(b, wo, wi), wo, wi);
+      return detail::roughPlasticEval(b, microfacet(b), detail::roughPlasticShared(b, wo, wi), wo, wi);
     case BsdfType::Principled: return principled::eval(b.principled, b.reflectance, b.ior, wo, wi);
     case BsdfType::Conductor:
     case BsdfType::Dielectric:
@@ -345,7 +382,7 @@ ENVGI_INLINE Color evalPdfInFrame(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf)
   }
   detail::RoughPlasticShared r = detail::roughPlasticShared(b, wo, wi);
   *pdf = detail::roughPlasticPdf(b, r, wo, wi);
-  return detail::roughPlasticEval(b, r, wo, wi);
+  return detail::roughPlasticEval(b, microfacet(b), r, wo, wi);
 }
 
 // Non-delta lobes: the pdf of the sampled direction over all lobes, and weight = eval / pdf.

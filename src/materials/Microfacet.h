@@ -9,6 +9,7 @@
 
 #include "core/ErfInv.h"
 #include "core/Vec.h"
+#include "sampling/Warp.h"
 
 namespace envgi {
 
@@ -76,22 +77,31 @@ struct MicrofacetDistribution {
     return fmaxf(0.f, 0.5f * (std::exp(-a * a) / (a * 1.7724538509f) - std::erfc(a)));
   }
 
-  ENVGI_HD Vec3f sampleVisibleGgx(Vec3f w, Vec2f u) const {
+  ENVGI_HD Vec3f sampleVisibleGgx(Vec3f w, Vec2f u) const { return visibleGgxFromDisk(w, fromPolar(visibleDiskPolar(u))); }
+
+ public:
+  // GGX's visible normal in two steps around libm (fromPolar): the uniform disk point that u
+  // draws, in polar form, then the normal it is warped to, seen from w.
+  ENVGI_HD static PolarPoint visibleDiskPolar(Vec2f u) { return {std::sqrt(u.x), 2.f * kPi * u.y}; }
+  ENVGI_HD Vec3f visibleGgxFromDisk(Vec3f w, Vec2f disk) const {
     Vec3f wh = normalize(Vec3f(alphaX * w.x, alphaY * w.y, w.z));
     if (wh.z < 0.f) wh = -wh;
     Vec3f t1 = wh.z < 0.99999f ? normalize(cross(Vec3f(0.f, 0.f, 1.f), wh)) : Vec3f(1.f, 0.f, 0.f);
     Vec3f t2 = cross(wh, t1);
-    // Uniform disk point, warped onto the visible half of the projected hemisphere.
-    float r = std::sqrt(u.x), phi = 2.f * kPi * u.y;
-    float px = r * std::cos(phi), py = r * std::sin(phi);
-    float h = std::sqrt(fmaxf(0.f, 1.f - px * px));
+    // The disk point warped onto the visible half of the projected hemisphere.
+    float px = disk.x, py = disk.y;
+    // Maxima as comparisons, for the lanes: fmaxf does not vectorise, and these agree with it for
+    // every value, NaN included (1 - px^2 is never -0).
+    const float h2 = 1.f - px * px;
+    float h = std::sqrt(h2 > 0.f ? h2 : 0.f);
     float s = 0.5f * (1.f + wh.z);
     py = (1.f - s) * h + s * py;
     float pz = safeSqrt(1.f - px * px - py * py);
     Vec3f nh = t1 * px + t2 * py + wh * pz;
-    return normalize(Vec3f(alphaX * nh.x, alphaY * nh.y, fmaxf(1e-6f, nh.z)));
+    return normalize(Vec3f(alphaX * nh.x, alphaY * nh.y, nh.z > 1e-6f ? nh.z : 1e-6f));
   }
 
+ private:
   // In the stretched frame (alpha = 1) and with w in the xz-plane at angle theta, the normal of
   // slope (x, y) is (-x, -y, 1) / |.|, seen with weight (1 - x tan theta) where x < cot theta,
   // and the slopes are Gaussian: y is a plain normal variate, x has the CDF

@@ -42,13 +42,25 @@ ENVGI_INLINE CoatNode coatNode(const float* table, int nodes, float alpha) {
 
 ENVGI_INLINE float coatEntry(const CoatNode& n, int i) { return n.a[i] + n.w * (n.b[i] - n.a[i]); }
 
-// t(mu): the share of light from a direction mu = cos theta above the coat that reaches the base.
-ENVGI_INLINE float coatTransmittance(const CoatNode& n, float mu) {
+// Where mu = cos theta falls among t's nodes: the node i below it and the share t of the way on
+// to i + 1. Apart from the lookup (coatTransmittanceAt) so that vector lanes can keep the node
+// in an array between two loops (RoundLanes::sampleRoughPlastic): inside one, GCC turned the
+// clamp's branches into a choice between addresses, which it does not gather from.
+struct CoatPlace {
+  int i;
+  float t;
+};
+ENVGI_INLINE CoatPlace coatPlace(float mu) {
   float x = clampf(mu, 0.f, 1.f) * float(kCoatRes - 1);
   int i = x < float(kCoatRes - 2) ? int(x) : kCoatRes - 2;
-  float v0 = coatEntry(n, i), v1 = coatEntry(n, i + 1);
-  return v0 + (x - float(i)) * (v1 - v0);
+  return {i, x - float(i)};
 }
+ENVGI_INLINE float coatTransmittanceAt(const CoatNode& n, CoatPlace p) {
+  float v0 = coatEntry(n, p.i), v1 = coatEntry(n, p.i + 1);
+  return v0 + p.t * (v1 - v0);
+}
+// t(mu): the share of light from a direction mu = cos theta above the coat that reaches the base.
+ENVGI_INLINE float coatTransmittance(const CoatNode& n, float mu) { return coatTransmittanceAt(n, coatPlace(mu)); }
 ENVGI_INLINE float coatInternalReflectance(const CoatNode& n) { return coatEntry(n, kCoatRes); }
 ENVGI_INLINE float coatDiffuseTransmittance(const CoatNode& n) { return coatEntry(n, kCoatRes + 1); }
 

@@ -227,6 +227,7 @@ struct TileBatch {
   std::vector<int> drawing;             // the round's paths with such a draw
   std::vector<int> escaping;            // the round's paths whose ray escaped
   std::vector<int> hitting;             // and those whose ray hit
+  std::vector<int> sampling, picking;   // hits whose BSDF samples go to the lanes; one material's
   RoundLanes lanes;                     // the round's work done lane by lane
   void resize(size_t n) {
     if (state.size() >= n) return;
@@ -234,9 +235,47 @@ struct TileBatch {
     active.resize(n), shadow.resize(n);
     ld.resize(n), ldBeta.resize(n), weight.resize(n), acc.resize(n), accSq.resize(n), accW.resize(n);
     ahead.resize(n), draw.resize(n), drawing.resize(n), escaping.resize(n), hitting.resize(n);
+    sampling.resize(n), picking.resize(n);
     lanes.resize(n);
   }
 };
+
+// The BSDF samples of a round's hits on rough plastics (RoundLanes::samplesInLanes), worked out
+// in vector lanes a material at a time into each hit's ahead.bs, from the pairs drawn ahead
+// (ahead.ub): pathShade then takes them (drawBsdfSample). Hits [0, hits) of b->hitting, their
+// interactions found (pathShadeAhead); a path that ends before its BSDF sample is left out.
+inline void sampleBsdfsInLanes(const SceneView& sc, const PathParams& pp, TileBatch* b, int hits) {
+  if (!pp.bsdfSample) return;
+  int left = 0;
+  for (int j = 0; j < hits; ++j) {
+    const int k = b->hitting[j];
+    const ShadeAhead& a = b->ahead[k];
+    if (!(pp.maxDepth >= 0 && b->state[k].depth >= pp.maxDepth) && RoundLanes::samplesInLanes(sc.bsdfs[a.si.bsdf]))
+      b->sampling[left++] = k;
+  }
+  RoundLanes& lanes = b->lanes;
+  while (left > 0) {
+    const int material = b->ahead[b->sampling[0]].si.bsdf;
+    int n = 0, rest = 0;
+    for (int i = 0; i < left; ++i) {
+      const int k = b->sampling[i];
+      const ShadeAhead& a = b->ahead[k];
+      if (a.si.bsdf != material) {
+        b->sampling[rest++] = k;
+        continue;
+      }
+      b->picking[n] = k;
+      lanes.setBsdfDraw(n++, a.si.shading.toLocal(-b->state[k].ray.d), a.ub.u);  // pathShade's woLocal
+    }
+    lanes.sampleRoughPlastic(sc.bsdfs[material], n);
+    for (int j = 0; j < n; ++j) {
+      BsdfSampleAhead& s = b->ahead[b->picking[j]].bs;
+      s.ok = lanes.bsdfSampleOf(j, &s.s);
+      s.made = true;
+    }
+    left = rest;
+  }
+}
 
 // Keeps a path's next-event sample for the round's shadow rays (renderTileByBounce; CPU only).
 // st is one of b->state, whose index names the path's slots. A sample without a ray adds its
@@ -416,6 +455,7 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
         if (integ.shadeAhead(b->state[k], b->hit[k], b->sampler[k], &b->ahead[k], &b->draw[k], inLanes ? &uL : nullptr))
           b->drawing[draws++] = k;
       }
+      if (inLanes) sampleBsdfsInLanes(*integ.scene, pp, b, hits);
       const EnvironmentMapView& env = integ.scene->env;
       for (int i = 0; i < draws; ++i) env.product.aheadLevel1(&b->draw[b->drawing[i]]);
       for (int i = 0; i < draws; ++i) env.product.aheadLevel2(&b->draw[b->drawing[i]]);

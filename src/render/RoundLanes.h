@@ -36,6 +36,15 @@ struct RoundLanes {
   // drawAhead: in, each lane's sampler (its pixel's hash, its position); out, two pairs of it.
   std::vector<uint32_t> dims;
   std::vector<float> lightU0, lightU1, bsdfU0, bsdfU1;
+  // sampleRoughPlastic: in, each lane's wo in its shading frame and its BSDF pair; between its
+  // steps, wo's z seen from the front, its coat reflectance, the disk points (polar, then
+  // Cartesian), the lobe (1: the coat) and a direction's place among the coat's nodes; out, the
+  // sample.
+  std::vector<float> woX, woY, woZ, sampleU0, sampleU1;
+  std::vector<float> frontZ, fo, diskR, diskAngle, diskX, diskY, coatLobe, coatShare;
+  std::vector<int> coatAt;
+  std::vector<float> wiX, wiY, wiZ, weightR, weightG, weightB, samplePdf;
+  std::vector<unsigned char> sampled;
 
   void resize(size_t n);
 
@@ -74,6 +83,26 @@ struct RoundLanes {
   // Lane j's draw as placeDraws left it, for ProductDraw: placed, with its radiance.
   void placedDraw(int j, Vec2f* uv, float* pdfUV, Color* radiance) const {
     *uv = uvOf(j), *pdfUV = placedPdf[j], *radiance = radianceOf(j);
+  }
+
+  // Whether sampleRoughPlastic takes this material: a rough plastic of GGX, isotropic, with its
+  // coat's tables and no texture (nor a normal or bump map). The example scenes' glossy BSDF;
+  // others are sampled one at a time, as before.
+  static bool samplesInLanes(const Bsdf& b) {
+    return b.type == BsdfType::RoughPlastic && b.distribution == MicrofacetType::GGX && !bsdfIsAnisotropic(b) &&
+           !bsdfHasTexture(b) && !bsdfIsBlend(b) && b.coatNodes > 0;
+  }
+  void setBsdfDraw(int j, Vec3f wo, Vec2f u) { woX[j] = wo.x, woY[j] = wo.y, woZ[j] = wo.z, sampleU0[j] = u.x, sampleU1[j] = u.y; }
+  // Lanes [0, n), all of material b (samplesInLanes): what bsdfSample(b, wo, 0, u, s, true)
+  // gives for each, to the bit, with libm's sine and cosine taken one lane at a time.
+  void sampleRoughPlastic(const Bsdf& b, int n);
+  // Lane j's answer: false where bsdfSample gives no sample, else the sample in *s.
+  bool bsdfSampleOf(int j, BsdfSample* s) const {
+    s->wi = Vec3f(wiX[j], wiY[j], wiZ[j]);
+    s->weight = Color(weightR[j], weightG[j], weightB[j]);
+    s->pdf = samplePdf[j];
+    s->delta = false;
+    return sampled[j] != 0;
   }
 };
 

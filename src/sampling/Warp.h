@@ -37,27 +37,31 @@ ENVGI_INLINE Vec3f sampleUniformCone(Vec2f u, float cosMax) {
 }
 ENVGI_INLINE float uniformConePdf(float cosMax) { return 1.f / (2.f * kPi * (1.f - cosMax)); }
 
-// Shirley-Chiu concentric map: keeps strata compact, which stratified sequences rely on.
-ENVGI_INLINE Vec2f sampleConcentricDisk(Vec2f u) {
-  float ox = 2.f * u.x - 1.f, oy = 2.f * u.y - 1.f;
-  if (ox == 0.f && oy == 0.f) return {0.f, 0.f};
-  float r, theta;
-  if (std::fabs(ox) > std::fabs(oy)) {
-    r = ox;
-    theta = (kPi / 4.f) * (oy / ox);
-  } else {
-    r = oy;
-    theta = kPi / 2.f - (kPi / 4.f) * (ox / oy);
-  }
-  return {r * std::cos(theta), r * std::sin(theta)};
+// A point of a disk as (r cos angle, r sin angle), in two steps: the disk warps below find r
+// and the angle, fromPolar calls libm. RoundLanes::sampleRoughPlastic runs the steps around
+// libm's sine and cosine in vector lanes and those one lane at a time, to the same bits.
+struct PolarPoint {
+  float r, angle;
+};
+ENVGI_INLINE Vec2f fromPolar(PolarPoint p) { return {p.r * std::cos(p.angle), p.r * std::sin(p.angle)}; }
+
+// Shirley-Chiu concentric map: keeps strata compact, which stratified sequences rely on. The
+// centre is r = 0 at angle 0, (0, 0) as fromPolar gives it.
+// Both octant pairs' forms are worked out, then one chosen: branch-free, for the lanes.
+ENVGI_INLINE PolarPoint concentricDiskPolar(Vec2f u) {
+  const float ox = 2.f * u.x - 1.f, oy = 2.f * u.y - 1.f;
+  const bool xMajor = std::fabs(ox) > std::fabs(oy);
+  const float r = xMajor ? ox : oy;
+  const float angle = xMajor ? (kPi / 4.f) * (oy / ox) : kPi / 2.f - (kPi / 4.f) * (ox / oy);
+  const bool centre = ox == 0.f && oy == 0.f;
+  return {centre ? 0.f : r, centre ? 0.f : angle};
 }
+ENVGI_INLINE Vec2f sampleConcentricDisk(Vec2f u) { return fromPolar(concentricDiskPolar(u)); }
 
 // Malley's method: cosine-weighted directions about +z, pdf = cos(theta) / pi.
-ENVGI_INLINE Vec3f sampleCosineHemisphere(Vec2f u) {
-  Vec2f d = sampleConcentricDisk(u);
-  float z = safeSqrt(1.f - d.x * d.x - d.y * d.y);
-  return {d.x, d.y, z};
-}
+// d: a point of the unit disk (sampleConcentricDisk's), lifted onto the hemisphere.
+ENVGI_INLINE Vec3f cosineHemisphereFromDisk(Vec2f d) { return {d.x, d.y, safeSqrt(1.f - d.x * d.x - d.y * d.y)}; }
+ENVGI_INLINE Vec3f sampleCosineHemisphere(Vec2f u) { return cosineHemisphereFromDisk(sampleConcentricDisk(u)); }
 ENVGI_INLINE float cosineHemispherePdf(float cosTheta) { return cosTheta > 0.f ? cosTheta * kInvPi : 0.f; }
 
 // A point of [0, 1) with density proportional to (1 - x) a + x b (a, b >= 0): the inverse of its
