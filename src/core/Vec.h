@@ -1,6 +1,9 @@
 // Small value types for points, directions and colours; usable on host and device.
 #pragma once
 
+#include <cstdint>
+#include <cstring>
+
 #include "core/Common.h"
 
 namespace envgi {
@@ -52,6 +55,13 @@ ENVGI_INLINE float luminance(Vec3f c) { return luminance(c.x, c.y, c.z); }
 ENVGI_INLINE bool isBlack(Vec3f c) { return c.x == 0.f && c.y == 0.f && c.z == 0.f; }
 ENVGI_INLINE bool isFiniteVec(Vec3f c) {
   return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
+}
+// Equal to the bit (+0 is not -0, a NaN is itself).
+ENVGI_INLINE bool sameBits(Vec3f a, Vec3f b) {
+  uint32_t x[3], y[3];
+  memcpy(x, &a.x, 4), memcpy(x + 1, &a.y, 4), memcpy(x + 2, &a.z, 4);
+  memcpy(y, &b.x, 4), memcpy(y + 1, &b.y, 4), memcpy(y + 2, &b.z, 4);
+  return x[0] == y[0] && x[1] == y[1] && x[2] == y[2];
 }
 ENVGI_INLINE Vec3f faceForward(Vec3f n, Vec3f v) { return dot(n, v) < 0.f ? -n : n; }
 ENVGI_INLINE Vec3f reflect(Vec3f wo, Vec3f n) { return -wo + 2.f * dot(wo, n) * n; }

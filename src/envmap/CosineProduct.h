@@ -76,6 +76,10 @@ struct ProductDraw {
   // map's radiance there looked up (RoundLanes::placeDraws).
   bool placed = false;
   Color radiance;
+  // Its world direction (EnvironmentMapView::fromLocal(uvToDir(uv))), worked out ahead (the
+  // CPU's renderTileByBounce, for the BSDF's value there in lanes).
+  bool directed = false;
+  Vec3f dir;
   ENVGI_HD bool isFor(Vec2f u2, Vec3f n2) const {
     return u.x == u2.x && u.y == u2.y && nLocal.x == n2.x && nLocal.y == n2.y && nLocal.z == n2.z;
   }

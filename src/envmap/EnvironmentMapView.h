@@ -334,6 +334,7 @@ struct EnvironmentMapView {
     EnvSample out;
     Vec3f local;
     const Color* lookedUp = nullptr;  // the radiance at out.uv, where a draw made ahead looked it up
+    const Vec3f* dirAhead = nullptr;  // and out.dir, where it was worked out ahead
     switch (strategyFor(s, normal)) {
       case EnvStrategy::Uniform: {
         local = sampleUniformSphere(u);
@@ -381,7 +382,8 @@ struct EnvironmentMapView {
         }
         if (ahead && drawn->placed) lookedUp = &drawn->radiance;
         else out.uv = placeInPixel(out.uv, &pdfUV);
-        local = uvToDir(out.uv);
+        if (ahead && drawn->directed) dirAhead = &drawn->dir;
+        else local = uvToDir(out.uv);
         out.pdf = solidAnglePdf(pdfUV, out.uv.y);
         break;
       }
@@ -403,7 +405,7 @@ struct EnvironmentMapView {
         return out;
       }
     }
-    out.dir = fromLocal(local);
+    out.dir = dirAhead ? *dirAhead : fromLocal(local);
     out.radiance = out.pdf > 0.f ? (lookedUp ? *lookedUp : lookupUV(out.uv)) : Color(0.f);
     return out;
   }

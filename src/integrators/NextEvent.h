@@ -21,17 +21,29 @@ struct LightSampleLd {
   bool needsRay = false;
 };
 
+// The BSDF's value and density for a light direction, worked out ahead (the CPU's
+// RoundLanes::evalRoughPlastic, a round's rough plastic evaluations in vector lanes): bsdfEvalPdf's
+// for wi in the shading frame, which prepareLd takes where its direction is wi to the bit.
+struct BsdfEvalAhead {
+  Vec3f wi;
+  Color f;
+  float pdf = 0.f;
+  bool made = false;
+};
+
 // Its sample dimensions are taken whatever happens, so sequences stay aligned across pixels.
 // `partner` is a blend's other material (sc.partnerAt(si)), evaluated beside bsdf at
 // si.partnerWeight (materials/BsdfMix.h). The kind of light is picked by uL.x (sampleLight), so
 // the dimension a choice of its own once took is skipped, as is the area light's second pair
 // where the map is the only light (the image stays the same there). uLDrawn: the light's 2D
 // draw where the caller took it ahead from a copy of smp (lightDrawOf), stepped over here;
-// productDrawn: the map's product draw for it, made ahead (sampleLight's).
+// productDrawn: the map's product draw for it, made ahead (sampleLight's); evalAhead: the BSDF
+// (without a partner) evaluated ahead for the direction that draw gives.
 ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
                                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
                                         Sampler& smp, const Bsdf* partner = nullptr,
-                                        const Vec2f* uLDrawn = nullptr, const ProductDraw* productDrawn = nullptr) {
+                                        const Vec2f* uLDrawn = nullptr, const ProductDraw* productDrawn = nullptr,
+                                        const BsdfEvalAhead* evalAhead = nullptr) {
   LightSampleLd out;
   const bool mapOnly = sc.envSelectProb() == 1.f;  // sampleLight then takes the map for any uL
   smp.skip1D();
@@ -43,7 +55,12 @@ ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceIntera
   if (bsdfMixIsDelta(bsdf, partner) || !sampleLight(sc, si, axis, strategy, uL, uL2, &ls, productDrawn)) return out;
   Vec3f wiLocal = si.shading.toLocal(ls.dir);
   float bsdfPdfOfLight;
-  Color f = bsdfMixEvalPdf(bsdf, partner, si.partnerWeight, woLocal, wiLocal, &bsdfPdfOfLight);
+  Color f;
+  if (evalAhead && evalAhead->made && !partner && sameBits(wiLocal, evalAhead->wi)) {
+    f = evalAhead->f, bsdfPdfOfLight = evalAhead->pdf;
+  } else {
+    f = bsdfMixEvalPdf(bsdf, partner, si.partnerWeight, woLocal, wiLocal, &bsdfPdfOfLight);
+  }
   if (isBlack(f) || isBlack(ls.radiance)) return out;
   out.o = offsetRayOrigin(si.p, si.ng, ls.dir, si.t);
   out.d = ls.dir;

@@ -47,6 +47,7 @@ struct ShadeAhead {
   bool drawn = false;  // uL holds prepareLd's draw
   Draw2DAhead ub;      // the BSDF's pair, where it was drawn ahead (pathBsdfDrawOffset)
   BsdfSampleAhead bs;  // and the BSDF's sample for it, where that was worked out ahead
+  BsdfEvalAhead ev;    // the BSDF at the product draw's direction, where that was worked out ahead
   // The map's product draw for uL, where the executor walked it to its end (aheadDraw).
   bool productAhead = false;
   ProductDraw product;
@@ -144,7 +145,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   if (pp.lightSample)
     shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, pp.bsdfSample ? 1.f : 0.f, smp, partner,
                      ahead && ahead->drawn ? &ahead->uL : nullptr,
-                     ahead && ahead->productAhead ? &ahead->product : nullptr),
+                     ahead && ahead->productAhead ? &ahead->product : nullptr, ahead ? &ahead->ev : nullptr),
            st);
   if (!pp.bsdfSample) return false;
 
@@ -192,6 +193,7 @@ inline bool pathShadeAhead(const SceneView& sc, const PathState& st, const Hit& 
   ahead->si = sc.interaction(st.ray, h);
   ahead->productAhead = false;
   ahead->bs.made = false;
+  ahead->ev.made = false;
   ahead->drawn = pp.lightSample && !(pp.maxDepth >= 0 && st.depth >= pp.maxDepth);
   if (!ahead->drawn) return false;
   ahead->uL = lightDrawOf(smp, uL);

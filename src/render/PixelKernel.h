@@ -240,41 +240,81 @@ struct TileBatch {
   }
 };
 
+// Lanes over the hits b->sampling[0, count), a material at a time: put(n, k) sets lane n from
+// hit k, run(material, n) runs lanes [0, n), take(j, k) reads lane j back into hit k.
+template <class Put, class Run, class Take>
+inline void byMaterial(TileBatch* b, int count, Put put, Run run, Take take) {
+  int left = count;
+  while (left > 0) {
+    const int material = b->ahead[b->sampling[0]].si.bsdf;
+    int n = 0, rest = 0;
+    for (int i = 0; i < left; ++i) {
+      const int k = b->sampling[i];
+      if (b->ahead[k].si.bsdf != material) {
+        b->sampling[rest++] = k;
+        continue;
+      }
+      b->picking[n] = k;
+      put(n++, k);
+    }
+    run(material, n);
+    for (int j = 0; j < n; ++j) take(j, b->picking[j]);
+    left = rest;
+  }
+}
+
+// What pathShade's woLocal is for hit k (its interaction found ahead).
+inline Vec3f aheadWo(const TileBatch* b, int k) { return b->ahead[k].si.shading.toLocal(-b->state[k].ray.d); }
+
 // The BSDF samples of a round's hits on rough plastics (RoundLanes::samplesInLanes), worked out
 // in vector lanes a material at a time into each hit's ahead.bs, from the pairs drawn ahead
 // (ahead.ub): pathShade then takes them (drawBsdfSample). Hits [0, hits) of b->hitting, their
 // interactions found (pathShadeAhead); a path that ends before its BSDF sample is left out.
 inline void sampleBsdfsInLanes(const SceneView& sc, const PathParams& pp, TileBatch* b, int hits) {
   if (!pp.bsdfSample) return;
-  int left = 0;
+  int count = 0;
   for (int j = 0; j < hits; ++j) {
     const int k = b->hitting[j];
-    const ShadeAhead& a = b->ahead[k];
-    if (!(pp.maxDepth >= 0 && b->state[k].depth >= pp.maxDepth) && RoundLanes::samplesInLanes(sc.bsdfs[a.si.bsdf]))
-      b->sampling[left++] = k;
+    if (!(pp.maxDepth >= 0 && b->state[k].depth >= pp.maxDepth) &&
+        RoundLanes::samplesInLanes(sc.bsdfs[b->ahead[k].si.bsdf]))
+      b->sampling[count++] = k;
   }
   RoundLanes& lanes = b->lanes;
-  while (left > 0) {
-    const int material = b->ahead[b->sampling[0]].si.bsdf;
-    int n = 0, rest = 0;
-    for (int i = 0; i < left; ++i) {
-      const int k = b->sampling[i];
-      const ShadeAhead& a = b->ahead[k];
-      if (a.si.bsdf != material) {
-        b->sampling[rest++] = k;
-        continue;
-      }
-      b->picking[n] = k;
-      lanes.setBsdfDraw(n++, a.si.shading.toLocal(-b->state[k].ray.d), a.ub.u);  // pathShade's woLocal
-    }
-    lanes.sampleRoughPlastic(sc.bsdfs[material], n);
-    for (int j = 0; j < n; ++j) {
-      BsdfSampleAhead& s = b->ahead[b->picking[j]].bs;
-      s.ok = lanes.bsdfSampleOf(j, &s.s);
-      s.made = true;
-    }
-    left = rest;
+  byMaterial(
+      b, count, [&](int n, int k) { lanes.setBsdfDraw(n, aheadWo(b, k), b->ahead[k].ub.u); },
+      [&](int material, int n) { lanes.sampleRoughPlastic(sc.bsdfs[material], n); },
+      [&](int j, int k) {
+        BsdfSampleAhead& s = b->ahead[k].bs;
+        s.ok = lanes.bsdfSampleOf(j, &s.s);
+        s.made = true;
+      });
+}
+
+// The same BSDFs evaluated in lanes for their light samples' directions, where the light sample
+// is a product draw placed ahead (ahead.product): the draw's world direction is worked out here,
+// which EnvironmentMapView::sample then takes, and prepareLd takes the value and density
+// (BsdfEvalAhead) for that direction. Hits [0, draws) of b->drawing; a hit with a blend's
+// partner is left out (prepareLd evaluates the two together).
+inline void evalBsdfsInLanes(const SceneView& sc, TileBatch* b, int draws) {
+  int count = 0;
+  for (int i = 0; i < draws; ++i) {
+    const int k = b->drawing[i];
+    const ShadeAhead& a = b->ahead[k];
+    if (a.product.drawn && a.product.placed && a.si.partner < 0 && RoundLanes::samplesInLanes(sc.bsdfs[a.si.bsdf]))
+      b->sampling[count++] = k;
   }
+  RoundLanes& lanes = b->lanes;
+  const EnvironmentMapView& env = sc.env;
+  byMaterial(
+      b, count,
+      [&](int n, int k) {
+        ProductDraw& d = b->ahead[k].product;
+        d.dir = env.fromLocal(EnvironmentMapView::uvToDir(d.uv));  // sample()'s, for the placed draw
+        d.directed = true;
+        lanes.setBsdfEval(n, aheadWo(b, k), b->ahead[k].si.shading.toLocal(d.dir));  // prepareLd's wiLocal
+      },
+      [&](int material, int n) { lanes.evalRoughPlastic(sc.bsdfs[material], n); },
+      [&](int j, int k) { b->ahead[k].ev = lanes.bsdfEvalOf(j); });
 }
 
 // Keeps a path's next-event sample for the round's shadow rays (renderTileByBounce; CPU only).
@@ -481,6 +521,7 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
           lanes.placedDraw(j++, &d.uv, &d.pdfUV, &d.radiance);
           d.placed = true;
         }
+        evalBsdfsInLanes(*integ.scene, b, draws);
       }
       for (int i = 0; i < live; ++i) {
         int k = b->active[i];

@@ -204,6 +204,53 @@ ENVGI_LANES void roughPlasticValues(int n, const Bsdf& bsdf, const CoatNode& nod
   }
 }
 
+// bsdfEvalPdf's evalPdfInFrame for rough plastic: the two-sided flip of both directions, each
+// one's place among the coat's nodes (apart, as coatPlaces).
+ENVGI_LANES void evalPlaces(int n, const float* __restrict zo, const float* __restrict zi, bool twoSided,
+                            float* __restrict fzo, float* __restrict fzi, int* __restrict ato,
+                            float* __restrict shareo, int* __restrict ati, float* __restrict sharei) {
+  for (int i = 0; i < n; ++i) {
+    const bool flip = twoSided && zo[i] < 0.f;
+    const float co = flip ? -zo[i] : zo[i], ci = flip ? -zi[i] : zi[i];
+    const CoatPlace po = coatPlace(co), pi = coatPlace(ci);
+    fzo[i] = co, fzi[i] = ci, ato[i] = po.i, shareo[i] = po.t, ati[i] = pi.i, sharei[i] = pi.t;
+  }
+}
+
+// Then the value and density, and whether both directions are above the (front) surface.
+template <bool Nonlinear>
+ENVGI_LANES void roughPlasticEvals(int n, const Bsdf& bsdf, const CoatNode& node, const MicrofacetDistribution& dist,
+                                   const float* __restrict wx, const float* __restrict wy,
+                                   const float* __restrict fzo, const float* __restrict ix,
+                                   const float* __restrict iy, const float* __restrict fzi,
+                                   const int* __restrict ato, const float* __restrict shareo,
+                                   const int* __restrict ati, const float* __restrict sharei, float* __restrict fr,
+                                   float* __restrict fg, float* __restrict fb, float* __restrict pdf,
+                                   unsigned char* __restrict above) {
+  Bsdf b = bsdf;
+  b.nonlinear = Nonlinear;
+  const CoatNode coat = node;
+  const MicrofacetDistribution d{dist.alphaX, dist.alphaY, MicrofacetType::GGX};
+  if (b.coatNodes <= 0) __builtin_unreachable();
+  // The coat's tables are read only and apart from the arrays written, which GCC cannot see
+  // through CoatNode's pointers here.
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC ivdep
+#endif
+  for (int i = 0; i < n; ++i) {
+    const Vec3f wo(wx[i], wy[i], fzo[i]), wi(ix[i], iy[i], fzi[i]);
+    const float fo = detail::roughCoatReflectanceAt(coat, CoatPlace{ato[i], shareo[i]});
+    const detail::RoughPlasticShared r = detail::roughPlasticShared(d, coat, fo, wo, wi);
+    const float p = detail::roughPlasticPdf(b, r, wo, wi);
+    const Color f = detail::roughPlasticSpecular(b, d, r, wo, wi) +
+                    detail::roughPlasticThroughCoat(b, r, coatTransmittanceAt(coat, CoatPlace{ati[i], sharei[i]}), wi);
+    // Written whatever the sides; the zeros below the surface are chosen when read (bsdfEvalOf):
+    // chosen here, GCC made the table's gathers conditional, which it does not vectorise.
+    above[i] = (wo.z > 0.f) & (wi.z > 0.f);
+    fr[i] = f.x, fg[i] = f.y, fb[i] = f.z, pdf[i] = p;
+  }
+}
+
 }  // namespace
 
 void RoundLanes::resize(size_t n) {
@@ -212,10 +259,10 @@ void RoundLanes::resize(size_t n) {
        {&ux, &uy, &lx, &ly, &weight, &ox, &oy, &oz, &dx, &dy, &dz, &tMax, &u, &v, &lightU0, &lightU1, &bsdfU0, &bsdfU1,
         &red, &green, &blue, &drawU, &drawV, &drawPdf, &placedPdf, &woX, &woY, &woZ, &sampleU0, &sampleU1, &diskR,
         &diskAngle, &diskX, &diskY, &coatLobe, &wiX, &wiY, &wiZ, &weightR, &weightG, &weightB, &samplePdf, &frontZ,
-        &fo, &coatShare})
+        &fo, &coatShare, &frontZi, &coatShareI})
     a->resize(n);
   px.resize(n), py.resize(n), hash.resize(n), dims.resize(n), picked.resize(n), redo.resize(n), sampled.resize(n);
-  coatAt.resize(n);
+  coatAt.resize(n), coatAtI.resize(n);
 }
 
 void RoundLanes::make(const Camera& cam, const Sampler& first, int n) {
@@ -304,6 +351,15 @@ void RoundLanes::sampleRoughPlastic(const Bsdf& b, int n) {
   values(n, b, coat, d, woX.data(), woY.data(), frontZ.data(), fo.data(), woZ.data(), coatAt.data(),
                      coatShare.data(), wiX.data(), wiY.data(), wiZ.data(), weightR.data(), weightG.data(),
                      weightB.data(), samplePdf.data(), sampled.data());
+}
+
+void RoundLanes::evalRoughPlastic(const Bsdf& b, int n) {
+  evalPlaces(n, woZ.data(), wiZ.data(), b.twoSided, frontZ.data(), frontZi.data(), coatAt.data(), coatShare.data(),
+             coatAtI.data(), coatShareI.data());
+  auto evals = b.nonlinear ? roughPlasticEvals<true> : roughPlasticEvals<false>;
+  evals(n, b, detail::roughCoat(b), microfacet(b), woX.data(), woY.data(), frontZ.data(), wiX.data(), wiY.data(),
+        frontZi.data(), coatAt.data(), coatShare.data(), coatAtI.data(), coatShareI.data(), weightR.data(),
+        weightG.data(), weightB.data(), samplePdf.data(), sampled.data());
 }
 
 }  // namespace envgi

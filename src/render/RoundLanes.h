@@ -43,6 +43,12 @@ struct RoundLanes {
   std::vector<float> woX, woY, woZ, sampleU0, sampleU1;
   std::vector<float> frontZ, fo, diskR, diskAngle, diskX, diskY, coatLobe, coatShare;
   std::vector<int> coatAt;
+  // evalRoughPlastic: in, wo (woX, woY, woZ) and wi (wiX, wiY, wiZ); between its steps, wi's z
+  // seen from the front and its place among the coat's nodes; out, the value (weightR, weightG,
+  // weightB) and the density (samplePdf), which count where both directions are above the
+  // surface (sampled).
+  std::vector<float> frontZi, coatShareI;
+  std::vector<int> coatAtI;
   std::vector<float> wiX, wiY, wiZ, weightR, weightG, weightB, samplePdf;
   std::vector<unsigned char> sampled;
 
@@ -96,6 +102,20 @@ struct RoundLanes {
   // Lanes [0, n), all of material b (samplesInLanes): what bsdfSample(b, wo, 0, u, s, true)
   // gives for each, to the bit, with libm's sine and cosine taken one lane at a time.
   void sampleRoughPlastic(const Bsdf& b, int n);
+  // Lanes [0, n), all of material b (samplesInLanes), wo and wi given (setBsdfEval): what
+  // bsdfEvalPdf(b, wo, wi, &pdf) gives for each, to the bit.
+  void setBsdfEval(int j, Vec3f wo, Vec3f wi) {
+    woX[j] = wo.x, woY[j] = wo.y, woZ[j] = wo.z, wiX[j] = wi.x, wiY[j] = wi.y, wiZ[j] = wi.z;
+  }
+  void evalRoughPlastic(const Bsdf& b, int n);
+  BsdfEvalAhead bsdfEvalOf(int j) const {
+    BsdfEvalAhead e;
+    e.wi = Vec3f(wiX[j], wiY[j], wiZ[j]);
+    e.f = sampled[j] ? Color(weightR[j], weightG[j], weightB[j]) : Color(0.f);
+    e.pdf = sampled[j] ? samplePdf[j] : 0.f;
+    e.made = true;
+    return e;
+  }
   // Lane j's answer: false where bsdfSample gives no sample, else the sample in *s.
   bool bsdfSampleOf(int j, BsdfSample* s) const {
     s->wi = Vec3f(wiX[j], wiY[j], wiZ[j]);

@@ -275,3 +275,45 @@ TEST(RoundLanes, RoughPlasticSamplesInLanesAreBsdfSampleToTheBit) {
   EXPECT_GT(base, 1000);
   EXPECT_GT(none, 300);
 }
+
+// A round's rough plastic evaluations in lanes (evalRoughPlastic) are bsdfEvalPdf's, value and
+// density, to the bit: one- and two-sided, linear and nonlinear, wo and wi on either side.
+TEST(RoundLanes, RoughPlasticEvaluationsInLanesAreBsdfEvalPdfToTheBit) {
+  Pcg32 rng(37);
+  int compared = 0, zero = 0;
+  for (int variant = 0; variant < 8; ++variant) {
+    Bsdf b;
+    b.type = BsdfType::RoughPlastic;
+    b.alpha = variant % 4 == 0 ? 0.02f : (variant % 4 == 1 ? 0.12f : (variant % 4 == 2 ? 0.5f : 1.7f));
+    b.twoSided = variant % 2 == 0;
+    b.nonlinear = variant / 2 % 2 == 1;
+    b.reflectance = Color(0.55f, 0.45f, 0.3f);
+    b.ior = variant < 4 ? 1.49f : 1.8f;
+    finishPlastic(b);
+    attachRoughCoat(b);
+    const int n = 503;
+    RoundLanes lanes;
+    lanes.resize(size_t(n));
+    std::vector<Vec3f> wos(n), wis(n);
+    for (int j = 0; j < n; ++j) {
+      wos[j] = sampleUniformSphere(Vec2f(rng.nextFloat(), rng.nextFloat()));
+      wis[j] = sampleUniformSphere(Vec2f(rng.nextFloat(), rng.nextFloat()));
+      if (j % 9 == 0) wis[j] = Vec3f(-wos[j].x, -wos[j].y, wos[j].z);  // the mirror direction
+      lanes.setBsdfEval(j, wos[j], wis[j]);
+    }
+    lanes.evalRoughPlastic(b, n);
+    for (int j = 0; j < n; ++j) {
+      float pdf;
+      const Color f = bsdfEvalPdf(b, wos[j], wis[j], &pdf);
+      const BsdfEvalAhead e = lanes.bsdfEvalOf(j);
+      EXPECT_TRUE(sameBits(f, e.f) && sameBits(Vec3f(pdf, 0.f, 0.f), Vec3f(e.pdf, 0.f, 0.f)) &&
+                  sameBits(e.wi, wis[j]) && e.made)
+          << "variant " << variant << " lane " << j;
+      ++compared;
+      zero += pdf == 0.f;
+    }
+  }
+  EXPECT_EQ(compared, 8 * 503);
+  EXPECT_GT(zero, 500) << "the directions below the surface were not reached";
+  EXPECT_LT(zero, 3000);
+}
