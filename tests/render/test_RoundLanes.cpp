@@ -209,6 +209,24 @@ TEST(RoundLanes, DrawsPlacedInLanesAreThePlacedDrawsToTheBit) {
   EXPECT_GT(redone, 0) << "no draw took insidePixel's steps: the edge cases no longer reach them";
 }
 
+namespace {
+// Eight rough plastics with their coat's tables: four roughnesses, one- and two-sided, linear
+// and nonlinear bases, two coats.
+Bsdf roughPlasticVariant(int variant) {
+  Bsdf b;
+  b.type = BsdfType::RoughPlastic;
+  b.alpha = variant % 4 == 0 ? 0.02f : (variant % 4 == 1 ? 0.12f : (variant % 4 == 2 ? 0.5f : 1.7f));
+  b.twoSided = variant % 2 == 0;
+  b.nonlinear = variant / 2 % 2 == 1;
+  b.reflectance = Color(0.55f, 0.45f, 0.3f);
+  b.specularReflectance = variant < 4 ? Color(1.f) : Color(0.9f, 0.8f, 0.6f);
+  b.ior = variant < 4 ? 1.49f : 1.8f;
+  finishPlastic(b);
+  attachRoughCoat(b);
+  return b;
+}
+}  // namespace
+
 // A round's rough plastic samples in lanes (sampleRoughPlastic) are bsdfSample's with the lobe
 // from u (path's and direct's call), to the bit, or fail where it fails: one- and two-sided,
 // linear and nonlinear bases, several roughnesses, wo in both hemispheres and at grazing angles,
@@ -217,16 +235,7 @@ TEST(RoundLanes, RoughPlasticSamplesInLanesAreBsdfSampleToTheBit) {
   Pcg32 rng(31);
   int cases = 0, failures = 0, coat = 0, base = 0, none = 0;
   for (int variant = 0; variant < 8; ++variant) {
-    Bsdf b;
-    b.type = BsdfType::RoughPlastic;
-    b.alpha = variant % 4 == 0 ? 0.02f : (variant % 4 == 1 ? 0.12f : (variant % 4 == 2 ? 0.5f : 1.7f));
-    b.twoSided = variant % 2 == 0;
-    b.nonlinear = variant / 2 % 2 == 1;
-    b.reflectance = Color(0.55f, 0.45f, 0.3f);
-    b.specularReflectance = variant < 4 ? Color(1.f) : Color(0.9f, 0.8f, 0.6f);
-    b.ior = variant < 4 ? 1.49f : 1.8f;
-    finishPlastic(b);
-    attachRoughCoat(b);
+    const Bsdf b = roughPlasticVariant(variant);
     ASSERT_TRUE(RoundLanes::samplesInLanes(b)) << "variant " << variant;
     const int n = 601;
     RoundLanes lanes;
@@ -282,15 +291,7 @@ TEST(RoundLanes, RoughPlasticEvaluationsInLanesAreBsdfEvalPdfToTheBit) {
   Pcg32 rng(37);
   int compared = 0, zero = 0;
   for (int variant = 0; variant < 8; ++variant) {
-    Bsdf b;
-    b.type = BsdfType::RoughPlastic;
-    b.alpha = variant % 4 == 0 ? 0.02f : (variant % 4 == 1 ? 0.12f : (variant % 4 == 2 ? 0.5f : 1.7f));
-    b.twoSided = variant % 2 == 0;
-    b.nonlinear = variant / 2 % 2 == 1;
-    b.reflectance = Color(0.55f, 0.45f, 0.3f);
-    b.ior = variant < 4 ? 1.49f : 1.8f;
-    finishPlastic(b);
-    attachRoughCoat(b);
+    const Bsdf b = roughPlasticVariant(variant);
     const int n = 503;
     RoundLanes lanes;
     lanes.resize(size_t(n));
