@@ -272,13 +272,13 @@ ENVGI_INLINE float roughPlasticPdf(const Bsdf& b, const RoughPlasticShared& r, V
 // eval's two terms. wo is above the surface (a two-sided one's seen from the front); d:
 // microfacet(b), GGX's; coat: roughCoat(b).
 // ps: the coat's share of the samples from wo (plasticSpecularProb); u.x < ps picks the coat,
-// and u.x is then stretched over the lobe's share: sampleInFrame's two stretchedDraw calls as one
-// (a choice between two masks does not vectorise).
-ENVGI_INLINE float roughPlasticLobeDraw(float ps, float ux) {
+// and u.x is then stretched over the lobe's share, in one stretchedDraw call (a choice between
+// two calls' clamps became a choice between masks, which GCC does not vectorise). Both plastics.
+ENVGI_INLINE float plasticLobeDraw(float ps, float ux) {
   const bool coatLobe = ux < ps;
   return stretchedDraw(ux, coatLobe ? 0.f : ps, coatLobe ? ps : 1.f - ps);
 }
-// u: the draw with u.x stretched (roughPlasticLobeDraw): the lobe's disk point in polar form.
+// u: the draw with u.x stretched (plasticLobeDraw): the lobe's disk point in polar form.
 ENVGI_INLINE PolarPoint roughPlasticDisk(bool coatLobe, Vec2f u) {
   const PolarPoint visible = MicrofacetDistribution::visibleDiskPolar(u), base = concentricDiskPolar(u);
   return {coatLobe ? visible.r : base.r, coatLobe ? visible.angle : base.angle};
@@ -513,7 +513,7 @@ ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, Bsdf
       float ps = detail::plasticSpecularProb(b, fo);
       if (lobeFromU) {  // bsdfLobeFromU: the coat below ps, the base above
         uc = u.x;
-        u.x = u.x < ps ? stretchedDraw(u.x, 0.f, ps) : stretchedDraw(u.x, ps, 1.f - ps);
+        u.x = plasticLobeDraw(ps, u.x);
       }
       if (b.type == BsdfType::Plastic && uc < ps) {
         s->wi = Vec3f(-wo.x, -wo.y, wo.z);

@@ -146,7 +146,7 @@ ENVGI_LANES void roughPlasticLobes(int n, const Bsdf& bsdf, const CoatNode& node
   for (int i = 0; i < n; ++i) {
     const float f = detail::roughCoatReflectanceAt(coat, CoatPlace{at[i], share[i]});
     const float ps = detail::plasticSpecularProb(b, f);
-    fo[i] = f, u0s[i] = detail::roughPlasticLobeDraw(ps, u0[i]), coatLobe[i] = u0[i] < ps ? 1.f : 0.f;
+    fo[i] = f, u0s[i] = detail::plasticLobeDraw(ps, u0[i]), coatLobe[i] = u0[i] < ps ? 1.f : 0.f;
   }
 }
 
