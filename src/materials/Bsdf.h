@@ -264,13 +264,22 @@ ENVGI_INLINE float roughPlasticPdf(const Bsdf& b, const RoughPlasticShared& r, V
   float visible = 1.f / (1.f + r.lambdaO) * cosOM * r.D / wo.z;
   return ps * (visible / (4.f * cosOM)) + (1.f - ps) * cosineHemispherePdf(wi.z);
 }
+// evalPdfInFrame's rough plastic with its coat's tables, for directions above the surface, its
+// two table lookups done ahead (fo: roughCoatReflectanceAt at wo, ti: t(wi)): the value, and
+// the density in *pdf. RoundLanes' sampling and evaluation loops both end with it.
+ENVGI_INLINE Color roughPlasticTabledEvalPdf(const Bsdf& b, const MicrofacetDistribution& d, const CoatNode& coat,
+                                             float fo, float ti, Vec3f wo, Vec3f wi, float* pdf) {
+  const RoughPlasticShared r = roughPlasticShared(d, coat, fo, wo, wi);
+  *pdf = roughPlasticPdf(b, r, wo, wi);
+  return roughPlasticSpecular(b, d, r, wo, wi) + roughPlasticThroughCoat(b, r, ti, wi);
+}
 
 // Rough plastic's sample with the lobe from u.x (bsdfLobeFromU, as path and direct draw it) in
 // the steps of sampleInFrame's that RoundLanes::sampleRoughPlastic runs in vector lanes around
-// libm's sine and cosine (fromPolar), one lane at a time: the lobe and its disk point in polar
-// form, then the direction from the point; then roughPlasticShared, roughPlasticPdf and the
-// eval's two terms. wo is above the surface (a two-sided one's seen from the front); d:
-// microfacet(b), GGX's; coat: roughCoat(b).
+// libm's sine and cosine (fromPolar), one lane at a time: the lobe's draw (plasticLobeDraw),
+// its disk point in polar form, the direction from the point, then roughPlasticTabledEvalPdf.
+// wo is above the surface (a two-sided one's seen from the front); d: microfacet(b), GGX's.
+
 // ps: the coat's share of the samples from wo (plasticSpecularProb); u.x < ps picks the coat,
 // and u.x is then stretched over the lobe's share, in one stretchedDraw call (a choice between
 // two calls' clamps became a choice between masks, which GCC does not vectorise). Both plastics.

@@ -192,10 +192,9 @@ ENVGI_LANES void roughPlasticValues(int n, const Bsdf& bsdf, const CoatNode& nod
   if (b.coatNodes <= 0) __builtin_unreachable();
   for (int i = 0; i < n; ++i) {
     const Vec3f wo(wx[i], wy[i], wz[i]), wi(ix[i], iy[i], iz[i]);
-    const detail::RoughPlasticShared r = detail::roughPlasticShared(d, coat, fo[i], wo, wi);
-    const float p = detail::roughPlasticPdf(b, r, wo, wi);
-    const Color f = detail::roughPlasticSpecular(b, d, r, wo, wi) +
-                    detail::roughPlasticThroughCoat(b, r, coatTransmittanceAt(coat, CoatPlace{at[i], share[i]}), wi);
+    float p;
+    const Color f = detail::roughPlasticTabledEvalPdf(
+        b, d, coat, fo[i], coatTransmittanceAt(coat, CoatPlace{at[i], share[i]}), wo, wi, &p);
     const Color w = f / p;
     ok[i] = (wo.z > 0.f) & (wi.z > 0.f) & (p > 0.f) & isFiniteVec(w);
     const bool flip = b.twoSided && zGiven[i] < 0.f;
@@ -239,11 +238,10 @@ ENVGI_LANES void roughPlasticEvals(int n, const Bsdf& bsdf, const CoatNode& node
 #endif
   for (int i = 0; i < n; ++i) {
     const Vec3f wo(wx[i], wy[i], fzo[i]), wi(ix[i], iy[i], fzi[i]);
-    const float fo = detail::roughCoatReflectanceAt(coat, CoatPlace{ato[i], shareo[i]});
-    const detail::RoughPlasticShared r = detail::roughPlasticShared(d, coat, fo, wo, wi);
-    const float p = detail::roughPlasticPdf(b, r, wo, wi);
-    const Color f = detail::roughPlasticSpecular(b, d, r, wo, wi) +
-                    detail::roughPlasticThroughCoat(b, r, coatTransmittanceAt(coat, CoatPlace{ati[i], sharei[i]}), wi);
+    float p;
+    const Color f = detail::roughPlasticTabledEvalPdf(
+        b, d, coat, detail::roughCoatReflectanceAt(coat, CoatPlace{ato[i], shareo[i]}),
+        coatTransmittanceAt(coat, CoatPlace{ati[i], sharei[i]}), wo, wi, &p);
     // Written whatever the sides; the zeros below the surface are chosen when read (bsdfEvalOf):
     // chosen here, GCC made the table's gathers conditional, which it does not vectorise.
     above[i] = (wo.z > 0.f) & (wi.z > 0.f);
@@ -336,7 +334,8 @@ void RoundLanes::placeDraws(const EnvironmentMapView& env, int n) {
 void RoundLanes::sampleRoughPlastic(const Bsdf& b, int n) {
   const CoatNode coat = detail::roughCoat(b);
   const MicrofacetDistribution d = microfacet(b);
-  // woZ keeps the given side; frontZ holds wo's z seen from the front.
+  // woZ keeps the given side; frontZ holds wo's z seen from the front. diskX holds the stretched
+  // u.x until fromPolar's loop writes the disk points there.
   coatPlaces(n, woZ.data(), frontZ.data(), b.twoSided, coatAt.data(), coatShare.data());
   roughPlasticLobes(n, b, coat, coatAt.data(), coatShare.data(), sampleU0.data(), fo.data(), diskX.data(),
                     coatLobe.data());
@@ -348,9 +347,9 @@ void RoundLanes::sampleRoughPlastic(const Bsdf& b, int n) {
   roughPlasticDirections(n, d, woX.data(), woY.data(), frontZ.data(), diskX.data(), diskY.data(), coatLobe.data(),
                          wiX.data(), wiY.data(), wiZ.data(), coatAt.data(), coatShare.data());
   auto values = b.nonlinear ? roughPlasticValues<true> : roughPlasticValues<false>;
-  values(n, b, coat, d, woX.data(), woY.data(), frontZ.data(), fo.data(), woZ.data(), coatAt.data(),
-                     coatShare.data(), wiX.data(), wiY.data(), wiZ.data(), weightR.data(), weightG.data(),
-                     weightB.data(), samplePdf.data(), sampled.data());
+  values(n, b, coat, d, woX.data(), woY.data(), frontZ.data(), fo.data(), woZ.data(), coatAt.data(), coatShare.data(),
+         wiX.data(), wiY.data(), wiZ.data(), weightR.data(), weightG.data(), weightB.data(), samplePdf.data(),
+         sampled.data());
 }
 
 void RoundLanes::evalRoughPlastic(const Bsdf& b, int n) {
