@@ -51,7 +51,11 @@ void runView(const ViewArgs& a) {
   ViewServer server(session, so);
   std::string url = fmt::format("http://{}:{}/", so.host == "0.0.0.0" ? "HOST" : so.host, server.port());
   if (!so.token.empty()) url += "?token=" + so.token;
-  spdlog::info("view: open {}  (Ctrl-C stops)", url);
+  // Printed even with -q: without the URL (and its token) the viewer cannot be opened.
+  if (spdlog::should_log(spdlog::level::info))
+    spdlog::info("view: open {}  (Ctrl-C stops)", url);
+  else
+    fmt::print("view: open {}  (Ctrl-C stops)\n", url);
   std::fflush(stdout);
   server.run();
   spdlog::info("view: stopped after {} frames", session.framesSent());

@@ -8,6 +8,7 @@
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 #include <ImfThreading.h>
 #include <openexr.h>
 #include <stb/stb_image.h>
@@ -265,10 +266,11 @@ bool writePfm(const Image& img, const fs::path& path) {
   return std::fclose(f.release()) == 0 && ok;
 }
 
-bool writeExr(const Image& img, const fs::path& path) {
+bool writeExr(const Image& img, const fs::path& path, const SaveOptions& opts) {
   useExrThreads();
   Imf::Header header(img.width, img.height);
   header.compression() = Imf::ZIP_COMPRESSION;
+  for (const auto& [name, value] : opts.exrAttributes) header.insert(name, Imf::StringAttribute(value));
   const char* names[3] = {"R", "G", "B"};
   Imf::FrameBuffer fb;
   size_t xs = 3 * sizeof(float), ys = xs * size_t(img.width);
@@ -457,6 +459,15 @@ const std::vector<std::string>& imageWriterExtensions() {
   return exts;
 }
 
+std::vector<std::pair<std::string, std::string>> exrStringAttributes(const std::string& path) {
+  checkExrHeader(path);
+  Imf::InputFile in(path.c_str());
+  std::vector<std::pair<std::string, std::string>> out;
+  for (auto it = in.header().begin(); it != in.header().end(); ++it)
+    if (auto* a = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) out.emplace_back(it.name(), a->value());
+  return out;
+}
+
 void saveImage(const Image& img, const std::string& path, const SaveOptions& opts) {
   fs::path p(path);
   std::string ext = lowerExtension(path);
@@ -474,7 +485,7 @@ void saveImage(const Image& img, const std::string& path, const SaveOptions& opt
     if (ext == ".pfm") {
       ok = writePfm(img, tmp);
     } else if (ext == ".exr") {
-      ok = writeExr(img, tmp);
+      ok = writeExr(img, tmp, opts);
     } else if (ext == ".hdr") {
       ok = stbi_write_hdr(tmp.c_str(), img.width, img.height, 3, img.rgb.data()) != 0;
     } else {

@@ -1,6 +1,7 @@
 // Linear RGB float images and their file formats (OpenEXR and stb_image underneath).
 #pragma once
 
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -40,12 +41,16 @@ enum class ToneMap { Clamp, Aces };
 struct SaveOptions {
   float exposure = 0.f;  // stops, applied before the tone curve (8-bit outputs only)
   ToneMap toneMap = ToneMap::Clamp;
+  // String attributes of an OpenEXR header (how the image was made); other formats ignore them.
+  std::vector<std::pair<std::string, std::string>> exrAttributes;
 };
 
 // Reads .exr (OpenEXR), .hdr, .png, .jpg (stb_image; 8-bit files are decoded from sRGB) and
 // .pfm into linear RGB; throws std::runtime_error naming the file on a missing, unreadable or
 // truncated file. decodeSrgb = false keeps 8-bit codes as code / 255 (Mitsuba's `raw`).
 Image loadImage(const std::string& path, bool decodeSrgb = true);
+// An OpenEXR file's string attributes, by name (what SaveOptions::exrAttributes wrote).
+std::vector<std::pair<std::string, std::string>> exrStringAttributes(const std::string& path);
 // Whether loadImage reads `path` as linear radiance (.exr, .pfm, .hdr), not as 8-bit display
 // codes (.png, .jpg): what an error against a reference can be measured on.
 bool holdsRadiance(const std::string& path);

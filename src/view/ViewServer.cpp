@@ -3,11 +3,15 @@
 #include <spdlog/spdlog.h>
 
 #include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
 #include <boost/asio/strand.hpp>
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
+#include <cctype>
+#include <chrono>
 #include <deque>
+#include <optional>
 #include <nlohmann/json.hpp>
 
 #include "view/ViewerPage.h"
@@ -19,6 +23,7 @@ namespace http = beast::http;
 namespace websocket = beast::websocket;
 namespace net = boost::asio;
 using tcp = net::ip::tcp;
+using Clock = std::chrono::steady_clock;
 
 namespace {
 
@@ -39,6 +44,28 @@ std::string queryValue(const std::string& target, const std::string& key) {
 
 std::string pathOf(const std::string& target) { return target.substr(0, target.find('?')); }
 
+std::string lower(std::string s) {
+  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+// The name in a Host header, without its port: "[::1]:8000" -> "[::1]", "localhost:9" -> "localhost".
+std::string hostName(const std::string& host) {
+  if (!host.empty() && host[0] == '[') return lower(host.substr(0, host.find(']') + 1));
+  return lower(host.substr(0, host.find(':')));
+}
+
+bool isLoopbackName(const std::string& name) {
+  return name == "127.0.0.1" || name == "localhost" || name == "[::1]";
+}
+
+// Compares without stopping at the first difference, so the time taken says nothing of the token.
+bool sameToken(const std::string& a, const std::string& b) {
+  unsigned char diff = a.size() == b.size() ? 0 : 1;
+  for (size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ (i < b.size() ? b[i] : 0));
+  return diff == 0;
+}
+
 }  // namespace
 
 class WsClient;
@@ -50,32 +77,77 @@ struct ViewServer::Impl {
   tcp::acceptor acceptor{ioc};
   net::signal_set signals{ioc, SIGINT, SIGTERM};
   std::shared_ptr<WsClient> client;  // the one connected page (I/O thread only)
+  net::steady_timer acceptRetry{ioc};
+  Clock::time_point lastAcceptWarning{};
 
   Impl(ViewSession& s, const ViewServerOptions& o) : session(s), opts(o) {}
   void accept();
   void shutdown();
+  // Why a request may not be served ("" where it may): the token, the Host on loopback, and a
+  // WebSocket's Origin.
+  std::string refusal(const http::request<http::string_body>& req, bool websocketUpgrade) const;
 };
 
-// One page's WebSocket: reads its messages, writes frames and replies through a queue (one
-// write in flight, as Beast requires).
+std::string ViewServer::Impl::refusal(const http::request<http::string_body>& req, bool websocketUpgrade) const {
+  const std::string target(req.target());
+  if (!opts.token.empty() && !sameToken(queryValue(target, "token"), opts.token))
+    return "this server needs its token (?token=...)";
+  const std::string host(req[http::field::host]);
+  // Bound wider, the token is the guard (a rebinding page cannot know it), and the names the
+  // machine is reached by are not known here.
+  if (opts.token.empty() && !isLoopbackName(hostName(host))) return "unknown Host '" + host + "'";
+  if (websocketUpgrade && req.find(http::field::origin) != req.end()) {
+    const std::string origin = lower(std::string(req[http::field::origin]));
+    if (origin != "http://" + lower(host) && origin != "https://" + lower(host))
+      return "WebSocket from a foreign page (Origin '" + std::string(req[http::field::origin]) + "')";
+  }
+  return "";
+}
+
+// One page's WebSocket: reads its messages, writes frames and replies through a bounded queue
+// (one write in flight, as Beast requires).
 class WsClient : public std::enable_shared_from_this<WsClient> {
  public:
   WsClient(ViewServer::Impl& server, tcp::socket socket) : server_(server), ws_(std::move(socket)) {}
 
   void start(http::request<http::string_body> req) {
-    ws_.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
+    // Frames are single writes that must go now, not wait for more bytes (Nagle held each
+    // frame's JPEG about 40 ms).
+    beast::error_code ec;
+    beast::get_lowest_layer(ws_).socket().set_option(tcp::no_delay(true), ec);
+    auto timeouts = websocket::stream_base::timeout::suggested(beast::role_type::server);
+    timeouts.idle_timeout = std::chrono::seconds(server_.opts.idleSeconds);
+    timeouts.keep_alive_pings = true;
+    ws_.set_option(timeouts);
+    ws_.read_message_max(server_.opts.maxMessageBytes);
     ws_.async_accept(req, [self = shared_from_this()](beast::error_code ec) { self->onAccept(ec); });
   }
 
   void send(std::string text, bool binary) {
+    if (closed_) return;
+    if (queue_.size() >= server_.opts.maxQueued) {
+      spdlog::warn("view: the page left {} messages unread; dropping it", queue_.size());
+      drop();
+      return;
+    }
     queue_.push_back({std::move(text), binary});
     if (queue_.size() == 1) writeNext();
   }
 
+  // Closes the socket at once; what is queued goes when the write in flight ends (it still
+  // reads its buffer until then).
   void close() {
     closed_ = true;
+    if (!writing_) queue_.clear();
     beast::error_code ec;
     beast::get_lowest_layer(ws_).socket().close(ec);
+  }
+
+  // Sends a last message, then closes the WebSocket with `code`.
+  void closeWith(const std::string& message, websocket::close_code code) {
+    send(message, false);
+    closeCode_ = code;
+    if (queue_.empty()) finish();
   }
 
  private:
@@ -88,15 +160,29 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
   beast::flat_buffer buffer_;
   std::deque<Out> queue_;
   bool closed_ = false;
+  bool writing_ = false;
+  std::optional<websocket::close_code> closeCode_;
+
+  void drop() {
+    if (server_.client.get() == this) server_.client.reset();
+    close();
+  }
+
+  void finish() {
+    closed_ = true;
+    ws_.async_close(*closeCode_, [self = shared_from_this()](beast::error_code) {});
+  }
 
   void onAccept(beast::error_code ec) {
     if (ec) return;
     if (server_.client) {
-      spdlog::warn("view: a second client was refused (one page at a time)");
-      auto self = shared_from_this();
-      send(nlohmann::json{{"type", "error"}, {"message", "another page is already connected"}}.dump(), false);
-      ws_.async_close(websocket::close_code::try_again_later, [self](beast::error_code) {});
-      return;
+      // The newer page takes over: a user who opened another tab, or whose page went silent,
+      // gets the session without waiting for the old socket's timeout.
+      spdlog::info("view: a new page took over the session");
+      server_.client->closeWith(
+          nlohmann::json{{"type", "takenOver"}, {"message", "another page took over this session"}}.dump(),
+          websocket::close_code::policy_error);
+      server_.client.reset();
     }
     server_.client = shared_from_this();
     spdlog::info("view: a page connected");
@@ -117,8 +203,11 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
       }
       return;
     }
+    if (closed_) return;
     std::string msg = beast::buffers_to_string(buffer_.data());
     buffer_.consume(buffer_.size());
+    // A page that was taken over steers nothing; it reads on until its close completes.
+    if (server_.client.get() != this) return read();
     try {
       std::string reply = server_.session.handle(msg);
       if (!reply.empty()) send(reply, false);
@@ -126,15 +215,23 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
       spdlog::warn("view: {}", e.what());
       send(nlohmann::json{{"type", "error"}, {"message", e.what()}}.dump(), false);
     }
-    read();
+    if (!closed_) read();
   }
 
   void writeNext() {
+    writing_ = true;
     ws_.binary(queue_.front().binary);
     ws_.async_write(net::buffer(queue_.front().data), [self = shared_from_this()](beast::error_code ec, size_t) {
+      self->writing_ = false;
       self->queue_.pop_front();
-      if (ec) return;  // the read side notices and logs
-      if (!self->queue_.empty()) self->writeNext();
+      if (ec || self->closed_) {  // the read side notices and logs
+        self->queue_.clear();
+        return;
+      }
+      if (!self->queue_.empty())
+        self->writeNext();
+      else if (self->closeCode_)
+        self->finish();
     });
   }
 };
@@ -167,9 +264,12 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
     if (ec) return;
     std::string target(req_.target());
     std::string path = pathOf(target);
-    if (!server_.opts.token.empty() && queryValue(target, "token") != server_.opts.token)
-      return reply(http::status::forbidden, "text/plain", "envgi view: this server needs its token (?token=...)\n");
-    if (path == "/ws" && websocket::is_upgrade(req_)) {
+    const bool upgrade = path == "/ws" && websocket::is_upgrade(req_);
+    if (std::string why = server_.refusal(req_, upgrade); !why.empty()) {
+      spdlog::warn("view: refused a request: {}", why);
+      return reply(http::status::forbidden, "text/plain", "envgi view: " + why + "\n");
+    }
+    if (upgrade) {
       stream_.expires_never();
       std::make_shared<WsClient>(server_, stream_.release_socket())->start(std::move(req_));
       return;
@@ -187,6 +287,9 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
     res->set(http::field::server, "envgi");
     res->set(http::field::content_type, type);
     res->set(http::field::cache_control, "no-store");
+    // No other site may frame the page and click its controls, nor a browser guess its type.
+    res->set("Content-Security-Policy", "frame-ancestors 'none'");
+    res->set("X-Content-Type-Options", "nosniff");
     if (status == http::status::method_not_allowed) res->set(http::field::allow, "GET, HEAD");
     const size_t length = body.size();
     res->body() = std::move(body);
@@ -206,7 +309,19 @@ class HttpConnection : public std::enable_shared_from_this<HttpConnection> {
 
 void ViewServer::Impl::accept() {
   acceptor.async_accept(ioc, [this](beast::error_code ec, tcp::socket socket) {
-    if (ec) return;  // closed: shutting down
+    if (!acceptor.is_open() || ec == net::error::operation_aborted) return;  // shutting down
+    if (ec) {
+      // Out of file descriptors, say: a moment later there may be some. Never stop accepting.
+      if (Clock::now() - lastAcceptWarning > std::chrono::seconds(5)) {
+        spdlog::warn("view: cannot accept a connection ({}); retrying", ec.message());
+        lastAcceptWarning = Clock::now();
+      }
+      acceptRetry.expires_after(std::chrono::milliseconds(50));
+      acceptRetry.async_wait([this](beast::error_code e) {
+        if (!e) accept();
+      });
+      return;
+    }
     std::make_shared<HttpConnection>(*this, std::move(socket))->start();
     accept();
   });
@@ -215,6 +330,7 @@ void ViewServer::Impl::accept() {
 void ViewServer::Impl::shutdown() {
   beast::error_code ec;
   acceptor.close(ec);
+  acceptRetry.cancel();
   if (client) client->close();
   client.reset();
   ioc.stop();

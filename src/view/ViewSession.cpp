@@ -7,11 +7,14 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 
 #include "core/PhysicalMemory.h"
 #include "render/ActivePixels.h"
+#include "render/Cancellation.h"
 #include "scene/NameTables.h"
 
 namespace envgi {
@@ -24,6 +27,7 @@ struct ViewSession::State {
   int cameraVersion = 0;
   float exposure = 0.f;
   ToneMap tone = ToneMap::Clamp;
+  bool falseColor = false;  // luminance as colour, in place of the tone curve
   float envRotation = 0.f, envScale = 1.f;  // degrees about +Y on top of the file's placement
   std::string strategy, integrator;
   float resolutionScale = 1.f;
@@ -35,6 +39,8 @@ struct ViewSession::State {
   bool toneChanged = false;
   bool frameRequested = true;
   bool resend = false;  // a new page: send the film as it is, even if the last page had it
+  bool paused = false;  // no further passes until resumed
+  std::string readyIntegrator;  // the last integrator prepared in full: what "cancel" returns to
 };
 
 namespace {
@@ -51,15 +57,48 @@ Vec3f vec3(const json& j, const char* key) {
   return Vec3f(finiteFloat(v[0], key), finiteFloat(v[1], key), finiteFloat(v[2], key));
 }
 json arr(Vec3f v) { return json::array({v.x, v.y, v.z}); }
+// A camera the worker can build: the same lookAt it calls (so no check is looser than the
+// camera's own), with origin and target within 10^4 scene sizes of the scene, where a ray's
+// float arithmetic still means something.
+void checkCamera(Vec3f origin, Vec3f target, Vec3f up, const SceneView& sc) {
+  const Vec3f centre = (sc.boundsMin + sc.boundsMax) * 0.5f;
+  const float reach = 1e4f * std::max(1.f, length(sc.boundsMax - sc.boundsMin));
+  if (!(length(origin - centre) <= reach && length(target - centre) <= reach))
+    throw std::runtime_error(fmt::format("camera: origin and target must lie within {:g} of the scene", reach));
+  if (!(length(target - origin) >= 1e-6f * reach / 1e4f))
+    throw std::runtime_error("camera: origin and target must be apart");
+  if (!(length(up) <= 1e30f)) throw std::runtime_error("camera: 'up' is too long");
+  Transform t = lookAt(origin, target, up);
+  for (const auto& row : t.mat.m)
+    for (float v : row)
+      if (!std::isfinite(v)) throw std::runtime_error("camera: origin, target and up must span a frame");
+}
 float number(const json& j, const char* key, float lo, float hi) {
-  double v = j.at(key).get<double>();
+  // Compared as floats, the precision the bounds and the state are kept in: 0.1 is in [0.1, 2].
+  double d = j.at(key).get<double>();
+  float v = std::fabs(d) <= 3.0e38 ? float(d) : std::numeric_limits<float>::quiet_NaN();
   if (!(v >= lo && v <= hi)) throw std::runtime_error(fmt::format("'{}' must be in [{}, {}]", key, lo, hi));
-  return float(v);
+  return v;
+}
+}  // namespace
+
+namespace {
+// FNV-1a over the file's bytes, in hex: which scene a saved image came from.
+std::string fileHash(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  uint64_t h = 1469598103934665603ull;
+  char c;
+  while (f.get(c)) h = (h ^ uint8_t(c)) * 1099511628211ull;
+  return fmt::format("{:016x}", h);
 }
 }  // namespace
 
 ViewSession::ViewSession(std::unique_ptr<Scene> scene, std::string scenePath, ViewOptions opts)
-    : scene_(std::move(scene)), scenePath_(std::move(scenePath)), opts_(opts), state_(std::make_unique<State>()) {
+    : scene_(std::move(scene)),
+      scenePath_(std::move(scenePath)),
+      sceneHash_(fileHash(scenePath_)),
+      opts_(opts),
+      state_(std::make_unique<State>()) {
   scene_->finalize();
   accel_ = std::make_unique<EmbreeAccel>(*scene_);
   const Transform& t = scene_->camera.toWorld;
@@ -87,6 +126,8 @@ void ViewSession::start(std::function<void(ViewFrame)> sink) {
 
 void ViewSession::stop() {
   stop_ = true;
+  cutPass_ = true;
+  cutPrepare_ = true;
   wake_.notify_all();
   if (worker_.joinable()) worker_.join();
 }
@@ -112,6 +153,8 @@ std::string ViewSession::hello() const {
             {"strategy", s.strategy},
             {"noiseThreshold", s.noiseThreshold},
             {"minSpp", s.minSpp},
+            {"targetSpp", opts_.maxSpp},
+            {"paused", s.paused},
             {"hasEnvironment", scene_->env != nullptr}};
   return j.dump();
 }
@@ -121,8 +164,9 @@ std::string ViewSession::handle(const std::string& message) {
   if (j.is_discarded() || !j.is_object() || !j.contains("type") || !j["type"].is_string())
     throw std::runtime_error("malformed message (not a JSON object with a 'type')");
   std::string type = j["type"];
-  static const char* known[] = {"next", "save", "camera", "exposure", "tonemap", "environment", "strategy",
-                                "integrator", "resolution", "adaptive"};
+  static const char* known[] = {"next",       "save",       "camera",   "exposure", "tonemap", "environment",
+                                "strategy",   "integrator", "resolution", "adaptive", "pause",   "cancel",
+                                "pixel"};
   if (std::find(std::begin(known), std::end(known), type) == std::end(known))
     throw std::runtime_error("unknown message type '" + type + "'");
   try {
@@ -131,14 +175,14 @@ std::string ViewSession::handle(const std::string& message) {
       return "";
     }
     if (type == "save") return json{{"type", "saved"}, {"path", saveExr()}}.dump();
+    if (type == "pixel") return pixelValue(j);
     std::lock_guard<std::mutex> lock(mutex_);
     State next = *state_;
     if (type == "camera") {
       next.origin = vec3(j, "origin");
       next.target = vec3(j, "target");
       next.up = vec3(j, "up");
-      if (length(next.target - next.origin) < 1e-6f || length(cross(next.target - next.origin, next.up)) < 1e-6f)
-        throw std::runtime_error("camera: origin, target and up must span a frame");
+      checkCamera(next.origin, next.target, next.up, scene_->view());
       next.cameraVersion = next.cameraVersion + 1;
       if (j.contains("version")) {
         const json& v = j["version"];
@@ -152,8 +196,10 @@ std::string ViewSession::handle(const std::string& message) {
       next.toneChanged = true;
     } else if (type == "tonemap") {
       std::string v = j.at("value");
-      if (v != "clamp" && v != "aces") throw std::runtime_error("tonemap must be clamp or aces");
-      next.tone = v == "aces" ? ToneMap::Aces : ToneMap::Clamp;
+      if (v != "clamp" && v != "aces" && v != "falsecolor")
+        throw std::runtime_error("tonemap must be clamp, aces or falsecolor");
+      next.falseColor = v == "falsecolor";
+      if (!next.falseColor) next.tone = v == "aces" ? ToneMap::Aces : ToneMap::Clamp;
       next.toneChanged = true;
     } else if (type == "environment") {
       if (!scene_->env) throw std::runtime_error("the scene has no environment map");
@@ -162,6 +208,7 @@ std::string ViewSession::handle(const std::string& message) {
       next.rebuild = true;
       ++next.sceneVersion;
     } else if (type == "strategy") {
+      if (!scene_->env) throw std::runtime_error("the scene has no environment map");
       next.strategy = findStrategy(j.at("value").get<std::string>()).name;
       next.rebuild = true;
       ++next.sceneVersion;
@@ -181,6 +228,23 @@ std::string ViewSession::handle(const std::string& message) {
         next.minSpp = int(v.get<int64_t>());
       }
       next.restart = true;
+    } else if (type == "pause") {
+      const json& v = j.at("value");
+      if (!v.is_boolean()) throw std::runtime_error("'value' must be true or false");
+      next.paused = v.get<bool>();
+      next.toneChanged = true;  // a frame that says so, even of a film that no longer refines
+    } else if (type == "cancel") {
+      // Stops a preparation (photon maps, a grid) and returns to the integrator ready before.
+      cutPrepare_ = true;
+      if (!next.readyIntegrator.empty() && next.readyIntegrator != next.integrator) {
+        next.integrator = next.readyIntegrator;
+        next.rebuild = true;
+      }
+    }
+    if (next.rebuild) cutPrepare_ = true;
+    if (next.restart || next.rebuild) {
+      cutPass_ = true;
+      ++changesGiven_;
     }
     *state_ = next;
   } catch (const json::exception& e) {
@@ -191,6 +255,13 @@ std::string ViewSession::handle(const std::string& message) {
   }
   wake_.notify_all();
   return "";
+}
+
+bool ViewSession::waitForWorker(double seconds) {
+  std::unique_lock<std::mutex> lock(mutex_);
+  const uint64_t given = changesGiven_;
+  return taken_.wait_for(lock, std::chrono::duration<double>(seconds),
+                         [&] { return changesTaken_ >= given || stop_; });
 }
 
 void ViewSession::pageConnected() {
@@ -211,23 +282,79 @@ void ViewSession::requestFrame() {
 }
 
 std::string ViewSession::saveExr() {
+  // Under the lock throughout: two saves at once must not both find the same free name.
+  std::lock_guard<std::mutex> lock(saveMutex_);
   Image img;
+  std::vector<std::pair<std::string, std::string>> attributes;
   {
-    std::lock_guard<std::mutex> lock(mutex_);
+    std::lock_guard<std::mutex> state(mutex_);
+    if (!lastSaved_.empty()) return lastSaved_;
     img = lastImage_;
+    attributes = lastImageAttributes_;
   }
   if (img.width == 0) throw std::runtime_error("nothing rendered yet");
+  if (savesWritten_ >= opts_.maxSaves)
+    throw std::runtime_error(fmt::format("this session has saved {} images, its limit; restart envgi view to save more",
+                                         opts_.maxSaves));
   namespace fs = std::filesystem;
   fs::path scene(scenePath_);
   fs::path dir = scene.has_parent_path() ? scene.parent_path() : fs::path(".");
-  for (int n = 1; n < 100000; ++n) {
+  // Past any name left by earlier sessions; the limit above bounds what this one adds.
+  for (int n = 1; n <= opts_.maxSaves + 10000; ++n) {
     fs::path p = dir / fmt::format("{}-view-{}.exr", scene.stem().string(), n);
-    if (fs::exists(p)) continue;
-    saveImage(img, p.string(), SaveOptions{});
-    spdlog::info("view: saved {}", p.string());
+    fs::path png = fs::path(p).replace_extension(".png");
+    if (fs::exists(p) || fs::exists(png)) continue;
+    SaveOptions so;
+    so.exrAttributes = attributes;
+    saveImage(img, p.string(), so);
+    {
+      std::lock_guard<std::mutex> state(mutex_);
+      so.exposure = state_->exposure;
+      so.toneMap = state_->tone;
+    }
+    saveImage(img, png.string(), so);
+    ++savesWritten_;
+    spdlog::info("view: saved {} and {}", p.string(), png.filename().string());
+    std::lock_guard<std::mutex> state(mutex_);
+    // Only if the film did not change meanwhile.
+    if (lastImage_.width == img.width && lastImage_.rgb == img.rgb) lastSaved_ = p.string();
     return p.string();
   }
   throw std::runtime_error("no free file name beside the scene");
+}
+
+std::string ViewSession::pixelValue(const json& j) {
+  auto coordinate = [&](const char* key) {
+    const json& v = j.at(key);
+    if (!v.is_number_integer()) throw std::runtime_error(std::string("'") + key + "' must be an integer");
+    return v.get<int64_t>();
+  };
+  const int64_t x = coordinate("x"), y = coordinate("y");
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (lastImage_.width == 0) throw std::runtime_error("nothing rendered yet");
+  if (x < 0 || y < 0 || x >= lastImage_.width || y >= lastImage_.height)
+    throw std::runtime_error(fmt::format("({}, {}) is outside the {} x {} film", x, y, lastImage_.width, lastImage_.height));
+  const float* p = &lastImage_.rgb[3 * (size_t(y) * size_t(lastImage_.width) + size_t(x))];
+  Color c(p[0], p[1], p[2]);
+  return json{{"type", "pixel"}, {"x", x}, {"y", y}, {"rgb", {c.x, c.y, c.z}}, {"luminance", luminance(c)}}.dump();
+}
+
+std::vector<unsigned char> falseColorImage(const Image& hdr, float exposure) {
+  // log2 luminance from -8 to +8 stops about the exposure, blue through green to red (tev's
+  // and Blender's "False Color" read the same way: each colour a band of stops).
+  static const float ramp[5][3] = {{0.f, 0.f, 0.5f}, {0.f, 0.6f, 1.f}, {0.1f, 0.9f, 0.1f}, {1.f, 0.9f, 0.f}, {1.f, 0.f, 0.f}};
+  const size_t n = size_t(hdr.width) * size_t(hdr.height);
+  std::vector<unsigned char> out(3 * n);
+  for (size_t i = 0; i < n; ++i) {
+    const float lum = luminance(Color(hdr.rgb[3 * i], hdr.rgb[3 * i + 1], hdr.rgb[3 * i + 2]));
+    const float stops = lum > 0.f ? std::log2(lum) + exposure : -8.f;
+    const float t = std::clamp((stops + 8.f) / 16.f, 0.f, 1.f) * 4.f;
+    const int k = std::min(3, int(t));
+    const float f = t - float(k);
+    for (int c = 0; c < 3; ++c)
+      out[3 * i + size_t(c)] = (unsigned char)std::lround(255.f * (ramp[k][c] * (1.f - f) + ramp[k + 1][c] * f));
+  }
+  return out;
 }
 
 ViewFrame ViewSession::makeFrame(const Image& hdr, const State& s) {
@@ -235,11 +362,42 @@ ViewFrame ViewSession::makeFrame(const Image& hdr, const State& s) {
   so.exposure = s.exposure;
   so.toneMap = s.tone;
   ViewFrame f;
-  f.jpeg = encodeJpeg(hdr.width, hdr.height, toneMapImage(hdr, so), opts_.jpegQuality);
+  f.jpeg = encodeJpeg(hdr.width, hdr.height, s.falseColor ? falseColorImage(hdr, s.exposure) : toneMapImage(hdr, so),
+                      opts_.jpegQuality);
   return f;
 }
 
+namespace {
+// Integrators that build something before their first pass (photon maps, a grid), which the
+// page shows as a state of its own.
+bool prepares(const std::string& integrator) { return integrator == "photon" || integrator == "grid" || integrator == "sppm"; }
+
+std::string statusMessage(const std::string& state, const std::string& message) {
+  return json{{"type", "status"}, {"state", state}, {"message", message}}.dump();
+}
+}  // namespace
+
 void ViewSession::run() {
+  while (!stop_) {
+    try {
+      renderLoop();
+      return;
+    } catch (const std::exception& e) {
+      // Nothing the page sends may end the process: the viewer says why this render stopped
+      // and waits for the next change.
+      ++renderFailures_;
+      spdlog::error("view: the render stopped: {}", e.what());
+      if (sink_) sink_(ViewFrame{json{{"type", "error"}, {"message", std::string("the render stopped: ") + e.what()}}.dump(), ""});
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        changesTaken_ = changesGiven_;
+      }
+      taken_.notify_all();
+    }
+  }
+}
+
+void ViewSession::renderLoop() {
   PreparedRender pr;
   std::string prIntegrator;
   // Executors of other integrators, kept while the scene stays the same, so that switching
@@ -255,41 +413,53 @@ void ViewSession::run() {
   PassCounters counters;
   Progress quiet(1, false);
   State s;
+  int filmCamera = -1;   // the camera version the film was started for
+  bool coarse = false;   // the film is a move's first, at half the resolution
+  bool refine = false;   // the coarse frame went out: start the full film
   // Adaptive sampling, as renderPasses does it; off for an executor that cannot mask pixels (SPPM).
   ActivePixels pixels(0, 0, 0.f);
-  auto limit = [&] { return pr.executor && !pixels.converged() ? std::min(opts_.maxSpp, pr.spp) : 0; };
+  auto limit = [&](bool paused) { return pr.executor && !pixels.converged() && !paused ? std::min(opts_.maxSpp, pr.spp) : 0; };
   // Whether the page asked for a frame that differs from the one it has (under mutex_).
   auto frameWanted = [&](const State& st) {
     return st.frameRequested && (st.toneChanged || st.resend || spp != sentSpp);
   };
   while (!stop_) {
-    bool restart = false, rebuild = false, send = false;
+    bool restart = refine, rebuild = false, send = false;
+    uint64_t takenNow = 0;
+    refine = false;
     {
       std::unique_lock<std::mutex> lock(mutex_);
       wake_.wait(lock, [&] {
         const State& st = *state_;
-        return stop_ || st.restart || st.rebuild || frameWanted(st) || spp < limit();
+        return stop_ || restart || st.restart || st.rebuild || frameWanted(st) || spp < limit(st.paused);
       });
       if (stop_) break;
-      restart = state_->restart;
+      restart = restart || state_->restart;
       rebuild = state_->rebuild;
       state_->restart = state_->rebuild = false;
+      takenNow = changesGiven_;
+      cutPass_ = false;
+      if (rebuild) cutPrepare_ = false;
       s = *state_;
     }
     if (restart || rebuild) {
-      Camera& cam = scene_->camera;
-      cam.toWorld = lookAt(s.origin, s.target, s.up) * cameraShape_;
-      cam.width = std::max(8, int(std::lround(baseW * s.resolutionScale)));
-      cam.height = std::max(8, int(std::lround(baseH * s.resolutionScale)));
-      if (baseFilm.filmWidth > 0) {
-        // A crop window scales with the image: the film and the window's corner by as much.
-        auto scaled = [](int base, int now, int was, int size) { return std::max(size, int(std::lround(double(base) * now / was))); };
-        cam.filmWidth = scaled(baseFilm.filmWidth, cam.width, baseW, cam.width);
-        cam.filmHeight = scaled(baseFilm.filmHeight, cam.height, baseH, cam.height);
-        cam.cropX = std::min(int(std::lround(double(baseFilm.cropX) * cam.width / baseW)), cam.filmWidth - cam.width);
-        cam.cropY = std::min(int(std::lround(double(baseFilm.cropY) * cam.height / baseH)), cam.filmHeight - cam.height);
-      }
+      // A move's first film is coarse; a refinement, a rebuild or any other change is full size.
+      coarse = opts_.coarseMoves && !rebuild && filmCamera >= 0 && s.cameraVersion != filmCamera;
+      filmCamera = s.cameraVersion;
+      const float scale = s.resolutionScale * (coarse ? 0.5f : 1.f);
       try {
+        Camera& cam = scene_->camera;
+        cam.toWorld = lookAt(s.origin, s.target, s.up) * cameraShape_;
+        cam.width = std::max(8, int(std::lround(baseW * scale)));
+        cam.height = std::max(8, int(std::lround(baseH * scale)));
+        if (baseFilm.filmWidth > 0) {
+          // A crop window scales with the image: the film and the window's corner by as much.
+          auto scaled = [](int base, int now, int was, int size) { return std::max(size, int(std::lround(double(base) * now / was))); };
+          cam.filmWidth = scaled(baseFilm.filmWidth, cam.width, baseW, cam.width);
+          cam.filmHeight = scaled(baseFilm.filmHeight, cam.height, baseH, cam.height);
+          cam.cropX = std::min(int(std::lround(double(baseFilm.cropX) * cam.width / baseW)), cam.filmWidth - cam.width);
+          cam.cropY = std::min(int(std::lround(double(baseFilm.cropY) * cam.height / baseH)), cam.filmHeight - cam.height);
+        }
         if (rebuild) {
           if (scene_->env) scene_->env->setPlacement(envBaseScale * s.envScale, rotate(Vec3f(0, 1, 0), s.envRotation) * envBase);
           scene_->integrator.type = findIntegrator(s.integrator);
@@ -320,18 +490,33 @@ void ViewSession::run() {
         ro.threads = opts_.threads;
         ro.spp = opts_.maxSpp;
         ro.noiseThreshold = s.noiseThreshold;
+        ro.cancel = &cutPrepare_;
         // Twice a large scene's resolution had resized the film past the machine's memory.
         requireFilmFits(scene_->view().camera, ro, opts_.memoryBytes > 0.0 ? opts_.memoryBytes : physicalMemoryBytes());
         if (!pr.executor || !pr.executor->restart(scene_->view().camera)) {
           auto tp = Clock::now();
           pr = PreparedRender{};  // free the old executor's maps first
+          const bool announce = prepares(s.integrator);
+          if (announce && sink_) sink_(ViewFrame{statusMessage("preparing", "preparing " + s.integrator + "..."), ""});
           pr = opts_.prepare ? opts_.prepare(*scene_, *accel_, ro) : prepareRender(*scene_, *accel_, ro);
           ++preparations_;
-          spdlog::info("view: {} ready in {:.2f} s", s.integrator,
-                       std::chrono::duration<double>(Clock::now() - tp).count());
+          const double secs = std::chrono::duration<double>(Clock::now() - tp).count();
+          spdlog::info("view: {} ready in {:.2f} s", s.integrator, secs);
+          if (announce && sink_)
+            sink_(ViewFrame{statusMessage("ready", fmt::format("{} ready in {:.2f} s", s.integrator, secs)), ""});
         }
+        pr.executor->watchCancel(&cutPass_);
         pixels = ActivePixels(scene_->camera.width, scene_->camera.height, s.noiseThreshold);
         pixels.attach(*pr.executor);
+        std::lock_guard<std::mutex> lock(mutex_);
+        state_->readyIntegrator = s.integrator;
+      } catch (const RenderCancelled&) {
+        // A newer choice (or stop) interrupted the preparation: the loop takes that choice next.
+        spdlog::info("view: preparing {} was cancelled", s.integrator);
+        pr = PreparedRender{};
+        prIntegrator.clear();
+        pixels = ActivePixels(0, 0, 0.f);
+        if (sink_) sink_(ViewFrame{statusMessage("cancelled", "preparing " + s.integrator + " was cancelled"), ""});
       } catch (const std::exception& e) {
         // Any failure (a bad setting, memory for a huge film) ends this render, not the viewer.
         spdlog::warn("view: {}", e.what());
@@ -343,20 +528,32 @@ void ViewSession::run() {
       spp = 0;
       sentSpp = -1;
       t0 = Clock::now();
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        changesTaken_ = std::max(changesTaken_, takenNow);
+      }
+      taken_.notify_all();
     }
-    if (spp < limit()) {
-      pr.executor->runPass(spp, spp + 1, quiet, &counters);
+    if (spp < limit(s.paused)) {
+      try {
+        pr.executor->runPass(spp, spp + 1, quiet, &counters);
+      } catch (const RenderCancelled&) {
+        continue;  // a pass that prepares as it goes (SPPM's photons) stopped for a change
+      }
+      // Cut for a change the loop takes next: this film is not going to be shown.
+      if (pr.executor->cutPass()) continue;
       ++spp;
       pixels.passDone(spp - 1, spp);
       // Every 4 passes from the minimum on: each check reads the film back (from a GPU too).
-      if (pixels.adaptive() && spp >= s.minSpp && (spp - s.minSpp) % 4 == 0 && spp < limit()) {
+      if (pixels.adaptive() && spp >= s.minSpp && (spp - s.minSpp) % 4 == 0 && spp < limit(s.paused)) {
         FilmSums film;
         pixels.update(*pr.executor, &film);
       }
     }
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      send = pr.executor && frameWanted(*state_);
+      // A film from a camera or setting already replaced is not encoded: the next one is due.
+      send = pr.executor && frameWanted(*state_) && !state_->restart && !state_->rebuild;
       if (send) {
         state_->frameRequested = false;
         state_->toneChanged = false;
@@ -365,6 +562,8 @@ void ViewSession::run() {
         // film holds, and the frame must not claim it.
         s.exposure = state_->exposure;
         s.tone = state_->tone;
+        s.falseColor = state_->falseColor;
+        s.paused = state_->paused;
       }
     }
     if (!send) continue;
@@ -380,12 +579,16 @@ void ViewSession::run() {
     f.meta = json{{"type", "frame"},
                   {"frame", ++frame},
                   {"spp", spp},
+                  {"targetSpp", std::min(opts_.maxSpp, pr.spp)},
+                  {"paused", s.paused},
+                  {"coarse", coarse},
                   {"seconds", seconds},
-                  {"fps", sinceLast > 0 ? 1.0 / sinceLast : 0.0},
+                  // The rate since the previous frame; none for the first, which has no previous.
+                  {"fps", frame > 1 && sinceLast > 0 ? 1.0 / sinceLast : 0.0},
                   {"width", cam.width},
                   {"height", cam.height},
                   {"exposure", s.exposure},
-                  {"tonemap", s.tone == ToneMap::Aces ? "aces" : "clamp"},
+                  {"tonemap", s.falseColor ? "falsecolor" : s.tone == ToneMap::Aces ? "aces" : "clamp"},
                   {"cameraVersion", s.cameraVersion},
                   {"integrator", s.integrator},
                   {"strategy", s.strategy},
@@ -399,10 +602,22 @@ void ViewSession::run() {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       lastImage_ = std::move(img);
+      lastSaved_.clear();
+      lastImageAttributes_ = {
+          {"envgi:scene", scenePath_},
+          {"envgi:sceneHash", sceneHash_},
+          {"envgi:integrator", s.integrator},
+          {"envgi:strategy", s.strategy},
+          {"envgi:spp", std::to_string(spp)},
+          {"envgi:camera", fmt::format("origin {} {} {} target {} {} {} up {} {} {}", s.origin.x, s.origin.y, s.origin.z,
+                                       s.target.x, s.target.y, s.target.z, s.up.x, s.up.y, s.up.z)},
+          {"envgi:environment", fmt::format("rotation {} scale {}", s.envRotation, s.envScale)}};
     }
     sentSpp = spp;
     ++framesSent_;
     if (sink_) sink_(std::move(f));
+    // The page has seen the move: the full film takes over from the coarse one.
+    if (coarse) refine = true;
   }
 }
 

@@ -1,7 +1,9 @@
 // What `envgi view` renders: one scene, progressively, on a worker thread, steered by the
 // page's messages (camera, exposure, tone curve, environment, strategy, integrator,
-// resolution, noise threshold, save). Frames go out tone-mapped as JPEG, at most one in flight: the page asks
-// for the next when it has shown the last, so a slow link never backs up the renderer.
+// resolution, noise threshold, pause, cancel, save). Frames go out tone-mapped as JPEG, at
+// most one in flight: the page asks for the next when it has shown the last, so a slow link
+// never backs up the renderer. A camera move cuts the pass in flight and starts coarse (half
+// the resolution) for its first frame, as Cycles' viewport does; the film refines after it.
 #pragma once
 
 #include <atomic>
@@ -9,7 +11,9 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <nlohmann/json_fwd.hpp>
 #include <string>
+#include <vector>
 #include <thread>
 
 #include "accel/EmbreeAccel.h"
@@ -35,10 +39,19 @@ struct ViewOptions {
   float noiseThreshold = 0.f;
   int adaptiveMinSpp = 16;
   int jpegQuality = 85;
+  // A camera move's first frame at half the resolution, then the full film (Cycles' start
+  // resolution): a move costs a quarter of the pixels until the page has seen it.
+  bool coarseMoves = true;
+  // Files "save" may write in one session (each a full-size EXR and PNG).
+  int maxSaves = 100;
   // The memory a film must fit in half of (requireFilmFits); 0: this machine's. A restart at
   // another resolution resizes the film without prepareRender, so the session checks it itself.
   double memoryBytes = 0.0;
 };
+
+// The page's false-colour view: each pixel's log2 luminance (plus exposure) as a colour ramp,
+// -8 stops dark blue to +8 stops red, 8-bit RGB.
+std::vector<unsigned char> falseColorImage(const Image& hdr, float exposure);
 
 class ViewSession {
  public:
@@ -64,19 +77,32 @@ class ViewSession {
   void pageConnected();
 
   int framesSent() const { return framesSent_.load(); }
+  // Waits until the worker has taken every change handed to it so far (a new camera built, an
+  // executor prepared or its failure reported); false if it has not after `seconds`.
+  bool waitForWorker(double seconds);
+  // Renders that ended in an exception escaping the render loop (each reported to the page);
+  // none is expected: every known failure is an error reply or an error frame.
+  int renderFailures() const { return renderFailures_.load(); }
   // How many executors were made (photon maps, grids...): switching back to an integrator
   // used before, with the same environment and strategy, makes none.
   int preparations() const { return preparations_.load(); }
-  // Writes the current image beside the scene (atomically); returns its path.
+  // Writes the current film beside the scene (atomically) as EXR, with how it was made in its
+  // header, and as PNG as the page shows it; returns the EXR's path. Saving the same film
+  // twice writes nothing new.
   std::string saveExr();
+  // Saves written so far (files beside the scene, EXR and PNG counted once).
+  int savesWritten() const { return savesWritten_.load(); }
 
  private:
   struct State;
   void run();
+  void renderLoop();
   ViewFrame makeFrame(const Image& hdr, const State& s);
+  std::string pixelValue(const nlohmann::json& message);
 
   std::unique_ptr<Scene> scene_;
   std::string scenePath_;
+  std::string sceneHash_;  // of the scene file's bytes, written into saved images
   ViewOptions opts_;
   std::unique_ptr<EmbreeAccel> accel_;
   // What the scene's to_world does before its rigid frame (an orthographic camera's scale,
@@ -84,13 +110,27 @@ class ViewSession {
   Transform cameraShape_;
   std::unique_ptr<State> state_;  // guarded by mutex_
   mutable std::mutex mutex_;
+  std::mutex saveMutex_;  // one save at a time (taken before mutex_)
   std::condition_variable wake_;
+  std::condition_variable taken_;  // the worker took the changes up to changesTaken_
+  uint64_t changesGiven_ = 0, changesTaken_ = 0;  // guarded by mutex_
   std::function<void(ViewFrame)> sink_;
   std::thread worker_;
   std::atomic<bool> stop_{false};
   std::atomic<int> framesSent_{0};
   std::atomic<int> preparations_{0};
-  Image lastImage_;  // the mean so far, for save (guarded by mutex_)
+  std::atomic<int> savesWritten_{0};
+  std::atomic<int> renderFailures_{0};
+  // Set by a change that makes the pass in flight useless (camera, resolution...): the CPU
+  // executor starts no further tile. Cleared when the worker takes the change.
+  std::atomic<bool> cutPass_{false};
+  // Set by a new integrator, strategy or environment, a cancel, or stop: photon maps and grids
+  // being prepared stop (RenderCancelled).
+  std::atomic<bool> cutPrepare_{false};
+  // The mean so far and what it is, for save (guarded by mutex_).
+  Image lastImage_;
+  std::vector<std::pair<std::string, std::string>> lastImageAttributes_;
+  std::string lastSaved_;  // the EXR written for lastImage_, if any
 };
 
 }  // namespace envgi

@@ -16,13 +16,19 @@ inline constexpr const char* kViewerPage = R"envgipage(<!doctype html>
   body { margin: 0; background: #1e1e1e; color: #ddd; font: 13px system-ui, sans-serif; display: flex; }
   #view { flex: 1; display: flex; align-items: center; justify-content: center; height: 100vh; }
   /* Scaled to fit the window whatever the render's size (the resolution control). */
-  #frame { width: 100%; height: 100vh; object-fit: contain; cursor: grab; }
+  #frame { width: 100%; height: 100vh; object-fit: contain; cursor: grab; transform-origin: 0 0; }
+  #frame.zoomed { image-rendering: pixelated; }
   #panel { width: 250px; padding: 10px; background: #2a2a2a; height: 100vh; box-sizing: border-box; overflow-y: auto; }
   #panel label { display: block; margin-top: 10px; }
   #panel input[type=range], #panel select { width: 100%; }
   #stats { font-family: monospace; white-space: pre; margin-top: 12px; color: #9c9; }
   #message { margin-top: 10px; color: #fc6; word-break: break-all; }
   button { margin-top: 12px; width: 100%; }
+  #view { overflow: hidden; position: relative; }
+  #progress { width: 100%; height: 6px; margin-top: 10px; }
+  #status { margin-top: 10px; color: #8cf; }
+  #status button { margin-top: 4px; }
+  #pixel { font-family: monospace; white-space: pre; margin-top: 8px; color: #ccc; }
 </style>
 </head>
 <body>
@@ -31,7 +37,8 @@ inline constexpr const char* kViewerPage = R"envgipage(<!doctype html>
   <b id="title">envgi</b>
   <label>Exposure <span id="exposureValue">0</span>
     <input id="exposure" type="range" min="-8" max="8" step="0.1" value="0"></label>
-  <label>Tone curve <select id="tonemap"><option value="clamp">clamp</option><option value="aces">ACES</option></select></label>
+  <label>View <select id="tonemap"><option value="clamp">clamp</option><option value="aces">ACES</option>
+    <option value="falsecolor">false colour (log2 luminance)</option></select></label>
   <label>Integrator <select id="integrator"></select></label>
   <label><input id="gridWhileMoving" type="checkbox"> grid while the camera moves</label>
   <label>Strategy <select id="strategy"></select></label>
@@ -41,17 +48,22 @@ inline constexpr const char* kViewerPage = R"envgipage(<!doctype html>
   <label>Resolution <select id="resolution">
     <option value="0.25">25%</option><option value="0.5">50%</option><option value="1" selected>100%</option><option value="2">200%</option></select></label>
   <label>Noise threshold (0: off) <input id="noiseThreshold" type="number" min="0" max="10" step="0.005" value="0"></label>
-  <button id="save">Save EXR</button>
+  <progress id="progress" max="1" value="0"></progress>
+  <button id="pause">Pause</button>
+  <button id="save">Save EXR + PNG</button>
+  <div id="status"></div>
+  <div id="pixel"></div>
   <div id="stats">connecting...</div>
   <div id="message"></div>
 </div>
 <script>
 "use strict";
-const T = window.envgiTest = { frames: 0, lastMeta: null, lastHash: 0, errors: [], saved: null, cameraSent: 0, latencyMs: null };
+const T = window.envgiTest = { frames: 0, lastMeta: null, lastHash: 0, errors: [], saved: null, cameraSent: 0, latencyMs: null,
+                               latencies: [], frameTimes: [], status: null, connects: 0, opened: performance.now() };
 window.addEventListener("error", e => T.errors.push(String(e.message)));
 const $ = id => document.getElementById(id);
 const img = $("frame");
-let ws, hello, cam, version = 0, pendingMeta = null, sendTimes = {}, lastUrl = null, cameraQueued = false;
+let ws, hello, cam, version = 0, pendingMeta = null, sendTimes = {}, lastUrl = null, cameraQueued = false, takenOver = false;
 
 const sub = (a, b) => [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
 const add = (a, b) => [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
@@ -113,22 +125,71 @@ function dolly(f) {
 }
 
 let drag = null;
-img.addEventListener("mousedown", e => { drag = { x: e.clientX, y: e.clientY, pan: e.button === 2 || e.shiftKey }; e.preventDefault(); });
+img.addEventListener("mousedown", e => {
+  drag = { x: e.clientX, y: e.clientY, pan: e.button === 2 || e.shiftKey, image: e.button === 1 };
+  e.preventDefault();
+});
 window.addEventListener("mouseup", () => { drag = null; });
 window.addEventListener("mousemove", e => {
   if (!drag || !cam) return;
+  if (drag.image) {
+    zoom.x += e.clientX - drag.x; zoom.y += e.clientY - drag.y;
+    drag.x = e.clientX; drag.y = e.clientY;
+    applyZoom();
+    return;
+  }
   const dx = e.clientX - drag.x, dy = e.clientY - drag.y;
   drag.x = e.clientX; drag.y = e.clientY;
   if (drag.pan) pan(dx, dy); else orbit(dx, dy);
 });
 img.addEventListener("contextmenu", e => e.preventDefault());
-img.addEventListener("wheel", e => { if (cam) { dolly(e.deltaY > 0 ? 1.1 : 1 / 1.1); e.preventDefault(); } }, { passive: false });
+// Wheel dollies the camera; Ctrl+wheel zooms the picture about the cursor (pixels drawn as
+// squares), middle-drag pans it, 0 resets it.
+let zoom = { s: 1, x: 0, y: 0 };
+function applyZoom() {
+  img.style.transform = `translate(${zoom.x}px, ${zoom.y}px) scale(${zoom.s})`;
+  img.classList.toggle("zoomed", zoom.s > 1);
+}
+img.addEventListener("wheel", e => {
+  if (!cam) return;
+  e.preventDefault();
+  if (e.ctrlKey) {
+    const r = $("view").getBoundingClientRect(), f = e.deltaY > 0 ? 1 / 1.25 : 1.25;
+    const px = e.clientX - r.left, py = e.clientY - r.top;
+    const s = Math.min(64, Math.max(1, zoom.s * f)), k = s / zoom.s;
+    zoom = { s: s, x: px - (px - zoom.x) * k, y: py - (py - zoom.y) * k };
+    if (s === 1) zoom = { s: 1, x: 0, y: 0 };
+    applyZoom();
+  } else dolly(e.deltaY > 0 ? 1.1 : 1 / 1.1);
+}, { passive: false });
+// The film pixel under the cursor: where the image is drawn (object-fit: contain, then zoomed).
+function filmPixel(e) {
+  const m = T.lastMeta;
+  if (!m) return null;
+  const r = img.getBoundingClientRect();
+  const fit = Math.min(r.width / m.width, r.height / m.height);
+  const ox = r.left + (r.width - m.width * fit) / 2, oy = r.top + (r.height - m.height * fit) / 2;
+  const x = Math.floor((e.clientX - ox) / fit), y = Math.floor((e.clientY - oy) / fit);
+  return x >= 0 && y >= 0 && x < m.width && y < m.height ? [x, y] : null;
+}
+let pixelQueued = null, pixelTimer = null;
+img.addEventListener("mousemove", e => {
+  pixelQueued = filmPixel(e);
+  if (pixelTimer) return;
+  pixelTimer = setTimeout(() => {
+    pixelTimer = null;
+    if (pixelQueued) send({ type: "pixel", x: pixelQueued[0], y: pixelQueued[1] });
+  }, 50);
+});
 window.addEventListener("keydown", e => {
-  if (!cam || e.target.tagName === "INPUT") return;
+  // Keys typed into a control (a dropdown's arrows, a number field) are the control's alone.
+  if (!cam || ["INPUT", "SELECT", "TEXTAREA", "BUTTON"].includes(e.target.tagName)) return;
   const k = { ArrowLeft: [-20, 0], ArrowRight: [20, 0], ArrowUp: [0, -20], ArrowDown: [0, 20] }[e.key];
   if (k) orbit(k[0], k[1]);
   if (e.key === "+" || e.key === "=") dolly(1 / 1.1);
   if (e.key === "-") dolly(1.1);
+  if (e.key === "0") { zoom = { s: 1, x: 0, y: 0 }; applyZoom(); }
+  if (e.key === " ") { e.preventDefault(); $("pause").click(); }
 });
 
 $("exposure").addEventListener("input", e => { $("exposureValue").textContent = e.target.value; send({ type: "exposure", value: parseFloat(e.target.value) }); });
@@ -144,6 +205,19 @@ $("noiseThreshold").addEventListener("change", e => {
   if (v >= 0 && v <= 10) send({ type: "adaptive", threshold: v }); else showMessage("noise threshold: 0 to 10");
 });
 $("save").addEventListener("click", () => send({ type: "save" }));
+let paused = false;
+$("pause").addEventListener("click", () => { paused = !paused; $("pause").textContent = paused ? "Resume" : "Pause"; send({ type: "pause", value: paused }); });
+function showStatus(m) {
+  const el = $("status");
+  el.textContent = m.message;
+  T.status = m.state;
+  if (m.state === "preparing") {
+    const b = document.createElement("button");
+    b.textContent = "Cancel";
+    b.addEventListener("click", () => send({ type: "cancel" }));
+    el.appendChild(b);
+  }
+}
 
 function fill(select, names, current) {
   select.innerHTML = "";
@@ -158,7 +232,8 @@ function onText(m) {
     $("title").textContent = "envgi: " + m.scene;
     fill($("integrator"), m.integrators, m.integrator);
     fill($("strategy"), m.strategies, m.strategy);
-    for (const id of ["rotation", "envScale"]) $(id).disabled = !m.hasEnvironment;
+    for (const id of ["rotation", "envScale", "strategy"]) $(id).disabled = !m.hasEnvironment;
+    paused = m.paused; $("pause").textContent = paused ? "Resume" : "Pause";
     $("noiseThreshold").value = m.noiseThreshold;
   } else if (m.type === "frame") {
     pendingMeta = m;
@@ -167,6 +242,14 @@ function onText(m) {
     showMessage("saved " + m.path);
   } else if (m.type === "error") {
     showMessage("error: " + m.message);
+  } else if (m.type === "status") {
+    showStatus(m);
+  } else if (m.type === "pixel") {
+    const f = v => v.toPrecision(4);
+    $("pixel").textContent = `(${m.x}, ${m.y})  R ${f(m.rgb[0])}  G ${f(m.rgb[1])}  B ${f(m.rgb[2])}\nluminance ${f(m.luminance)}`;
+  } else if (m.type === "takenOver") {
+    takenOver = true;
+    showMessage(m.message);
   }
 }
 
@@ -182,14 +265,18 @@ function onFrame(buffer) {
     lastUrl = url;
     T.frames += 1;
     T.lastMeta = m;
+    T.frameTimes.push(performance.now());
+    if (m) { $("progress").max = m.targetSpp; $("progress").value = m.spp; }
     T.lastHash = h;
     if (m && sendTimes[m.cameraVersion] !== undefined) {
       T.latencyMs = performance.now() - sendTimes[m.cameraVersion];
+      T.latencies.push(T.latencyMs);
       for (const v in sendTimes) if (+v <= m.cameraVersion) delete sendTimes[v];
     }
     if (m) {
       $("stats").textContent =
-        `frame   ${m.frame}\nspp     ${m.spp}\ntime    ${m.seconds.toFixed(2)} s\nfps     ${m.fps.toFixed(1)}\n` +
+        `frame   ${m.frame}\nspp     ${m.spp} / ${m.targetSpp}${m.paused ? " (paused)" : ""}\n` +
+        `time    ${m.seconds.toFixed(2)} s\nfps     ${m.fps > 0 ? m.fps.toFixed(1) : "-"}\n` +
         `size    ${m.width}x${m.height}\n${m.integrator} / ${m.strategy}\n` +
         (m.adaptive ? `adaptive ${m.converged ? "converged" : (100 * m.sampling).toFixed(0) + "% sampling"}\n` +
                       `mean spp ${m.meanSpp.toFixed(1)}\n` :
@@ -202,12 +289,18 @@ function onFrame(buffer) {
   img.src = url;
 }
 
+// The page reconnects when the server comes back (a restart), unless another page took over.
 function connect() {
   ws = new WebSocket((location.protocol === "https:" ? "wss://" : "ws://") + location.host + "/ws" + location.search);
   ws.binaryType = "arraybuffer";
+  ws.onopen = () => { T.connects += 1; showMessage(""); };
   ws.onmessage = e => { if (typeof e.data === "string") onText(JSON.parse(e.data)); else onFrame(e.data); };
-  ws.onclose = () => { $("stats").textContent = "disconnected"; };
+  ws.onclose = () => {
+    $("stats").textContent = takenOver ? "another page has this session" : "disconnected: reconnecting...";
+    if (!takenOver) setTimeout(connect, 1000);
+  };
 }
+T.orbit = (dx, dy) => orbit(dx, dy);
 connect();
 </script>
 </body>

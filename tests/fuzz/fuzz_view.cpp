@@ -1,7 +1,8 @@
 // libFuzzer target: the viewer's messages (ViewSession::handle), one JSON message a line, sent
-// to a session that renders on its own thread meanwhile, as a page would send them. A message
-// may be refused with std::runtime_error; anything else, a crash or a sanitizer report on
-// either thread, is a defect.
+// to a session that renders on its own thread meanwhile, as a page would send them; each input
+// waits for the worker to take its changes. A message may be refused with std::runtime_error;
+// anything else, a crash or a sanitizer report on either thread, is a defect.
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <stdexcept>
@@ -55,5 +56,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     }
     start = end + 1;
   }
+  // The worker builds the camera and the executor from what was taken: let it, so that a
+  // message that kills the worker fails on the input that sent it.
+  if (!session().waitForWorker(30.0) || session().renderFailures() > 0) std::abort();
   return 0;
 }

@@ -11,7 +11,13 @@
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
 #include <chrono>
+#include <array>
+#include <atomic>
+#include <cctype>
+#include <cstdlib>
 #include <fstream>
+#include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -62,6 +68,7 @@ class Child {
     return false;
   }
   void signal(int sig) { kill(pid_, sig); }
+  pid_t pid() const { return pid_; }
   // The exit code, or -1 if it is still running after `seconds` (or died of a signal).
   int wait(double seconds) {
     auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
@@ -121,12 +128,40 @@ inline std::string httpRaw(int port, const std::string& request) {
   return out;
 }
 
-// A WebSocket to ws://127.0.0.1:port/path, synchronous.
+// Sends `request` to 127.0.0.1:port and returns what comes back within `seconds` (empty if
+// nothing does: a server that no longer accepts).
+inline std::string httpRawWithin(int port, const std::string& request, double seconds) {
+  net::io_context ioc;
+  beast::tcp_stream stream(ioc);
+  std::string out;
+  stream.expires_after(std::chrono::milliseconds(int(seconds * 1000)));
+  stream.async_connect(tcp::endpoint(net::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)),
+                       [&](beast::error_code ec) {
+                         if (ec) return;
+                         net::write(stream.socket(), net::buffer(request), ec);
+                       });
+  ioc.run();
+  ioc.restart();
+  auto buf = std::make_shared<std::array<char, 4096>>();
+  std::function<void(beast::error_code, size_t)> onRead = [&](beast::error_code ec, size_t n) {
+    out.append(buf->data(), n);
+    if (!ec) stream.async_read_some(net::buffer(*buf), onRead);
+  };
+  stream.async_read_some(net::buffer(*buf), onRead);
+  ioc.run();
+  return out;
+}
+
+// A WebSocket to ws://127.0.0.1:port/path, synchronous; origin: the Origin header a browser
+// would send (none when empty).
 class WsConnection {
  public:
-  WsConnection(int port, const std::string& path) : ws_(ioc_) {
+  WsConnection(int port, const std::string& path, const std::string& origin = "") : ws_(ioc_) {
     beast::get_lowest_layer(ws_).connect(
         tcp::endpoint(net::ip::make_address("127.0.0.1"), static_cast<unsigned short>(port)));
+    if (!origin.empty())
+      ws_.set_option(beast::websocket::stream_base::decorator(
+          [origin](beast::websocket::request_type& req) { req.set(beast::http::field::origin, origin); }));
     ws_.handshake("127.0.0.1:" + std::to_string(port), path);
   }
   void send(const std::string& text) {
@@ -146,6 +181,13 @@ class WsConnection {
     if (ec) throw beast::system_error(ec);
     if (binary) *binary = ws_.got_binary();
     return beast::buffers_to_string(buf.data());
+  }
+  // Sends without waiting for any reply; false once the server has closed the connection.
+  bool trySend(const std::string& text) {
+    beast::error_code ec;
+    ws_.text(true);
+    ws_.write(net::buffer(text), ec);
+    return !ec;
   }
 
  private:
@@ -204,6 +246,128 @@ class DevTools {
       errors_.push_back(m["params"].dump());
     if (method == "Log.entryAdded" && m["params"]["entry"].value("level", "") == "error")
       errors_.push_back(m["params"].dump());
+  }
+};
+
+// The port a child printed in "http://HOST:PORT/" (or ws://), or -1.
+inline int printedPort(const std::string& log) {
+  size_t at = log.find("://");
+  while (at != std::string::npos) {
+    size_t colon = log.find_first_of(":/", at + 3);
+    if (colon != std::string::npos && log[colon] == ':') {
+      size_t end = colon + 1;
+      while (end < log.size() && std::isdigit(static_cast<unsigned char>(log[end]))) ++end;
+      if (end > colon + 1) return std::stoi(log.substr(colon + 1, end - colon - 1));
+    }
+    at = log.find("://", at + 3);
+  }
+  return -1;
+}
+
+// A running `envgi view SCENE --port 0 ARGS` (through bash, after `shell`: ulimit...), its port
+// read from the URL it printed (-1 if it printed none within 30 s).
+struct ViewerProcess {
+  std::unique_ptr<Child> child;
+  int port = -1;
+  ViewerProcess(const std::string& scene, const std::string& logPath, const std::string& args = "",
+                const std::string& shell = "") {
+    child = std::make_unique<Child>(
+        std::vector<std::string>{"bash", "-c", shell + "exec " + ENVGI_CLI_PATH + " view " + scene + " --port 0 " + args},
+        logPath);
+    if (child->waitForLog("view: open http://", 30)) port = printedPort(child->log());
+  }
+  std::string log() const { return child->log(); }
+};
+
+inline std::string findChromium() {
+  for (const char* name : {"chromium", "chromium-browser", "google-chrome"}) {
+    std::string cmd = std::string("command -v ") + name + " >/dev/null 2>&1";
+    if (std::system(cmd.c_str()) == 0) return name;
+  }
+  return "";
+}
+
+// Headless Chromium with one blank page, driven over the DevTools protocol. Throws where the
+// browser is missing or does not start.
+class Browser {
+ public:
+  Browser(const std::string& dir, const std::vector<std::string>& extraArgs = {}) {
+    const std::string chromium = findChromium();
+    if (chromium.empty()) throw std::runtime_error("the browser tests need Debian's chromium (scripts/install-deps.sh)");
+    std::vector<std::string> argv = {chromium,
+                                     "--headless=new",
+                                     "--no-sandbox",
+                                     "--disable-gpu",
+                                     "--no-first-run",
+                                     "--remote-debugging-port=0",
+                                     "--user-data-dir=" + dir + "/profile",
+                                     "--window-size=900,600"};
+    argv.insert(argv.end(), extraArgs.begin(), extraArgs.end());
+    argv.push_back("about:blank");
+    child_ = std::make_unique<Child>(argv, dir + "/chromium.log");
+    if (!child_->waitForLog("DevTools listening on ws://", 60)) throw std::runtime_error("chromium: " + child_->log());
+    const int devPort = printedPort(child_->log());
+    std::string list;
+    if (httpGet(devPort, "/json/list", &list) != 200) throw std::runtime_error("chromium: no page list");
+    std::string pageWs;
+    for (const nlohmann::json& t : nlohmann::json::parse(list))
+      if (t.value("type", "") == "page") pageWs = t.value("webSocketDebuggerUrl", "");
+    if (pageWs.empty()) throw std::runtime_error("chromium: no page in " + list);
+    page_ = std::make_unique<DevTools>(devPort, pageWs.substr(pageWs.find('/', 5)));
+    page_->call("Runtime.enable");
+    page_->call("Log.enable");
+    page_->call("Page.enable");
+  }
+  DevTools& page() { return *page_; }
+  Child& process() { return *child_; }
+  void navigate(const std::string& url) { page_->call("Page.navigate", {{"url", url}}); }
+
+ private:
+  std::unique_ptr<Child> child_;
+  std::unique_ptr<DevTools> page_;
+};
+
+// A plain HTTP server on 127.0.0.1 that answers every GET with one HTML page: another site's
+// page, for the tests where a foreign page tries to drive the viewer.
+class OnePageServer {
+ public:
+  explicit OnePageServer(std::string html) : html_(std::move(html)), acceptor_(ioc_, tcp::endpoint(net::ip::make_address("127.0.0.1"), 0)) {
+    thread_ = std::thread([this] { serve(); });
+  }
+  ~OnePageServer() {
+    stop_ = true;
+    beast::error_code ec;
+    // Wakes the blocking accept.
+    tcp::socket s(ioc_);
+    s.connect(acceptor_.local_endpoint(), ec);
+    thread_.join();
+  }
+  int port() const { return acceptor_.local_endpoint().port(); }
+
+ private:
+  std::string html_;
+  net::io_context ioc_;
+  tcp::acceptor acceptor_;
+  std::thread thread_;
+  std::atomic<bool> stop_{false};
+  void serve() {
+    while (!stop_) {
+      beast::error_code ec;
+      tcp::socket sock(ioc_);
+      acceptor_.accept(sock, ec);
+      if (ec || stop_) continue;
+      beast::flat_buffer buf;
+      beast::http::request<beast::http::string_body> req;
+      beast::http::read(sock, buf, req, ec);
+      if (ec) continue;
+      beast::http::response<beast::http::string_body> res(beast::http::status::ok, 11);
+      res.set(beast::http::field::content_type, "text/html");
+      res.body() = html_;
+      res.prepare_payload();
+      res.keep_alive(false);
+      beast::http::write(sock, res, ec);
+      sock.shutdown(tcp::socket::shutdown_both, ec);
+    }
   }
 };
 

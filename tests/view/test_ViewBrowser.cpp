@@ -1,7 +1,7 @@
 // `envgi view` in a real browser: headless Chromium (Debian's `chromium`, installed by
 // scripts/install-deps.sh) opens the page over the DevTools protocol; the first frame comes,
 // a mouse drag orbits (a new frame, from the new camera), the exposure slider re-tones, "Save
-// EXR" writes a readable file beside the scene, a second page is refused, bad messages get
+// EXR" writes a readable file beside the scene, a second page takes over, bad messages get
 // error replies, and Ctrl-C stops the server cleanly. No display, no network.
 #include <gtest/gtest.h>
 
@@ -20,21 +20,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string findChromium() {
-  for (const char* name : {"chromium", "chromium-browser", "google-chrome"}) {
-    std::string cmd = std::string("command -v ") + name + " >/dev/null 2>&1";
-    if (std::system(cmd.c_str()) == 0) return name;
-  }
-  return "";
-}
-
-// The port a child printed in "http://HOST:PORT/".
-int portFrom(const std::string& log) {
-  std::smatch m;
-  if (std::regex_search(log, m, std::regex(R"(http://[^:/]+:([0-9]+)/)"))) return std::stoi(m[1]);
-  return -1;
-}
-
 std::string writeScene(const TempDir& d) {
   std::string xml = d.file("ball.xml");
   writeBallScene(xml, 96, 64, std::string(ENVGI_SOURCE_DIR) + "/scenes/envmaps/studio.hdr");
@@ -44,33 +29,16 @@ std::string writeScene(const TempDir& d) {
 }  // namespace
 
 TEST(ViewBrowser, OrbitExposureSaveInHeadlessChromium) {
-  std::string chromium = findChromium();
-  ASSERT_FALSE(chromium.empty()) << "the browser test needs Debian's chromium (scripts/install-deps.sh installs it)";
   TempDir d;
   std::string scene = writeScene(d);
   Child view({ENVGI_CLI_PATH, "view", scene, "--port", "0", "--threads", "2", "--max-spp", "256"}, d.file("view.log"));
   ASSERT_TRUE(view.waitForLog("view: open http://", 30)) << view.log();
-  int port = portFrom(view.log());
+  int port = printedPort(view.log());
   ASSERT_GT(port, 0) << view.log();
 
-  Child browser({chromium, "--headless=new", "--no-sandbox", "--disable-gpu", "--no-first-run",
-                 "--remote-debugging-port=0", "--user-data-dir=" + d.file("profile"), "--window-size=900,600",
-                 "about:blank"},
-                d.file("chromium.log"));
-  ASSERT_TRUE(browser.waitForLog("DevTools listening on ws://", 60)) << browser.log();
-  int devPort = portFrom(std::regex_replace(browser.log(), std::regex("ws://"), "http://"));
-  ASSERT_GT(devPort, 0) << browser.log();
-  std::string list;
-  ASSERT_EQ(httpGet(devPort, "/json/list", &list), 200);
-  std::string pageWs;
-  for (const json& t : json::parse(list))
-    if (t.value("type", "") == "page") pageWs = t.value("webSocketDebuggerUrl", "");
-  ASSERT_FALSE(pageWs.empty()) << list;
-  DevTools page(devPort, pageWs.substr(pageWs.find('/', 5)));
-  page.call("Runtime.enable");
-  page.call("Log.enable");
-  page.call("Page.enable");
-  page.call("Page.navigate", {{"url", "http://127.0.0.1:" + std::to_string(port) + "/"}});
+  Browser browser(d.path.string());
+  DevTools& page = browser.page();
+  browser.navigate("http://127.0.0.1:" + std::to_string(port) + "/");
 
   // The first frame, then a drag across the image: a frame from camera version >= 1 that differs.
   ASSERT_TRUE(page.waitFor("window.envgiTest !== undefined && envgiTest.frames >= 1", 30)) << view.log();
@@ -115,26 +83,43 @@ TEST(ViewBrowser, OrbitExposureSaveInHeadlessChromium) {
   EXPECT_NE(page.eval("document.getElementById('stats').textContent").get<std::string>().find("adaptive"),
             std::string::npos);
 
-  // A second page is refused; the first keeps its frames.
-  {
-    WsConnection second(port, "/ws");
-    json m = json::parse(second.read(10));
-    EXPECT_EQ(m["type"], "error");
-    EXPECT_EQ(m["message"], "another page is already connected");
-  }
-  EXPECT_TRUE(view.waitForLog("a second client was refused", 10));
-  int frames = page.eval("envgiTest.frames");
-  page.eval("(() => { const e = document.getElementById('exposure'); e.value = '1';"
-            " e.dispatchEvent(new Event('input')); })()");
-  EXPECT_TRUE(page.waitFor("envgiTest.frames > " + std::to_string(frames), 30));
+  // The value under the cursor: the film's HDR value, shown in the panel.
+  page.mouse("mouseMoved", x, y);
+  EXPECT_TRUE(page.waitFor("document.getElementById('pixel').textContent.includes('luminance')", 10));
+  // Pause holds the samples; the panel says so.
+  page.eval("document.getElementById('pause').click()");
+  EXPECT_TRUE(page.waitFor("envgiTest.lastMeta.paused === true", 30)) << view.log();
+  page.eval("document.getElementById('pause').click()");
+  EXPECT_TRUE(page.waitFor("envgiTest.lastMeta.paused === false", 30)) << view.log();
+  // Arrow keys in a dropdown are the dropdown's: no orbit.
+  const int sentBefore = page.eval("envgiTest.cameraSent");
+  page.eval("document.getElementById('tonemap').focus()");
+  page.call("Input.dispatchKeyEvent", {{"type", "keyDown"}, {"key", "ArrowLeft"}, {"code", "ArrowLeft"},
+                                       {"windowsVirtualKeyCode", 37}});
+  page.call("Input.dispatchKeyEvent", {{"type", "keyUp"}, {"key", "ArrowLeft"}, {"code", "ArrowLeft"},
+                                       {"windowsVirtualKeyCode", 37}});
+  std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  EXPECT_EQ(page.eval("envgiTest.cameraSent"), sentBefore);
+  page.eval("document.activeElement.blur()");
 
   EXPECT_EQ(page.eval("envgiTest.errors.length"), 0) << page.eval("JSON.stringify(envgiTest.errors)").dump();
   page.call("Runtime.evaluate", {{"expression", "1"}});  // drain pending events
   EXPECT_TRUE(page.pageErrors().empty()) << page.pageErrors().front();
 
-  // Closing the browser drops the socket; the server says so and goes on.
-  browser.signal(SIGKILL);
-  EXPECT_TRUE(view.waitForLog("the page disconnected", 10)) << view.log();
+  // A second page takes the session over; the first says so and does not fight back.
+  {
+    WsConnection second(port, "/ws");
+    json m = json::parse(second.read(10));
+    EXPECT_EQ(m["type"], "hello");
+    EXPECT_TRUE(page.waitFor("document.getElementById('stats').textContent === 'another page has this session'", 10))
+        << page.eval("document.getElementById('stats').textContent").dump();
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+    EXPECT_EQ(page.eval("envgiTest.connects"), 1) << "a page taken over does not reconnect";
+  }
+  EXPECT_TRUE(view.waitForLog("a new page took over the session", 10));
+
+  // Closing the browser drops the socket; the server goes on.
+  browser.process().signal(SIGKILL);
   {
     // Bad messages from a new client: error replies, the server keeps serving.
     WsConnection ws(port, "/ws");
@@ -196,7 +181,7 @@ TEST(ViewBrowser, OtherRequestsGetTheirHttpStatus) {
   std::string scene = writeScene(d);
   Child view({ENVGI_CLI_PATH, "view", scene, "--port", "0", "--threads", "1"}, d.file("v.log"));
   ASSERT_TRUE(view.waitForLog("view: open http://", 30)) << view.log();
-  const int port = portFrom(view.log());
+  const int port = printedPort(view.log());
   ASSERT_GT(port, 0) << view.log();
   std::string page;
   ASSERT_EQ(httpGet(port, "/", &page), 200);
@@ -236,3 +221,99 @@ TEST(ViewBrowser, BadArgumentsAreOneErrorLine) {
   CliResult missing = runCli("view " + d.file("absent.xml"));
   EXPECT_NE(missing.code, 0);
 }
+
+// Another site's page in the same browser (another localhost port) tries to drive the viewer:
+// its WebSocket is refused (the Origin is not the viewer's own) before any message, and a
+// rebound name (evil.example resolving to 127.0.0.1) gets 403 for the page itself.
+TEST(ViewBrowser, AForeignPageCannotDriveTheViewer) {
+  TempDir d;
+  ViewerProcess viewer(writeScene(d), d.file("view.log"), "--threads 1");
+  Child& view = *viewer.child;
+  const int port = viewer.port;
+  ASSERT_GT(port, 0) << viewer.log();
+  OnePageServer foreign(R"(<!doctype html><script>
+window.result = { opened: false, messages: 0, closed: false };
+const ws = new WebSocket("ws://127.0.0.1:)" + std::to_string(port) + R"(/ws");
+ws.onopen = () => { result.opened = true; ws.send(JSON.stringify({ type: "save" })); };
+ws.onmessage = () => { result.messages += 1; };
+ws.onclose = () => { result.closed = true; };
+</script>)");
+  Browser browser(d.path.string(), {"--host-resolver-rules=MAP evil.example 127.0.0.1"});
+  DevTools& page = browser.page();
+  browser.navigate("http://localhost:" + std::to_string(foreign.port()) + "/");
+  ASSERT_TRUE(page.waitFor("window.result !== undefined && result.closed", 20)) << view.log();
+  EXPECT_EQ(page.eval("result.opened"), false);
+  EXPECT_EQ(page.eval("result.messages"), 0);
+  EXPECT_TRUE(view.waitForLog("refused a request: WebSocket from a foreign page (Origin 'http://localhost:", 10))
+      << view.log();
+  EXPECT_FALSE(std::filesystem::exists(d.file("ball-view-1.exr"))) << "the foreign page saved nothing";
+
+  // DNS rebinding: the browser's own origin is evil.example, so the Origin matches the Host;
+  // the Host is what gives it away.
+  browser.navigate("http://evil.example:" + std::to_string(port) + "/");
+  EXPECT_TRUE(page.waitFor("document.body !== null && document.body.textContent.includes(\"unknown Host 'evil.example:\")",
+                           20))
+      << page.eval("document.body ? document.body.textContent : ''").dump() << view.log();
+  EXPECT_EQ(page.eval("window.envgiTest === undefined"), true) << "the viewer's page was not served";
+  view.signal(SIGTERM);
+  EXPECT_EQ(view.wait(20), 0) << view.log();
+}
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return -1.0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+// The viewer's budgets as the page sees them, printed (a time on a shared machine is a
+// measure, not a pass mark): page open to first frame, single moves to their first frame, and
+// frames a second while orbiting continuously.
+void measureViewport(const std::string& sceneFile, const std::string& name) {
+  TempDir d;
+  Child view({ENVGI_CLI_PATH, "view", std::string(ENVGI_SOURCE_DIR) + "/scenes/" + sceneFile, "-D", "res=256",
+              "--integrator", "path", "--port", "0"},
+             d.file("view.log"));
+  ASSERT_TRUE(view.waitForLog("view: open http://", 60)) << view.log();
+  Browser browser(d.path.string());
+  DevTools& page = browser.page();
+  // The server is running and warm (its first film rendered for no page): what a reload costs.
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  browser.navigate("http://127.0.0.1:" + std::to_string(printedPort(view.log())) + "/");
+  ASSERT_TRUE(page.waitFor("window.envgiTest !== undefined && envgiTest.frames >= 1", 30)) << view.log();
+  const double firstFrame = page.eval("envgiTest.frameTimes[0]").get<double>();
+
+  // Single moves, each after the last one's frame: the time to the first frame of the move.
+  std::vector<double> moves;
+  for (int i = 0; i < 15; ++i) {
+    const int frames = page.eval("envgiTest.frames");
+    page.eval("envgiTest.orbit(12, 0)");
+    ASSERT_TRUE(page.waitFor("envgiTest.lastMeta.cameraVersion === envgiTest.cameraSent && envgiTest.frames > " +
+                                 std::to_string(frames),
+                             10));
+    moves.push_back(page.eval("envgiTest.latencyMs").get<double>());
+    std::this_thread::sleep_for(std::chrono::milliseconds(150));
+  }
+  // A continuous orbit, a move every animation frame for 3 s.
+  json orbit = page.eval(R"((async () => {
+    const t0 = performance.now(), f0 = envgiTest.frames;
+    envgiTest.latencies = [];
+    while (performance.now() - t0 < 3000) { envgiTest.orbit(4, 0); await new Promise(r => requestAnimationFrame(r)); }
+    return { frames: envgiTest.frames - f0, seconds: (performance.now() - t0) / 1000, latencies: envgiTest.latencies };
+  })())");
+  std::vector<double> orbitLatency = orbit["latencies"].get<std::vector<double>>();
+  const double fps = orbit["frames"].get<double>() / orbit["seconds"].get<double>();
+  std::printf("viewer budget, %s path 256x256: page open -> first frame %.0f ms; move -> frame median %.1f ms "
+              "(%zu moves); orbiting %.1f frames/s, move -> frame median %.1f ms\n",
+              name.c_str(), firstFrame, median(moves), moves.size(), fps, median(orbitLatency));
+  EXPECT_GT(orbit["frames"].get<int>(), 0);
+  EXPECT_EQ(page.eval("envgiTest.errors.length"), 0);
+  view.signal(SIGTERM);
+  EXPECT_EQ(view.wait(20), 0) << view.log();
+}
+
+}  // namespace
+
+TEST(ViewBrowser, ViewportBudgetsCornellBox) { measureViewport("cornell-box.xml", "cornell-box"); }
+TEST(ViewBrowser, ViewportBudgetsBuddha) { measureViewport("buddha.xml", "buddha"); }

@@ -129,7 +129,7 @@ TEST(ViewSession, BadMessagesAreErrorsAndChangeNothing) {
   EXPECT_EQ(errorOf(R"({"type":"exposure","value":99})"), "exposure: 'value' must be in [-20, 20]");
   EXPECT_NE(errorOf(R"({"type":"exposure","value":"bright"})").find("exposure: "), std::string::npos);
   EXPECT_EQ(errorOf(R"({"type":"camera","origin":[0,0,1],"target":[0,0,1],"up":[0,1,0]})"),
-            "camera: origin, target and up must span a frame");
+            "camera: origin and target must be apart");
   EXPECT_EQ(errorOf(R"({"type":"camera","origin":[0,0],"target":[0,0,1],"up":[0,1,0]})"),
             "camera: 'origin' must be 3 numbers");
   EXPECT_NE(errorOf(R"({"type":"strategy","value":"nope"})").find("unknown strategy 'nope'"), std::string::npos);
