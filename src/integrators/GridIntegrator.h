@@ -24,9 +24,12 @@ ENVGI_HD Color gridTrace(const SceneView& sc, const Tracer& tracer, const Ray& r
                          const IlluminationGridView& grid, const CausticIrradiance& causticIrradiance,
                          const GridParams& gp, uint64_t* rays) {
   auto estimate = [&](const SurfaceInteraction& si, Vec3f wo, Sampler&, uint64_t*) {
+    const Bsdf& bsdf = sc.bsdfAt(si.bsdf, si.uv);
+    // A one-sided reflector seen from behind reflects nothing, as the BSDF's own eval says.
+    if (!bsdf.twoSided && !bsdfTransmits(bsdf) && dot(si.shading.n, wo) <= 0.f) return Color(0.f);
     Vec3f n = faceForward(si.shading.n, wo);
     Color E = grid.irradiance(si.p, n) + causticIrradiance(si.p, faceForward(si.ng, wo));
-    return diffuseAlbedo(sc.bsdfAt(si.bsdf, si.uv)) * kInvPi * E;
+    return diffuseAlbedo(bsdf) * kInvPi * E;
   };
   return traceSpecularChain(sc, tracer, ray, smp, gp.chain, estimate, rays);
 }

@@ -142,3 +142,22 @@ TEST(GridIntegrator, FurnaceBiasIsBounded) {
   EXPECT_GE(mean, 0.6 * 0.99);
   EXPECT_LE(mean, 0.6 * 1.15);
 }
+
+// A one-sided diffuse surface seen from behind is black, as path, photon and sppm draw it
+// (Mitsuba's convention: no reflection when wo is below the surface); the grid once lit it
+// from its back with albedo / pi times the irradiance there (the Cornell box's walls from
+// outside).
+TEST(GridIntegrator, AOneSidedSurfaceSeenFromBehindIsBlack) {
+  auto scene = sphereOnFloorScene();
+  scene->camera.toWorld = lookAt(Vec3f(0.3f, -2.f, 0.5f), Vec3f(0.f, 0.f, 0.f), Vec3f(0, 1, 0));
+  Image ref = run(*scene, IntegratorType::Path, 16);
+  Image grid = runSmallGrid(*scene);
+  int underside = 0;
+  for (int y = 0; y < 16; ++y)
+    for (int x = 0; x < 16; ++x)
+      if (luminance(ref.at(x, y)) == 0.f) {
+        ++underside;
+        EXPECT_EQ(luminance(grid.at(x, y)), 0.f) << x << "," << y;
+      }
+  EXPECT_GT(underside, 128) << "the floor's underside fills most of the view";
+}
