@@ -28,12 +28,18 @@ std::string makeToken() {
   return t;
 }
 
-void runView(const ViewArgs& a) {
+std::unique_ptr<Scene> loadViewedScene(const ViewArgs& a) {
   auto scene = std::make_unique<Scene>();
   loadScene(a.scene, parseDefines(a.defines), *scene);
   if (!a.integrator.empty()) scene->integrator.type = findIntegrator(a.integrator);
   if (!a.strategy.empty()) scene->integrator.setStrategy(a.strategy);
+  return scene;
+}
+
+void runView(const ViewArgs& a) {
+  auto scene = loadViewedScene(a);
   ViewOptions vo;
+  vo.reload = [a] { return loadViewedScene(a); };
   vo.threads = a.threads;
   vo.maxSpp = a.maxSpp;
   vo.noiseThreshold = a.noiseThreshold;

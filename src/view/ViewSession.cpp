@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -93,28 +94,48 @@ std::string fileHash(const std::string& path) {
 }
 }  // namespace
 
+namespace {
+std::filesystem::file_time_type modifiedTime(const std::string& path) {
+  std::error_code ec;
+  auto t = std::filesystem::last_write_time(path, ec);
+  return ec ? std::filesystem::file_time_type{} : t;
+}
+}  // namespace
+
 ViewSession::ViewSession(std::unique_ptr<Scene> scene, std::string scenePath, ViewOptions opts)
-    : scene_(std::move(scene)),
-      scenePath_(std::move(scenePath)),
-      sceneHash_(fileHash(scenePath_)),
-      opts_(opts),
-      state_(std::make_unique<State>()) {
-  scene_->finalize();
-  accel_ = std::make_unique<EmbreeAccel>(*scene_);
-  const Transform& t = scene_->camera.toWorld;
+    : scenePath_(std::move(scenePath)), opts_(opts), state_(std::make_unique<State>()) {
+  adopt(std::move(scene));
+  sceneFileTime_ = modifiedTime(scenePath_);
   State& s = *state_;
-  s.origin = t.point(Vec3f(0.f));
-  Vec3f fwd = normalize(t.vector(Vec3f(0.f, 0.f, 1.f)));
-  const SceneView& sc = scene_->view();
-  Vec3f centre = (sc.boundsMin + sc.boundsMax) * 0.5f;
-  float dist = std::max(dot(centre - s.origin, fwd), 1e-2f * length(sc.boundsMax - sc.boundsMin) + 1e-3f);
-  s.target = s.origin + fwd * dist;
-  s.up = normalize(t.vector(Vec3f(0.f, 1.f, 0.f)));
-  if (scene_->camera.orthographic) cameraShape_ = lookAt(s.origin, s.target, s.up).inverse() * t;
   s.strategy = scene_->integrator.env.strategy;
   s.integrator = integratorName(scene_->integrator.type);
   s.noiseThreshold = opts_.noiseThreshold;
   s.minSpp = opts_.adaptiveMinSpp;
+}
+
+void ViewSession::adopt(std::unique_ptr<Scene> scene) {
+  scene->finalize();
+  auto accel = std::make_unique<EmbreeAccel>(*scene);
+  // The camera the file sets, as origin, target and up: the page's camera unless the file's
+  // own camera changed since the last one adopted.
+  const Transform& t = scene->camera.toWorld;
+  Vec3f origin = t.point(Vec3f(0.f));
+  Vec3f fwd = normalize(t.vector(Vec3f(0.f, 0.f, 1.f)));
+  const SceneView& sc = scene->view();
+  Vec3f centre = (sc.boundsMin + sc.boundsMax) * 0.5f;
+  float dist = std::max(dot(centre - origin, fwd), 1e-2f * length(sc.boundsMax - sc.boundsMin) + 1e-3f);
+  Vec3f target = origin + fwd * dist, up = normalize(t.vector(Vec3f(0.f, 1.f, 0.f)));
+  std::lock_guard<std::mutex> lock(mutex_);
+  const bool fileCameraChanged = !scene_ || std::memcmp(&scene_->camera.toWorld.mat, &t.mat, sizeof t.mat) != 0;
+  scene_ = std::move(scene);
+  accel_ = std::move(accel);
+  sceneHash_ = fileHash(scenePath_);
+  cameraShape_ = scene_->camera.orthographic ? lookAt(origin, target, up).inverse() * t : Transform{};
+  if (fileCameraChanged) {
+    state_->origin = origin;
+    state_->target = target;
+    state_->up = up;
+  }
 }
 
 ViewSession::~ViewSession() { stop(); }
@@ -380,8 +401,9 @@ std::string statusMessage(const std::string& state, const std::string& message) 
 void ViewSession::run() {
   while (!stop_) {
     try {
-      renderLoop();
-      return;
+      if (!renderLoop()) return;
+      reloadScene();
+      continue;
     } catch (const std::exception& e) {
       // Nothing the page sends may end the process: the viewer says why this render stopped
       // and waits for the next change.
@@ -397,7 +419,43 @@ void ViewSession::run() {
   }
 }
 
-void ViewSession::renderLoop() {
+bool ViewSession::sceneFileChanged() {
+  if (!opts_.reload) return false;
+  auto t = modifiedTime(scenePath_);
+  if (t == sceneFileTime_) return false;
+  sceneFileTime_ = t;
+  return true;
+}
+
+void ViewSession::reloadScene() {
+  std::unique_ptr<Scene> scene;
+  try {
+    scene = opts_.reload();
+  } catch (const std::exception& e) {
+    // A half-edited file: say why, keep rendering the scene as it was.
+    spdlog::warn("view: the scene file changed but does not load: {}", e.what());
+    if (sink_) sink_(ViewFrame{json{{"type", "error"}, {"message", std::string("scene not reloaded: ") + e.what()}}.dump(), ""});
+  }
+  const bool reloaded = scene != nullptr;
+  if (reloaded) {
+    adopt(std::move(scene));
+    spdlog::info("view: reloaded {}", scenePath_);
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    state_->restart = state_->rebuild = true;
+    ++state_->sceneVersion;
+    state_->frameRequested = true;
+    state_->resend = true;
+  }
+  if (reloaded && sink_) {
+    json hi = json::parse(hello());
+    hi["reloaded"] = true;
+    sink_(ViewFrame{hi.dump(), ""});
+  }
+}
+
+bool ViewSession::renderLoop() {
   PreparedRender pr;
   std::string prIntegrator;
   // Executors of other integrators, kept while the scene stays the same, so that switching
@@ -423,17 +481,25 @@ void ViewSession::renderLoop() {
   auto frameWanted = [&](const State& st) {
     return st.frameRequested && (st.toneChanged || st.resend || spp != sentSpp);
   };
+  auto lastFileCheck = Clock::now();
   while (!stop_) {
+    // The scene file, twice a second: a change ends this loop (its executors hold the old
+    // scene) and run() reloads.
+    if (opts_.reload && Clock::now() - lastFileCheck > std::chrono::milliseconds(500)) {
+      lastFileCheck = Clock::now();
+      if (sceneFileChanged()) return true;
+    }
     bool restart = refine, rebuild = false, send = false;
     uint64_t takenNow = 0;
-    refine = false;
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait(lock, [&] {
+      const bool ready = wake_.wait_for(lock, std::chrono::milliseconds(500), [&] {
         const State& st = *state_;
         return stop_ || restart || st.restart || st.rebuild || frameWanted(st) || spp < limit(st.paused);
       });
       if (stop_) break;
+      if (!ready) continue;
+      refine = false;
       restart = restart || state_->restart;
       rebuild = state_->rebuild;
       state_->restart = state_->rebuild = false;
@@ -619,6 +685,7 @@ void ViewSession::renderLoop() {
     // The page has seen the move: the full film takes over from the coarse one.
     if (coarse) refine = true;
   }
+  return false;
 }
 
 }  // namespace envgi

@@ -8,6 +8,7 @@
 
 #include <atomic>
 #include <condition_variable>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -42,6 +43,10 @@ struct ViewOptions {
   // A camera move's first frame at half the resolution, then the full film (Cycles' start
   // resolution): a move costs a quarter of the pixels until the page has seen it.
   bool coarseMoves = true;
+  // Loads the scene file anew (with the command line's -D values and overrides). Set: the
+  // session watches the file and reloads it when it changes, keeping the page's camera unless
+  // the file's camera changed. Files the scene names (meshes, maps) are not watched.
+  std::function<std::unique_ptr<Scene>()> reload;
   // Files "save" may write in one session (each a full-size EXR and PNG).
   int maxSaves = 100;
   // The memory a film must fit in half of (requireFilmFits); 0: this machine's. A restart at
@@ -96,13 +101,18 @@ class ViewSession {
  private:
   struct State;
   void run();
-  void renderLoop();
+  // Renders until stop (false) or until the scene file changed (true: reload, then again).
+  bool renderLoop();
+  void adopt(std::unique_ptr<Scene> scene);  // a loaded scene, its BVH and its camera
+  bool sceneFileChanged();
+  void reloadScene();
   ViewFrame makeFrame(const Image& hdr, const State& s);
   std::string pixelValue(const nlohmann::json& message);
 
   std::unique_ptr<Scene> scene_;
   std::string scenePath_;
   std::string sceneHash_;  // of the scene file's bytes, written into saved images
+  std::filesystem::file_time_type sceneFileTime_{};  // when the file adopted was written
   ViewOptions opts_;
   std::unique_ptr<EmbreeAccel> accel_;
   // What the scene's to_world does before its rigid frame (an orthographic camera's scale,

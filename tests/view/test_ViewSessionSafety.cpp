@@ -343,3 +343,45 @@ TEST(ViewSessionSafety, FalseColourMapsStopsToTheRamp) {
   EXPECT_EQ(falseColorImage(img, 8.f)[3], 255);
   EXPECT_EQ(falseColorImage(img, 8.f)[4], 0);
 }
+
+// The scene file changes: the session reloads it (a new hello, then frames of the new scene);
+// a file that no longer loads is an error and the old scene goes on.
+TEST(ViewSessionSafety, AChangedSceneFileIsReloaded) {
+  test::TempDir d;
+  std::string xml = (d.path / "ball.xml").string();
+  test::writeBallScene(xml, 24, 16, "");
+  auto scene = std::make_unique<Scene>();
+  loadScene(xml, {}, *scene);
+  ViewOptions vo;
+  vo.threads = 1;
+  vo.maxSpp = 4;
+  vo.reload = [xml] {
+    auto s = std::make_unique<Scene>();
+    loadScene(xml, {}, *s);
+    return s;
+  };
+  Sink sink;
+  auto session = std::make_unique<ViewSession>(std::move(scene), xml, vo);
+  session->start([&sink](ViewFrame f) { sink(std::move(f)); });
+  frameWhere(*session, sink, [](const json& f) { return f.value("width", 0) == 24; });
+  auto touch = [&](int seconds) {
+    std::filesystem::last_write_time(xml, std::filesystem::file_time_type::clock::now() + std::chrono::seconds(seconds));
+  };
+  size_t from = messagesSeen(sink);
+  test::writeBallScene(xml, 32, 16, "");
+  touch(2);
+  json hello = messageOf(sink, "hello", from);
+  EXPECT_EQ(hello["reloaded"], true);
+  EXPECT_EQ(hello["width"], 32);
+  json f = frameWhere(*session, sink, [](const json& m) { return m.value("width", 0) == 32; });
+  EXPECT_EQ(f["width"], 32);
+
+  from = messagesSeen(sink);
+  std::ofstream(xml) << "<scene version=\"3.0.0\"><shape type=";
+  touch(4);
+  json error = messageOf(sink, "error", from);
+  EXPECT_NE(error["message"].get<std::string>().find("scene not reloaded: "), std::string::npos) << error;
+  json still = frameWhere(*session, sink, [](const json& m) { return m.value("type", "") == "frame"; });
+  EXPECT_EQ(still["width"], 32) << "the scene as it was goes on";
+  session->stop();
+}
