@@ -75,26 +75,29 @@ std::vector<double> positiveNumbers(const std::string& list, const std::string& 
 // A run's largest sample count: a render's pass arithmetic is in int.
 constexpr long long kMaxStudySpp = 2147483647;
 
-// A strategy name of the study: a render strategy, or points-N (the collapsed map with N
-// lights), each with its own sample counts (setStrategy) whatever the scene file asked for.
+// A strategy name of the study: a render strategy, points-N (the collapsed map with N lights,
+// every one at each point) or points-draw-N (one of them drawn a light sample), each with its
+// own sample counts (setStrategy) whatever the scene file asked for.
 void applyStrategy(const std::string& name, Scene& scene) {
-  if (name.rfind("points-", 0) == 0) {
+  for (const char* base : {"points-draw", "points"}) {
+    const std::string prefix = std::string(base) + "-";
+    if (name.rfind(prefix, 0) != 0 || (std::string(base) == "points" && name.rfind("points-draw", 0) == 0)) continue;
     long long n = 0;
     try {
       size_t used = 0;
-      n = std::stoll(name.substr(7), &used);
-      if (used != name.size() - 7) n = 0;
+      n = std::stoll(name.substr(prefix.size()), &used);
+      if (used != name.size() - prefix.size()) n = 0;
     } catch (...) {
     }
     if (n < 1 || n > kMaxCollapsedPoints)
       throw std::runtime_error(
-          fmt::format("strategy '{}': points-N needs a whole N from 1 to {}", name, kMaxCollapsedPoints));
-    scene.integrator.setStrategy("points");
+          fmt::format("strategy '{}': {}-N needs a whole N from 1 to {}", name, base, kMaxCollapsedPoints));
+    scene.integrator.setStrategy(base);
     scene.integrator.env.pointCount = int(n);
     return;
   }
-  if (findStrategy(name).env == EnvStrategy::Points)
-    throw std::runtime_error("strategy 'points': name its size, points-N");
+  if (isCollapsedMap(findStrategy(name).env))
+    throw std::runtime_error("strategy '" + name + "': name its size, " + name + "-N");
   scene.integrator.setStrategy(name);
 }
 
@@ -256,7 +259,19 @@ void runStudy(const StudyArgs& a) {
   Scene scene;
   loadScene(a.scene, parseDefines(a.defines), scene);
   scene.integrator.type = integrator;
-  for (const std::string& s : strategies) applyStrategy(s, scene);  // names checked before any work
+  for (const std::string& s : strategies) {
+    applyStrategy(s, scene);  // names checked before any work
+    // path always joins one light sample to one BSDF sample by MIS: only the map's density is
+    // the strategy's to choose, and a row must not be another's under a second name.
+    const StrategyName& sn = findStrategy(scene.integrator.env.strategy);
+    if (integrator == IntegratorType::Path && (sn.name == std::string("bsdf") || sn.name == std::string("mis") ||
+                                               sn.env == EnvStrategy::PointsAll))
+      throw std::runtime_error(fmt::format(
+          "strategy '{}' names direct's samples; under --integrator path every vertex takes one light and one BSDF "
+          "sample (MIS), so choose the map's density: uniform, cosine, importance, alias, adaptive, product or "
+          "points-draw-N",
+          s));
+  }
   scene.finalize();
   bool cuda = chooseCuda(a.device);
   EmbreeAccel accel(scene);
@@ -382,7 +397,8 @@ void addStudyCommand(CLI::App& app) {
   CLI::App* c = app.add_subcommand("study", "Compare environment strategies against a reference (RMSE, plots, report)");
   c->add_option("scene", a->scene, "Scene file (.xml)")->required()->check(CLI::ExistingFile);
   c->add_option("-o,--output", a->out, "Output folder (results.csv, results.json, report.html, runs/)")->required();
-  c->add_option("--strategies", a->strategies, "Comma-separated: uniform,cosine,bsdf,importance,alias,adaptive,mis,product,points-N");
+  c->add_option("--strategies", a->strategies, "Comma-separated: uniform,cosine,bsdf,importance,alias,adaptive,mis,product,points-N (every one of N "
+                "collapsed-map lights at each point), points-draw-N (one of them a sample)");
   c->add_option("--spp", a->spp, "Comma-separated sample counts (default 1,4,16,64,256)");
   c->add_option("--time", a->times, "Comma-separated time budgets in seconds for equal-time runs");
   // Each seed is one more run of every configuration; 10^8 of them had ended in std::bad_alloc.

@@ -24,9 +24,18 @@ enum class EnvStrategy : int {
   Importance = 2,  // Algorithm 1: marginal/conditional CDFs, binary search
   Alias = 3,       // the same density through an alias table
   Adaptive = 4,    // energy-balanced quadtree baseline
-  Points = 5,      // the collapsed map: a fixed set of directional lights (biased)
+  Points = 5,      // the collapsed map, one of its lights drawn a light sample by its share
   Product = 6,     // Algorithm 1's density times a cosine bound about the normal (CosineProduct)
+  // The collapsed map as the paper means it (Section 2.2): every one of its N lights, each with
+  // its shadow ray, at every shading point; one set for the whole render, so neighbouring
+  // pixels share one estimate (biased, no noise from the map). Not a sampling density:
+  // next-event estimation adds the sum itself (collapsedMapLighting) and draws nothing here.
+  PointsAll = 7,
 };
+
+// Strategies whose map light comes from the collapsed map's delta lights, which no BSDF-sampled
+// direction can find.
+ENVGI_INLINE bool isCollapsedMap(EnvStrategy s) { return s == EnvStrategy::Points || s == EnvStrategy::PointsAll; }
 
 // One light of the collapsed map (the paper's Section 2): a direction and the irradiance it
 // delivers to a surface facing it, E = L(w) / (pdf(w) N) for weighted sampling, or the power
@@ -404,6 +413,7 @@ struct EnvironmentMapView {
         out.delta = true;
         return out;
       }
+      case EnvStrategy::PointsAll: return out;  // summed whole, never drawn
     }
     out.dir = dirAhead ? *dirAhead : fromLocal(local);
     out.radiance = out.pdf > 0.f ? (lookedUp ? *lookedUp : lookupUV(out.uv)) : Color(0.f);
@@ -412,7 +422,7 @@ struct EnvironmentMapView {
 
   ENVGI_HD float pdf(EnvStrategy s, Vec3f worldDir, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
     EnvStrategy t = strategyFor(s, normal);
-    bool mapped = t != EnvStrategy::Uniform && t != EnvStrategy::Cosine && t != EnvStrategy::Points;
+    bool mapped = t != EnvStrategy::Uniform && t != EnvStrategy::Cosine && !isCollapsedMap(t);
     return pdfAt(t, worldDir, mapped ? dirToUV(toLocalUnnormalized(worldDir)) : Vec2f(0.f, 0.f), normal);
   }
 
@@ -437,7 +447,8 @@ struct EnvironmentMapView {
       case EnvStrategy::Importance:
       case EnvStrategy::Alias: return importancePdfUV(uv) * pdfInPixel(uv);
       case EnvStrategy::Adaptive: return adaptive.pdf(uv);
-      case EnvStrategy::Points: return 0.f;  // no direction drawn by BSDF sampling hits a point
+      case EnvStrategy::Points:
+      case EnvStrategy::PointsAll: return 0.f;  // no direction drawn by BSDF sampling hits a point
       case EnvStrategy::Product:
         return solidAnglePdf(product.pdf(uv, toLocalUnnormalized(normal)) * pdfInPixel(uv), uv.y);
     }

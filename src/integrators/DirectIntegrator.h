@@ -21,6 +21,28 @@ struct DirectParams {
 // mixBlend: a blend's two materials evaluated as their mix (materials/BsdfMix.h), which only a
 // caller that estimates direct light at every hit may ask for; the photon mappers' specular
 // chains do so only where the chosen material is not a delta, so they keep the choice alone.
+// The collapsed map's light at si (the paper's Section 2.2): every one of its lights, each
+// with its shadow ray, sum_i f(wo, w_i) E_i V(w_i), where E_i = L(w_i) / (p(w_i) N) for
+// Algorithm 1's draws or a median-cut region's power. The same set at every point: no noise
+// between neighbours, a bias that falls as N grows.
+template <class Tracer>
+ENVGI_HD Color collapsedMapLighting(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& si,
+                                    const Bsdf& bsdf, const Bsdf* partner, Vec3f woLocal, uint64_t* rayCount) {
+  Color L(0.f);
+  if (!sc.hasEnvironment || bsdfMixIsDelta(bsdf, partner)) return L;
+  for (int i = 0; i < sc.env.pointCount; ++i) {
+    const DirectionalLight& light = sc.env.points[i];
+    Vec3f wiLocal = si.shading.toLocal(light.dir);
+    float pdf;
+    Color f = bsdfMixEvalPdf(bsdf, partner, si.partnerWeight, woLocal, wiLocal, &pdf);
+    if (isBlack(f) || isBlack(light.irradiance)) continue;
+    ++*rayCount;
+    if (tracer.occluded(offsetRayOrigin(si.p, si.ng, light.dir, si.t), light.dir, INFINITY)) continue;
+    L += f * light.irradiance;
+  }
+  return L;
+}
+
 template <class Tracer>
 ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& si, Vec3f wo,
                               Sampler& smp, EnvStrategy strategy, int emitterSamples, int bsdfSamples,
@@ -35,6 +57,7 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
 
   for (int i = 0; i < emitterSamples; ++i)
     L += sampleLd(sc, tracer, si, bsdf, woLocal, axis, strategy, nE, nB, smp, rayCount, partner);
+  if (strategy == EnvStrategy::PointsAll) L += collapsedMapLighting(sc, tracer, si, bsdf, partner, woLocal, rayCount);
 
   for (int j = 0; j < bsdfSamples; ++j) {
     BsdfSample bs;

@@ -25,7 +25,7 @@ ENVGI_INLINE Vec3f envSamplingAxis(const SurfaceInteraction& si, Vec3f wo, const
 
 // Whether a BSDF-sampled ray that escapes to the map counts: not where next-event estimation
 // already took the whole map as collapsed-map lights (a delta bounce still sees the map).
-ENVGI_INLINE bool envSeenByBsdfSampling(EnvStrategy s, bool prevDelta) { return prevDelta || s != EnvStrategy::Points; }
+ENVGI_INLINE bool envSeenByBsdfSampling(EnvStrategy s, bool prevDelta) { return prevDelta || !isCollapsedMap(s); }
 
 // The map's radiance along an escaping BSDF-sampled direction and, through *lightPdf, the
 // density next-event estimation would have drawn it with (selection included).
@@ -94,6 +94,9 @@ ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si,
                               Vec2f u, Vec2f u2, LightSample* ls, const ProductDraw* productDrawn = nullptr) {
   float pe = sc.envSelectProb();
   if (!(u.x < pe)) return sampleDeltaOrAreaLight(sc, si, pe, u, u2, ls);
+  // The whole collapsed map is added at every point (collapsedMapLighting): a light sample
+  // that picks the map carries nothing, and the other lights' shares stay unbiased.
+  if (strategy == EnvStrategy::PointsAll) return false;
   if (pe < 1.f) u.x = stretchedDraw(u.x, 0.f, pe);
   EnvSample es = sc.env.sample(strategy, u, axis, productDrawn);
   if (!(es.pdf > 0.f)) return false;

@@ -26,7 +26,8 @@ enum class SampleIntegratorType : int { Path = 0, Direct = 1 };
 // in the same order and the same MIS weights (Eq. 6 with nE, nB in {0, 1}; weight 1 where one
 // count is 0), so an executor may shade it a bounce at a time as that path.
 ENVGI_HD inline bool directIsOneBouncePath(const DirectParams& dp) {
-  return dp.emitterSamples >= 0 && dp.emitterSamples <= 1 && dp.bsdfSamples >= 0 && dp.bsdfSamples <= 1 &&
+  // The whole collapsed map at each point is not a path's one light sample.
+  return dp.envStrategy != EnvStrategy::PointsAll && dp.emitterSamples >= 0 && dp.emitterSamples <= 1 && dp.bsdfSamples >= 0 && dp.bsdfSamples <= 1 &&
          dp.emitterSamples + dp.bsdfSamples > 0;
 }
 ENVGI_HD inline PathParams directAsPath(const DirectParams& dp) {

@@ -232,6 +232,11 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
       k.direct.bsdfSamples == 0)
     throw std::runtime_error("direct integrator: mis_compensation samples only the map's bright part; it needs "
                              "bsdf_samples > 0 (or the strategy 'mis') to cover the rest");
+  // A path's next-event estimation draws one light a bounce; the whole collapsed map at every
+  // vertex is the paper's direct-light method, which direct, photon, sppm and grid take.
+  if (k.type == SampleIntegratorType::Path && sn.env == EnvStrategy::PointsAll)
+    throw std::runtime_error("strategy 'points' (every collapsed-map light at each point) is a direct-light method: "
+                             "use it with direct, photon, sppm or grid, or 'points-draw' (one light a sample) with path");
   k.sequence.type = scene.sampler.type;
   k.sequence.spp = uint32_t(k.spp);
   k.sequence.seed = scene.sampler.seed;

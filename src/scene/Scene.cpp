@@ -9,6 +9,7 @@
 
 #include "envmap/CollapsedMap.h"
 #include "materials/BsdfFactory.h"
+#include "scene/NameTables.h"
 
 namespace envgi {
 
@@ -163,8 +164,8 @@ void Scene::finalize() {
   if (bsdfs.empty()) bsdfs.push_back(Bsdf{});
   // A rough plastic whose alpha or ior changed since loading reads the tables of its new ones.
   for (Bsdf& b : bsdfs) attachRoughCoat(b);
-  // The collapsed map, for the points strategy: made here so every device reads the same lights.
-  if (env && integrator.env.strategy == "points") {
+  // The collapsed map, for the points strategies: made here so every device reads the same lights.
+  if (env && isCollapsedMap(findStrategy(integrator.env.strategy).env)) {
     if (integrator.env.pointMethod == "mediancut") env->setPoints(collapseByMedianCut(*env, integrator.env.pointCount));
     else if (integrator.env.pointMethod == "sample")
       env->setPoints(collapseByWeightedSampling(*env, integrator.env.pointCount, sampler.seed));

@@ -111,6 +111,75 @@ std::string svgLogLogPlot(const std::string& title, const std::string& xLabel, c
   return o + "</svg>";
 }
 
+namespace {
+
+// N of a points-N strategy (the collapsed map with every light at each point), else 0.
+int collapsedMapSize(const std::string& strategy) {
+  if (strategy.rfind("points-", 0) != 0 || strategy.rfind("points-draw", 0) == 0) return 0;
+  try {
+    return std::stoi(strategy.substr(7));
+  } catch (...) {
+    return 0;
+  }
+}
+
+// The paper's trade made visible: RMSE against N for each sample count and each time budget,
+// the other strategies as flat lines at their own RMSE, and, for each budget, whether the
+// best collapsed map beats them.
+std::string collapsedMapSection(const std::vector<StudyRun>& runs, const std::vector<std::string>& strategies) {
+  std::vector<int> sizes;
+  for (const std::string& s : strategies)
+    if (int n = collapsedMapSize(s)) sizes.push_back(n);
+  if (sizes.size() < 2) return "";
+  std::sort(sizes.begin(), sizes.end());
+  // Median RMSE by (strategy, budget): budget "N spp" or "T s".
+  std::map<std::pair<std::string, std::string>, std::vector<double>> rmse;
+  std::vector<std::string> budgets;
+  for (const StudyRun& r : runs) {
+    std::string b = r.timeBudget > 0 ? fmt::format("{:g} s", r.timeBudget) : fmt::format("{} spp", r.spp);
+    rmse[{r.strategy, b}].push_back(r.rmse);
+    if (std::find(budgets.begin(), budgets.end(), b) == budgets.end()) budgets.push_back(b);
+  }
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> xs, ys;
+  std::string verdicts;
+  for (const std::string& b : budgets) {
+    std::vector<double> x, y;
+    double bestPoints = INFINITY;
+    int bestN = 0;
+    for (int n : sizes)
+      if (auto it = rmse.find({fmt::format("points-{}", n), b}); it != rmse.end()) {
+        x.push_back(n);
+        y.push_back(median(it->second));
+        if (y.back() < bestPoints) bestPoints = y.back(), bestN = n;
+      }
+    if (x.size() < 2) continue;
+    names.push_back("points-N, " + b);
+    xs.push_back(x), ys.push_back(y);
+    std::string beats, loses;
+    for (const std::string& s : strategies) {
+      if (collapsedMapSize(s) || !rmse.count({s, b})) continue;
+      const double e = median(rmse[{s, b}]);
+      names.push_back(s + ", " + b);
+      xs.push_back({double(sizes.front()), double(sizes.back())});
+      ys.push_back({e, e});
+      (bestPoints < e ? beats : loses) += fmt::format("{}{} ({:.5f})", (bestPoints < e ? beats : loses).empty() ? "" : ", ",
+                                                      escape(s), e);
+    }
+    verdicts += fmt::format("<li>{}: the best collapsed map is points-{} (RMSE {:.5f}); it beats {}{}.</li>", escape(b),
+                            bestN, bestPoints, beats.empty() ? "none of the others" : beats,
+                            loses.empty() ? "" : "; it loses to " + loses);
+  }
+  if (names.empty()) return "";
+  return "<h2>The collapsed map against N</h2><p>Every one of N lights at each shading point (the paper's Section "
+         "2.2): no noise between neighbouring pixels, a bias that falls as N grows and a cost that grows with it. "
+         "Flat lines are the other strategies at the same budget.</p>" +
+         svgLogLogPlot("RMSE against the collapsed map's N", "N (lights)", "RMSE", names, xs, ys) + "<ul>" + verdicts +
+         "</ul>";
+}
+
+}  // namespace
+
 std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun>& runs, const Image& reference,
                             const std::vector<StudyImage>& images, const std::vector<std::string>& strategies) {
   // Median over seeds for each (strategy, spp) and (strategy, time budget).
@@ -168,6 +237,7 @@ std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun
                      "RMSE", strategies, xs, ys);
   bool anyTime = !byTime.empty();
   if (anyTime) h += svgLogLogPlot("RMSE against render time", "seconds", "RMSE", strategies, tx, ty);
+  h += collapsedMapSection(runs, strategies);
   h += "<h2>Images</h2><div>";
   h += "<figure><img src=\"" + pngDataUri(reference) + "\"><figcaption>reference</figcaption></figure></div><div>";
   for (const StudyImage& im : images)

@@ -615,9 +615,12 @@ TEST(RenderCli, SamplerVersionAndParseErrors) {
     EXPECT_EQ(b.output.find('\n', at), b.output.size() - 1) << bad << ": " << b.output;
     EXPECT_FALSE(fs::exists(d.file("bad.exr"))) << bad;
   }
-  CliResult pts = runCli("render " + scene + " -o " + d.file("p.exr") + " --no-progress --strategy points --points 8 "
+  CliResult pts = runCli("render " + scene + " -o " + d.file("p.exr") + " --no-progress --strategy points-draw --points 8 "
                          "--point-method mediancut");
   EXPECT_EQ(pts.code, 0) << pts.output;
+  CliResult all = runCli("render " + scene + " -o " + d.file("a.exr") + " --no-progress --integrator direct --strategy points "
+                         "--points 8 --point-method mediancut");
+  EXPECT_EQ(all.code, 0) << all.output;
   CliResult v = runCli("--version");
   EXPECT_EQ(v.code, 0);
   EXPECT_EQ(v.output.rfind("envgi ", 0), 0u) << v.output;

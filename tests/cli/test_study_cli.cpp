@@ -169,6 +169,13 @@ TEST(StudyCli, BadInputIsOneErrorLine) {
   expectError("--strategies points-0", "points-N needs a whole N from 1 to 16777216");
   expectError("--strategies points-99999999999", "points-N needs a whole N from 1 to 16777216");
   expectError("--strategies points-12x", "points-N needs a whole N from 1 to 16777216");
+  expectError("--strategies points-draw", "name its size, points-draw-N");
+  expectError("--strategies points-draw-0", "points-draw-N needs a whole N from 1 to 16777216");
+  // Under path every vertex takes one light and one BSDF sample: bsdf and mis were the alias
+  // table's row twice (identical RMSE), and the whole collapsed map is direct's method.
+  for (const char* s : {"bsdf", "mis", "points-16"})
+    expectError(std::string("--integrator path --strategies importance,") + s,
+                std::string("strategy '") + s + "' names direct's samples");
   // A list that names an item twice (its rows were written twice into results.csv).
   expectError("--strategies importance,uniform,importance", "--strategies names 'importance' twice");
   expectError("--spp 4,1,4", "--spp names '4' twice");
