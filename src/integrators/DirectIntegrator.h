@@ -13,6 +13,7 @@ struct DirectParams {
   int bsdfSamples = 1;
   bool hideEmitters = false;
   EnvStrategy envStrategy = EnvStrategy::Importance;
+  MisHeuristic heuristic = MisHeuristic::Power;
 };
 
 // Direct light reflected at si towards wo (its own emission excluded): nE light samples and
@@ -46,7 +47,8 @@ ENVGI_HD Color collapsedMapLighting(const SceneView& sc, const Tracer& tracer, c
 template <class Tracer>
 ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& si, Vec3f wo,
                               Sampler& smp, EnvStrategy strategy, int emitterSamples, int bsdfSamples,
-                              uint64_t* rayCount, bool skipDelta = false, bool mixBlend = false) {
+                              uint64_t* rayCount, bool skipDelta = false, bool mixBlend = false,
+                              MisHeuristic heuristic = MisHeuristic::Power) {
   Color L(0.f);
   BsdfScratch textured, texturedPartner;
   const Bsdf& bsdf = sc.bsdfAt(si, &textured);
@@ -56,7 +58,7 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
   float nE = float(emitterSamples), nB = float(bsdfSamples);
 
   for (int i = 0; i < emitterSamples; ++i)
-    L += sampleLd(sc, tracer, si, bsdf, woLocal, axis, strategy, nE, nB, smp, rayCount, partner);
+    L += sampleLd(sc, tracer, si, bsdf, woLocal, axis, strategy, nE, nB, heuristic, smp, rayCount, partner);
   if (strategy == EnvStrategy::PointsAll) L += collapsedMapLighting(sc, tracer, si, bsdf, partner, woLocal, rayCount);
 
   for (int j = 0; j < bsdfSamples; ++j) {
@@ -78,7 +80,7 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
       if (isBlack(Le)) continue;
       lightPdf = areaLightPdf(sc, s2.light, si.p, s2.p, s2.ng);
     }
-    float w = (bs.delta || nE == 0.f) ? 1.f : powerHeuristic(nB, bs.pdf, nE, lightPdf);
+    float w = (bs.delta || nE == 0.f) ? 1.f : misHeuristic(heuristic, nB, bs.pdf, nE, lightPdf);
     L += bs.weight * Le * (w / nB);
   }
   return L;
@@ -95,7 +97,7 @@ ENVGI_HD Color directTrace(const SceneView& sc, const Tracer& tracer, Ray ray, S
   Vec3f wo = -ray.d;
   Color L = dp.hideEmitters ? Color(0.f) : sc.emitted(si, wo);
   return L + directLighting(sc, tracer, si, wo, smp, dp.envStrategy, dp.emitterSamples, dp.bsdfSamples, rayCount,
-                            false, true);
+                            false, true, dp.heuristic);
 }
 
 }  // namespace envgi

@@ -41,7 +41,7 @@ struct BsdfEvalAhead {
 // (without a partner) evaluated ahead for the direction that draw gives.
 ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
                                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
-                                        Sampler& smp, const Bsdf* partner = nullptr,
+                                        MisHeuristic heuristic, Sampler& smp, const Bsdf* partner = nullptr,
                                         const Vec2f* uLDrawn = nullptr, const ProductDraw* productDrawn = nullptr,
                                         const BsdfEvalAhead* evalAhead = nullptr) {
   LightSampleLd out;
@@ -76,7 +76,7 @@ ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceIntera
     out.d = to / len;
     out.tMax = len * (1.f - 1e-4f);
   }
-  float w = nB > 0.f && !ls.delta ? powerHeuristic(nE, ls.pdf, nB, bsdfPdfOfLight) : 1.f;
+  float w = nB > 0.f && !ls.delta ? misHeuristic(heuristic, nE, ls.pdf, nB, bsdfPdfOfLight) : 1.f;
   out.value = f * ls.radiance * (w / (ls.pdf * nE));
   out.needsRay = true;
   return out;
@@ -147,9 +147,9 @@ ENVGI_HD bool shadowRayBlocked(const Tracer& tracer, const LightSampleLd& ld, ui
 // it is blocked.
 template <class Tracer>
 ENVGI_HD Color sampleLd(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& si, const Bsdf& bsdf,
-                        Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB, Sampler& smp,
-                        uint64_t* rayCount, const Bsdf* partner = nullptr) {
-  LightSampleLd ld = prepareLd(sc, si, bsdf, woLocal, axis, strategy, nE, nB, smp, partner);
+                        Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB, MisHeuristic heuristic,
+                        Sampler& smp, uint64_t* rayCount, const Bsdf* partner = nullptr) {
+  LightSampleLd ld = prepareLd(sc, si, bsdf, woLocal, axis, strategy, nE, nB, heuristic, smp, partner);
   return resolvedLd(ld, shadowRayBlocked(tracer, ld, rayCount));
 }
 

@@ -143,7 +143,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
 
   // Next-event estimation, weighted against this bounce's BSDF sample.
   if (pp.lightSample)
-    shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, pp.bsdfSample ? 1.f : 0.f, smp, partner,
+    shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, pp.bsdfSample ? 1.f : 0.f, MisHeuristic::Power, smp, partner,
                      ahead && ahead->drawn ? &ahead->uL : nullptr,
                      ahead && ahead->productAhead ? &ahead->product : nullptr, ahead ? &ahead->ev : nullptr),
            st);

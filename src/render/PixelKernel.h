@@ -27,7 +27,8 @@ enum class SampleIntegratorType : int { Path = 0, Direct = 1 };
 // count is 0), so an executor may shade it a bounce at a time as that path.
 ENVGI_HD inline bool directIsOneBouncePath(const DirectParams& dp) {
   // The whole collapsed map at each point is not a path's one light sample.
-  return dp.envStrategy != EnvStrategy::PointsAll && dp.emitterSamples >= 0 && dp.emitterSamples <= 1 && dp.bsdfSamples >= 0 && dp.bsdfSamples <= 1 &&
+  // The path's weights are the power heuristic's.
+  return dp.envStrategy != EnvStrategy::PointsAll && dp.heuristic == MisHeuristic::Power && dp.emitterSamples >= 0 && dp.emitterSamples <= 1 && dp.bsdfSamples >= 0 && dp.bsdfSamples <= 1 &&
          dp.emitterSamples + dp.bsdfSamples > 0;
 }
 ENVGI_HD inline PathParams directAsPath(const DirectParams& dp) {

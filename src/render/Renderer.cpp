@@ -214,6 +214,7 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
   k.path.hideEmitters = is.path.hideEmitters;
   k.path.envStrategy = sn.env;
   k.direct.hideEmitters = is.direct.hideEmitters;
+  k.direct.heuristic = is.direct.misHeuristic == "balance" ? MisHeuristic::Balance : MisHeuristic::Power;
   k.direct.envStrategy = sn.env;
   k.direct.emitterSamples = is.direct.emitterSamples >= 0 ? is.direct.emitterSamples : sn.emitterSamples;
   k.direct.bsdfSamples = is.direct.bsdfSamples >= 0 ? is.direct.bsdfSamples : sn.bsdfSamples;

@@ -55,6 +55,8 @@ DirectSettings DirectSettings::fromProperties(Properties& p) {
   s.emitterSamples = p.getInt("emitter_samples", shading);
   s.bsdfSamples = p.getInt("bsdf_samples", shading);
   s.hideEmitters = p.getBool("hide_emitters", s.hideEmitters);
+  s.misHeuristic = p.getString("mis_heuristic", s.misHeuristic);
+  if (s.misHeuristic != "power" && s.misHeuristic != "balance") p.fail("mis_heuristic must be power or balance");
   if (s.emitterSamples < -1 || s.bsdfSamples < -1) p.fail("sample counts must not be negative");
   return s;
 }

@@ -44,6 +44,7 @@ struct DirectSettings {
   int emitterSamples = -1;  // -1: the strategy's own count (kStrategyNames)
   int bsdfSamples = -1;
   bool hideEmitters = false;
+  std::string misHeuristic = "power";  // power, or balance (the paper's Eq. 5-6)
   static DirectSettings fromProperties(Properties& p);
 };
 

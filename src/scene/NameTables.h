@@ -87,14 +87,17 @@ struct StrategyName {
   bool mapOnly;        // a map strategy in its own right (envmap samples/plot accept it)
 };
 
-// bsdf and mis draw light samples (mis) through the alias table: Algorithm 1's density,
-// which bench_envmap measures 1.45x faster than the binary search. product (the default)
-// multiplies that density by a cosine bound about the normal (envmap/CosineProduct.h).
+// mis is the paper's Eq. 3-6: Algorithm 1's CDFs (binary search) for the light sample beside a
+// BSDF sample, so that importance against mis changes one thing; alias draws the same density
+// through an alias table (1.45x faster in bench_envmap). bsdf never draws the map (its table
+// entry is unused). product (the default) multiplies the density by a cosine bound about the
+// normal (envmap/CosineProduct.h); points is the collapsed map at every point, points-draw
+// one of its lights a sample.
 inline constexpr StrategyName kStrategyNames[] = {
     {"uniform", EnvStrategy::Uniform, 1, 0, true},       {"cosine", EnvStrategy::Cosine, 1, 0, true},
     {"importance", EnvStrategy::Importance, 1, 0, true}, {"alias", EnvStrategy::Alias, 1, 0, true},
     {"adaptive", EnvStrategy::Adaptive, 1, 0, true},     {"bsdf", EnvStrategy::Alias, 0, 1, false},
-    {"mis", EnvStrategy::Alias, 1, 1, false},            {"points", EnvStrategy::PointsAll, 1, 0, false},
+    {"mis", EnvStrategy::Importance, 1, 1, false},       {"points", EnvStrategy::PointsAll, 1, 0, false},
     {"product", EnvStrategy::Product, 1, 1, true},       {"points-draw", EnvStrategy::Points, 1, 0, false},
 };
 

@@ -160,6 +160,25 @@ void buildLightCells(const std::vector<MeshView>& meshes, const std::vector<Text
 }
 }  // namespace
 
+void Scene::requireCompensationCovered() const {
+  // MIS compensation (Karlik et al. 2019) samples max(L - mean, 0): the map's dim directions get
+  // density 0, which only BSDF samples MIS-weighted beside them cover. An estimator without such
+  // samples would lose that light silently.
+  if (!env || !env->options().misCompensation) return;
+  const EnvStrategy s = findStrategy(integrator.env.strategy).env;
+  if (s == EnvStrategy::Uniform || s == EnvStrategy::Cosine) return;  // they do not read the map's tables
+  std::string why;
+  if (isCollapsedMap(s))
+    why = "the collapsed map's lights are drawn from its density and no BSDF sample finds them";
+  else if (integrator.type == IntegratorType::Photon || integrator.type == IntegratorType::Grid)
+    why = std::string("the ") + integratorName(integrator.type) +
+          " integrator's gathers take light samples of the map without BSDF samples";
+  if (!why.empty())
+    throw std::runtime_error("mis_compensation: " + why +
+                             ", so the map's dim directions would be lost; turn mis_compensation off, or use path or "
+                             "direct with BSDF samples");
+}
+
 void Scene::finalize() {
   if (bsdfs.empty()) bsdfs.push_back(Bsdf{});
   // A rough plastic whose alpha or ior changed since loading reads the tables of its new ones.
@@ -171,6 +190,7 @@ void Scene::finalize() {
       env->setPoints(collapseByWeightedSampling(*env, integrator.env.pointCount, sampler.seed));
     else throw std::runtime_error("unknown point_method '" + integrator.env.pointMethod + "' (sample, mediancut)");
   }
+  requireCompensationCovered();
   // Embree reads vertices with 16-byte loads: keep one element of slack after the last one.
   for (TriangleMesh& m : meshes) m.positions.reserve(m.positions.size() + 1);
   for (TriangleMesh& m : prototypes) m.positions.reserve(m.positions.size() + 1);

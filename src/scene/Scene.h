@@ -73,6 +73,9 @@ class Scene {
 
   // Builds the views, the light list, the bounds and (points strategy) the collapsed map;
   // call after loading and again after changing any of the above.
+  // Throws where the map's MIS compensation would bias the chosen estimator (no BSDF samples
+  // beside its light samples): photon and grid gathers, the collapsed map.
+  void requireCompensationCovered() const;
   void finalize();
   const SceneView& view() const { return view_; }
   // Geometry ids (Hit::geomId): the meshes, then the instances, then the spheres.

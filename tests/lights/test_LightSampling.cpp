@@ -109,7 +109,7 @@ double shadowedIrradiance(const SceneView& sc, const EmbreeTracer& tracer, Vec3f
   uint64_t rays = 0;
   for (int i = 0; i < n; ++i) {
     smp.start(0, uint32_t(i));
-    sum += double(sampleLd(sc, tracer, si, white, si.shading.toLocal(wo), si.ng, EnvStrategy::Importance, 1.f, 0.f,
+    sum += double(sampleLd(sc, tracer, si, white, si.shading.toLocal(wo), si.ng, EnvStrategy::Importance, 1.f, 0.f, MisHeuristic::Power,
                            smp, &rays).y);
   }
   return kPi * sum / n;
