@@ -66,8 +66,56 @@ EnvironmentMap EnvironmentMap::load(const std::string& path, const EnvironmentMa
   if (img.height >= 2) {  // the lookup's r, g, b become the file's own rows
     map.setLookupRgb(img);
     map.rowsFromPoles_ = true;
+    map.buildAlgorithm1Table();
   }
   return map;
+}
+
+void EnvironmentMap::buildAlgorithm1Table() {
+  // Algorithm 1: the pixel's luminance times sin(theta) at its row's centre (the paper's
+  // cos(phi) of the latitude). Under MIS compensation, max(Y - mean, 0) in place of Y.
+  const int w = width_, h = height_;
+  std::vector<float> lum(size_t(w) * h);
+  for (size_t i = 0; i < lum.size(); ++i) lum[i] = luminance(texels_[i * 4], texels_[i * 4 + 1], texels_[i * 4 + 2]);
+  if (opts_.misCompensation) {
+    double sum = 0.0, sa = 0.0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) sum += lum[size_t(y) * w + x] * rowSinTheta(y, h), sa += rowSinTheta(y, h);
+    const float mean = sa > 0.0 ? float(sum / sa) : 0.f;
+    bool any = false;
+    for (float& l : lum) any = any || l > mean;
+    if (any)
+      for (float& l : lum) l = std::max(l - mean, 0.f);
+  }
+  std::vector<float> weight(lum.size());
+  double total = 0.0;
+  int positive = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      weight[size_t(y) * w + x] = lum[size_t(y) * w + x] * rowSinTheta(y, h);
+      total += weight[size_t(y) * w + x];
+      positive += weight[size_t(y) * w + x] > 0.f;
+    }
+  // A black pixel beside a lit one still shows light through the bilinear lookup: it keeps a
+  // floor of 1e-4 of the mean weight, so the density is positive wherever the lookup is and the
+  // estimator stays unbiased (Algorithm 1 itself would give it none).
+  if (opts_.bilinear && positive > 0 && !opts_.misCompensation) {
+    const float floorWeight = float(1e-4 * total / positive);
+    std::vector<float> out = weight;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (weight[size_t(y) * w + x] > 0.f) continue;
+        bool litNeighbour = false;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const int yy = std::clamp(y + dy, 0, h - 1), xx = (x + dx + w) % w;
+            litNeighbour = litNeighbour || lum[size_t(yy) * w + xx] > 0.f;
+          }
+        if (litNeighbour) out[size_t(y) * w + x] = floorWeight * rowSinTheta(y, h);
+      }
+    weight.swap(out);
+  }
+  paperDist_ = PiecewiseConstant2D(weight.data(), w, h);
 }
 
 void EnvironmentMap::setLookupRgb(const Image& img) {
@@ -192,6 +240,7 @@ EnvironmentMap::EnvironmentMap(Image img, const EnvironmentMapOptions& opts, con
   std::vector<float> plain = opts.misCompensation ? samplingWeights(img, opts.bilinear, false) : weight;
   adaptive_ = AdaptiveQuadtree(plain.data(), img.width, img.height, opts.adaptiveLeaves);
   if (opts.misCompensation) emission_ = AliasTable(plain.data(), plain.size());
+  buildAlgorithm1Table();
   if (dist_.integral() <= 0.f) spdlog::warn("environment map '{}' is black everywhere: a light of zero power", name);
 }
 
@@ -231,6 +280,7 @@ EnvironmentMapView EnvironmentMap::view() const {
   v.bilinear = opts_.bilinear;
   v.toWorld = opts_.toWorld;
   v.dist = dist_.view();
+  v.paperDist = paperDist_.view();
   v.alias = alias_.view();
   v.emission = opts_.misCompensation ? emission_.view() : v.alias;
   v.adaptive = adaptive_.view();

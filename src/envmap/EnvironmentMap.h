@@ -65,7 +65,7 @@ class EnvironmentMap {
   // Luminance power, integral of Y(L) over the sphere (zero for an all-black map).
   float luminancePower() const;
   size_t samplingBytes() const {
-    return dist_.bytes() + alias_.bytes() + emission_.bytes() + product_.bytes() + warpBits_.size() * sizeof(uint32_t);
+    return dist_.bytes() + paperDist_.bytes() + alias_.bytes() + emission_.bytes() + product_.bytes() + warpBits_.size() * sizeof(uint32_t);
   }
 
   // The collapsed map that the `points` strategy uses (envmap/CollapsedMap.h makes one).
@@ -99,6 +99,9 @@ class EnvironmentMap {
   }
   EnvironmentMapOptions opts_;
   PiecewiseConstant2D dist_;
+  PiecewiseConstant2D paperDist_;  // Algorithm 1's table, from the lookup's own pixels
+  // Builds paperDist_ from the texels' r, g, b (the file's pixels).
+  void buildAlgorithm1Table();
   AliasTable alias_;
   AliasTable emission_;  // plain luminance; built only when alias_ is compensated
   CosineProduct product_;

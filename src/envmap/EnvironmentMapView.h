@@ -31,6 +31,10 @@ enum class EnvStrategy : int {
   // pixels share one estimate (biased, no noise from the map). Not a sampling density:
   // next-event estimation adds the sum itself (collapsedMapLighting) and draws nothing here.
   PointsAll = 7,
+  // Algorithm 1 exactly: the file's pixel luminance x sin(theta) at its row's centre, constant
+  // over the pixel, on pixel rows, and uniform inside the pixel (`importance`). Importance
+  // above is the density matched to the bilinear lookup (`importance-bilinear`).
+  Algorithm1 = 8,
 };
 
 // Strategies whose map light comes from the collapsed map's delta lights, which no BSDF-sampled
@@ -68,6 +72,7 @@ struct EnvironmentMapView {
   bool bilinear = true;
   Transform toWorld;
   PiecewiseConstant2DView dist;  // func = luminance x sin(theta) per pixel
+  PiecewiseConstant2DView paperDist;  // Algorithm 1's own table (EnvStrategy::Algorithm1)
   AliasTableView alias;          // over all pixels, same weights as dist
   // Light leaving the map, by plain luminance x sin(theta): the same table as `alias` unless
   // MIS compensation made dist and alias sample max(L - mean, 0), which misses dim directions.
@@ -367,6 +372,13 @@ struct EnvironmentMapView {
         out.pdf = importancePdfUV(out.uv) * inPixel;
         break;
       }
+      case EnvStrategy::Algorithm1: {
+        float pdfUV;
+        out.uv = paperDist.sample(u, &pdfUV);
+        local = uvToDir(out.uv);
+        out.pdf = solidAnglePdf(pdfUV, out.uv.y);
+        break;
+      }
       case EnvStrategy::Alias: {
         float pmf, inPixel = 1.f;
         out.uv = placeInPixel(sampleTable(alias, u, &pmf), &inPixel);
@@ -447,6 +459,7 @@ struct EnvironmentMapView {
       case EnvStrategy::Importance:
       case EnvStrategy::Alias: return importancePdfUV(uv) * pdfInPixel(uv);
       case EnvStrategy::Adaptive: return adaptive.pdf(uv);
+      case EnvStrategy::Algorithm1: return solidAnglePdf(paperDist.pdf(uv), uv.y);
       case EnvStrategy::Points:
       case EnvStrategy::PointsAll: return 0.f;  // no direction drawn by BSDF sampling hits a point
       case EnvStrategy::Product:

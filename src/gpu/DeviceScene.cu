@@ -8,11 +8,14 @@ namespace envgi::gpu {
 EnvironmentMapView uploadEnvironment(DeviceArena& a, EnvironmentMapView v) {
   size_t px = size_t(v.width) * v.height;
   v.texels = a.upload(v.texels, px * 4, "environment map");
-  v.dist.condFunc = a.upload(v.dist.condFunc, px, "environment CDFs");
-  v.dist.condCdf = a.upload(v.dist.condCdf, size_t(v.height) * (v.width + 1), "environment CDFs");
-  v.dist.condInt = a.upload(v.dist.condInt, size_t(v.height), "environment CDFs");
-  v.dist.marginal.func = a.upload(v.dist.marginal.func, size_t(v.height), "environment CDFs");
-  v.dist.marginal.cdf = a.upload(v.dist.marginal.cdf, size_t(v.height) + 1, "environment CDFs");
+  // The bilinear-matched density's tables and Algorithm 1's own, alike in shape.
+  for (PiecewiseConstant2DView* d : {&v.dist, &v.paperDist}) {
+    d->condFunc = a.upload(d->condFunc, px, "environment CDFs");
+    d->condCdf = a.upload(d->condCdf, size_t(v.height) * (v.width + 1), "environment CDFs");
+    d->condInt = a.upload(d->condInt, size_t(v.height), "environment CDFs");
+    d->marginal.func = a.upload(d->marginal.func, size_t(v.height), "environment CDFs");
+    d->marginal.cdf = a.upload(d->marginal.cdf, size_t(v.height) + 1, "environment CDFs");
+  }
   bool sharedEmission = v.emission.bins == v.alias.bins;
   v.alias.bins = a.upload(v.alias.bins, size_t(v.alias.n), "environment alias table");
   v.emission.bins = sharedEmission ? v.alias.bins : a.upload(v.emission.bins, size_t(v.emission.n), "environment emission table");

@@ -228,7 +228,7 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
   // it does every direction get covered (Karlik et al. 2019).
   bool compensated = scene.env && scene.env->options().misCompensation;
   bool mapDensity = k.direct.envStrategy == EnvStrategy::Alias || k.direct.envStrategy == EnvStrategy::Importance ||
-                    k.direct.envStrategy == EnvStrategy::Product;
+                    k.direct.envStrategy == EnvStrategy::Product || k.direct.envStrategy == EnvStrategy::Algorithm1;
   if (k.type == SampleIntegratorType::Direct && compensated && mapDensity && k.direct.emitterSamples > 0 &&
       k.direct.bsdfSamples == 0)
     throw std::runtime_error("direct integrator: mis_compensation samples only the map's bright part; it needs "

@@ -95,9 +95,10 @@ struct StrategyName {
 // one of its lights a sample.
 inline constexpr StrategyName kStrategyNames[] = {
     {"uniform", EnvStrategy::Uniform, 1, 0, true},       {"cosine", EnvStrategy::Cosine, 1, 0, true},
-    {"importance", EnvStrategy::Importance, 1, 0, true}, {"alias", EnvStrategy::Alias, 1, 0, true},
+    {"importance", EnvStrategy::Algorithm1, 1, 0, true}, {"alias", EnvStrategy::Alias, 1, 0, true},
+    {"importance-bilinear", EnvStrategy::Importance, 1, 0, true},
     {"adaptive", EnvStrategy::Adaptive, 1, 0, true},     {"bsdf", EnvStrategy::Alias, 0, 1, false},
-    {"mis", EnvStrategy::Importance, 1, 1, false},       {"points", EnvStrategy::PointsAll, 1, 0, false},
+    {"mis", EnvStrategy::Algorithm1, 1, 1, false},       {"points", EnvStrategy::PointsAll, 1, 0, false},
     {"product", EnvStrategy::Product, 1, 1, true},       {"points-draw", EnvStrategy::Points, 1, 0, false},
 };
 

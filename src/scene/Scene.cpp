@@ -166,7 +166,8 @@ void Scene::requireCompensationCovered() const {
   // samples would lose that light silently.
   if (!env || !env->options().misCompensation) return;
   const EnvStrategy s = findStrategy(integrator.env.strategy).env;
-  if (s == EnvStrategy::Uniform || s == EnvStrategy::Cosine) return;  // they do not read the map's tables
+  // Uniform and cosine read none of the map's tables; the adaptive quadtree balances plain power.
+  if (s == EnvStrategy::Uniform || s == EnvStrategy::Cosine || s == EnvStrategy::Adaptive) return;
   std::string why;
   if (isCollapsedMap(s))
     why = "the collapsed map's lights are drawn from its density and no BSDF sample finds them";

@@ -185,7 +185,9 @@ TEST(CollapsedMap, AtOneSampleItBeatsImportanceAndItsBiasFallsWithN) {
     std::printf("points-%d: RMSE %.4f at 1 spp (importance %.4f, ratio %.3f), %.4f at 64 spp\n", n, atOne,
                 importance, atOne / importance, bias);
     EXPECT_LT(bias, 0.7 * last) << "the bias falls as N grows";
-    if (n >= 256) EXPECT_LE(atOne, 0.3 * importance) << n;
+    if (n >= 256) {
+      EXPECT_LE(atOne, 0.3 * importance) << n;
+    }
     last = bias;
   }
 }
