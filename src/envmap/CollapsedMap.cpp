@@ -32,7 +32,7 @@ std::vector<DirectionalLight> collapseByWeightedSampling(const EnvironmentMap& m
     smp.start(0, uint32_t(i));
     EnvSample es = v.sample(EnvStrategy::Importance, smp.get2D());
     Color e = es.pdf > 0.f ? es.radiance / (es.pdf * float(n)) : Color(0.f);
-    out.push_back({es.dir, e});
+    out.push_back({es.dir, e, 0.f, 0.f, es.pdf > 0.f ? 1.f / (es.pdf * float(n)) : 0.f});
   }
   return out;
 }
@@ -105,12 +105,13 @@ std::vector<DirectionalLight> collapseByMedianCut(const EnvironmentMap& map, int
   std::vector<DirectionalLight> out;
   for (const Region& r : done) {
     Color e(0.f);
-    double cx = 0.0, cy = 0.0, wsum = 0.0;
+    double cx = 0.0, cy = 0.0, wsum = 0.0, omega = 0.0;
     for (int y = r.y0; y < r.y1; ++y)
       for (int x = r.x0; x < r.x1; ++x) {
         Color c = img.at(x, y);
         double om = pixelOmega(y), w = luminance(c) * om;
         e += c * float(om);
+        omega += om;
         cx += w * (x + 0.5);
         cy += w * (y + 0.5);
         wsum += w;
@@ -123,7 +124,7 @@ std::vector<DirectionalLight> collapseByMedianCut(const EnvironmentMap& map, int
       cy /= wsum;
     }
     Vec3f dir = v.fromLocal(EnvironmentMapView::uvToDir(Vec2f(float(cx / W), float(cy / H))));
-    out.push_back({dir, e * v.scale});
+    out.push_back({dir, e * v.scale, 0.f, 0.f, float(omega)});
   }
   return out;
 }

@@ -16,8 +16,10 @@ enum class CollapseMethod { WeightedSampling, MedianCut };
 // rather than an allocation the machine refuses.
 inline constexpr int kMaxCollapsedPoints = 1 << 24;
 
-// N directions drawn by Algorithm 1 (stratified, Owen-scrambled Sobol' points for `seed`), each
-// with irradiance L / (pdf N): their sum estimates the map's integral.
+// N directions drawn by Algorithm 1's density as the bilinear lookup matches it
+// (importance-bilinear: L / pdf is flatter than under the per-pixel table, so N lights carry the
+// map's power closer), stratified, Owen-scrambled Sobol' points for `seed`, each with
+// irradiance L / (pdf N): their sum estimates the map's integral.
 std::vector<DirectionalLight> collapseByWeightedSampling(const EnvironmentMap& map, int n, uint32_t seed);
 
 // Debevec's median cut (2005): the map split into N regions of equal luminance power (always

@@ -49,6 +49,9 @@ struct DirectionalLight {
   Color irradiance;
   float pmf = 0.f;  // chance next-event estimation picks it: by luminance of its irradiance
   float cdf = 0.f;  // sum of the pmfs up to and including this one
+  // Its share of the sphere (the paper's Delta Phi_p weight): 1 / (p N) for a weighted-sampling
+  // draw, the region's solid angle for median cut. The shares sum to 4 pi in expectation.
+  float solidAngle = 0.f;
 };
 
 struct EnvSample {

@@ -26,6 +26,9 @@ PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const Embre
       pr.spp = sppmPasses(scene, opts);
       break;
     case IntegratorType::Grid: {
+      if (scene.integrator.grid.basis == "directions")
+        throw std::runtime_error("the grid's basis 'directions' (the paper's M coefficients) runs on the CPU only: "
+                                 "--device cpu, or basis 'sh' on the GPU");
       SequenceAndSpp q = gridSequence(scene, opts);
       pr.executor = makeCudaGridExecutor(scene, bvh, gridExecutorSettings(scene, opts), q.sequence, gpu,
                                          opts.keepsVariance(), &bytes);

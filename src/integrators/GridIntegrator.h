@@ -36,20 +36,24 @@ ENVGI_HD Color gridTrace(const SceneView& sc, const Tracer& tracer, const Ray& r
 
 // Indirect radiance arriving at a grid point from direction ray.d: light that has left a
 // diffuse-like surface at least once, hitRadiance(si, wi, smp, rays) (direct light there plus
-// photon irradiance). Sharp glossy lobes are followed; mirrors and glass end the ray, since
-// what comes through them is a caustic, which the caustic map gives per pixel far less noisily
-// than a few hundred rays a point could. Emitters and the map seen from the point are direct
-// light, which the pixel adds itself. *backFace: the first surface was met from behind (the
+// photon irradiance), followed through mirrors, glass and sharp glossy lobes. What the ray
+// sees of emitters and the map is counted only after a non-delta bounce: seen directly it is
+// direct light (the pixel adds it), and seen through mirrors and glass alone it is a caustic,
+// which the caustic map gives per pixel. *backFace: the first surface was met from behind (the
 // point is inside something).
 template <class Tracer, class HitRadiance>
 ENVGI_HD Color gridGather(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& smp, const ChainParams& cp,
                           const HitRadiance& hitRadiance, bool* backFace, uint64_t* rays) {
-  Color beta(1.f);
+  Color beta(1.f), L(0.f);
+  bool throughGlossy = false;  // a non-delta bounce so far: emitters and the map now count
   *backFace = false;
   for (int depth = 0; depth < cp.maxDepth; ++depth) {
     Hit h;
     ++*rays;
-    if (!tracer.intersect(ray, &h)) return Color(0.f);
+    if (!tracer.intersect(ray, &h)) {
+      if (throughGlossy && sc.hasEnvironment) L += beta * sc.env.eval(ray.d);
+      return L;
+    }
     SurfaceInteraction si = sc.interaction(ray, h);
     BsdfScratch textured;
     const Bsdf& bsdf = sc.bsdfAt(si, &textured);
@@ -57,17 +61,19 @@ ENVGI_HD Color gridGather(const SceneView& sc, const Tracer& tracer, Ray ray, Sa
       *backFace = true;
       return Color(0.f);
     }
-    if (isDiffuseLike(bsdf, cp.glossyThreshold)) return beta * hitRadiance(si, ray.d, smp, rays);
+    if (throughGlossy) L += beta * sc.emitted(si, -ray.d);
+    if (isDiffuseLike(bsdf, cp.glossyThreshold)) return L + beta * hitRadiance(si, ray.d, smp, rays);
     BsdfSample bs;
     float uc = smp.get1D();
     Vec2f ub = smp.get2D();
-    if (!bsdfSample(bsdf, si.shading.toLocal(-ray.d), uc, ub, &bs) || bs.delta) return Color(0.f);
+    if (!bsdfSample(bsdf, si.shading.toLocal(-ray.d), uc, ub, &bs)) return L;
     beta *= bs.weight;
-    if (isBlack(beta)) return Color(0.f);
+    if (isBlack(beta)) return L;
+    throughGlossy = throughGlossy || !bs.delta;
     Vec3f wi = si.shading.toWorld(bs.wi);
     ray = Ray{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};
   }
-  return Color(0.f);
+  return L;
 }
 
 // Rays [first, first + rays) of grid point i at p: radiance gathered by gridGather, projected
@@ -100,18 +106,27 @@ ENVGI_HD void gridPointGather(const SceneView& sc, const Tracer& tracer, Vec3f p
   }
 }
 
+// The SH grid's camera path (gridSample's choice for an IlluminationGridView).
+template <class Tracer, class CausticIrradiance>
+ENVGI_HD Color gridSample(const SceneView& sc, const Tracer& tracer, const Ray& ray, Sampler& smp,
+                          const IlluminationGridView& grid, const CausticIrradiance& caustics, const GridParams& gp,
+                          uint64_t* rays) {
+  return gridTrace(sc, tracer, ray, smp, grid, caustics, gp, rays);
+}
+
 // One camera sample of the grid integrator, on either device: caustics from the caustic map's
-// precomputed irradiance, the rest from the grid.
-template <class Tracer>
+// precomputed irradiance, the rest from the grid, of either basis (GridView: the SH grid's
+// IlluminationGridView, or the paper's DirectionalGridView).
+template <class Tracer, class GridView = IlluminationGridView>
 struct GridSample {
   const SceneView* scene = nullptr;
   Tracer tracer;
-  IlluminationGridView grid;
+  GridView grid;
   IrradianceCacheView caustic;
   GridParams params;
   ENVGI_HD Color operator()(const Ray& ray, Sampler& smp, uint64_t* rays) const {
     auto caustics = [&](Vec3f p, Vec3f n) { return caustic.irradiance(p, n); };
-    return gridTrace(*scene, tracer, ray, smp, grid, caustics, params, rays);
+    return gridSample(*scene, tracer, ray, smp, grid, caustics, params, rays);
   }
 };
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "core/Vec.h"
+#include "photon/GridCorners.h"
 
 namespace envgi {
 
@@ -50,30 +51,13 @@ struct IlluminationGridView {
     return point(int(i % size_t(nx)), int(i / size_t(nx) % size_t(ny)), int(i / (size_t(nx) * size_t(ny))));
   }
 
-  // Irradiance at p for normal n: the 8 surrounding points' SH, trilinearly weighted; points
-  // inside geometry or behind the surface count less, so light leaks less through walls.
+  // Irradiance at p for normal n: the 8 surrounding points' SH, weighted by gridCorners.
   ENVGI_HD Color irradiance(Vec3f p, Vec3f n) const {
-    Vec3f g((p.x - lo.x) / spacing.x, (p.y - lo.y) / spacing.y, (p.z - lo.z) / spacing.z);
-    int i0 = clampi(int(floorf(g.x)), 0, nx - 2), j0 = clampi(int(floorf(g.y)), 0, ny - 2),
-        k0 = clampi(int(floorf(g.z)), 0, nz - 2);
-    float fx = clampf(g.x - float(i0), 0.f, 1.f), fy = clampf(g.y - float(j0), 0.f, 1.f),
-          fz = clampf(g.z - float(k0), 0.f, 1.f);
+    const GridCorners c = gridCorners(lo, spacing, nx, ny, nz, weight, p, n);
     Color sum(0.f);
-    float wsum = 0.f;
-    for (int c = 0; c < 8; ++c) {
-      int di = c & 1, dj = (c >> 1) & 1, dk = (c >> 2) & 1;
-      int idx = index(i0 + di, j0 + dj, k0 + dk);
-      float w = (di ? fx : 1.f - fx) * (dj ? fy : 1.f - fy) * (dk ? fz : 1.f - fz) * weight[idx];
-      // A point behind the surface sees the other side of it: weight it down smoothly.
-      Vec3f toPoint = point(i0 + di, j0 + dj, k0 + dk) - p;
-      float len = length(toPoint);
-      float facing = len > 0.f ? 0.5f * (1.f + dot(toPoint, n) / len) : 1.f;
-      w *= facing * facing + 0.05f;
-      if (w <= 0.f) continue;
-      sum += shL1Irradiance(sh[idx], n) * w;
-      wsum += w;
-    }
-    return wsum > 0.f ? sum / wsum : Color(0.f);
+    for (int k = 0; k < 8; ++k)
+      if (c.weight[k] > 0.f) sum += shL1Irradiance(sh[c.index[k]], n) * c.weight[k];
+    return sum;
   }
 };
 

@@ -14,6 +14,7 @@
 #include "render/ActivePixels.h"
 #include "render/CpuExecutor.h"
 #include "integrators/PhotonIntegrator.h"
+#include "render/DirectionalGridExecutor.h"
 #include "render/GridExecutor.h"
 #include "render/SppmExecutor.h"
 #include "scene/NameTables.h"
@@ -150,6 +151,17 @@ PreparedRender prepareOnTracer(const Scene& scene, const Tracer& tracer, const R
       GridExecutorSettings ge = gridExecutorSettings(scene, opts);
       if (!ge.photons.tracer) ge.photons.tracer = cpuPhotonTracer(scene, tracer);
       SequenceAndSpp q = gridSequence(scene, opts);
+      if (scene.integrator.grid.basis == "directions") {
+        auto ex = std::make_unique<DirectionalGridExecutor<Tracer>>(scene, tracer, ge, scene.integrator.grid.directions,
+                                                                    q.sequence, opts.threads, opts.keepsVariance(),
+                                                                    opts.tileSize);
+        logPhotonStats(ex->photonStats());
+        const DirectionalGridView& gv = ex->grid().view();
+        spdlog::info("grid: {}x{}x{} points x {} directions, {} samples each, {:.2f} M rays in {:.2f} s, {:.1f} MB",
+                     gv.nx, gv.ny, gv.nz, gv.m, ex->grid().samplesPerDirection(), ex->gridStats().rays / 1e6,
+                     ex->gridStats().seconds, ex->grid().bytes() / 1e6);
+        return {std::move(ex), q.spp};
+      }
       auto ex = std::make_unique<GridExecutor<Tracer>>(scene, tracer, ge, q.sequence, opts.threads,
                                                        opts.keepsVariance(), opts.tileSize);
       logGridBuild(ex->build(), ge.gatherRays);

@@ -102,6 +102,10 @@ GridSettings GridSettings::fromProperties(Properties& p) {
   s.refineRays = p.getInt("refine_rays", s.refineRays);
   s.maxGatherRays = p.getInt("max_gather_rays", std::max(s.maxGatherRays, s.gatherRays));
   int g = p.getInt("global_photons", int(s.globalPhotons)), c = p.getInt("caustic_photons", int(s.causticPhotons));
+  s.basis = p.getString("basis", s.basis);
+  s.directions = p.getInt("directions", s.directions);
+  if (s.basis != "sh" && s.basis != "directions") p.fail("basis must be sh or directions");
+  if (s.directions < 1 || s.directions > 4096) p.fail("directions must be between 1 and 4096");
   if (s.resolution < 2 || s.resolution > 512) p.fail("resolution must be between 2 and 512");
   if (s.gatherRays < 1) p.fail("gather_rays must be positive");
   if (s.refineRays < 0) p.fail("refine_rays must not be negative");

@@ -87,6 +87,11 @@ struct GridSettings {
   int maxDepth = kSpecularChainDepth;
   int rrDepth = kRouletteDepth;
   bool hideEmitters = false;
+  // What a grid point keeps: "sh", L1 spherical harmonics of indirect radiance (an irradiance
+  // volume, diffuse response only); or "directions", the paper's M coefficients, the radiance
+  // along each of M collapsed-map directions, to which each pixel applies its BSDF (docs/grid.md).
+  std::string basis = "sh";
+  int directions = 64;  // M, for basis "directions"
   static GridSettings fromProperties(Properties& p);
 };
 

@@ -182,3 +182,17 @@ TEST(NameTables, NamesRoundTripAndUnknownNamesAreErrors) {
   EXPECT_THROW(findStrategy("uniform-ish"), std::runtime_error);
   EXPECT_THROW(findStrategy("mis", /*mapOnly=*/true), std::runtime_error);
 }
+
+// The grid's basis and its count of directions: named values and a bounded count only.
+TEST(IntegratorSettings, GridBasisAndDirectionsAreChecked) {
+  auto gridWith = [](const std::string& name, const std::string& tag, const std::string& value) {
+    Properties p;
+    p.set(name, tag, value);
+    return GridSettings::fromProperties(p);
+  };
+  EXPECT_EQ(gridWith("basis", "string", "directions").basis, "directions");
+  EXPECT_EQ(gridWith("directions", "integer", "256").directions, 256);
+  EXPECT_THROW(gridWith("basis", "string", "wavelets"), std::runtime_error);
+  EXPECT_THROW(gridWith("directions", "integer", "0"), std::runtime_error);
+  EXPECT_THROW(gridWith("directions", "integer", "5000"), std::runtime_error);
+}

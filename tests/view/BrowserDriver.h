@@ -306,7 +306,9 @@ class Browser {
     argv.push_back("about:blank");
     child_ = std::make_unique<Child>(argv, dir + "/chromium.log");
     if (!child_->waitForLog("DevTools listening on ws://", 60)) throw std::runtime_error("chromium: " + child_->log());
-    const int devPort = printedPort(child_->log());
+    // The port in the line that announces it: other lines may name other URLs first.
+    const std::string log = child_->log();
+    const int devPort = printedPort(log.substr(log.find("DevTools listening on ws://")));
     std::string list;
     if (httpGet(devPort, "/json/list", &list) != 200) throw std::runtime_error("chromium: no page list");
     std::string pageWs;

@@ -1,0 +1,99 @@
+// The grid integrator's CPU driver for the paper's own basis (`basis` = directions): photon
+// maps, the M directions from the collapsed map, the grid filled by directionalPointGather;
+// then camera passes that read it, with more samples of every direction before each pass after
+// the first, up to the limit (the paper's step 4, "as the time budget allows").
+#pragma once
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <memory>
+
+#include "integrators/DirectionalGridIntegrator.h"
+#include "render/Cancellation.h"
+#include "render/CpuExecutor.h"
+#include "render/IlluminationGridBuilder.h"
+
+namespace envgi {
+
+// The M directions and their shares: the collapsed map's (Algorithm 1's draws, each 1 / (p M) of
+// the sphere) where the scene has a map, else M directions spread evenly (a spiral), 4 pi / M each.
+void gridDirections(const Scene& scene, int m, uint32_t seed, std::vector<Vec3f>* dirs, std::vector<float>* share);
+
+// A directional grid over the scene's bounds, as makeIlluminationGrid places the SH grid's points;
+// refused where it would not fit in half the machine's memory.
+DirectionalGrid makeDirectionalGrid(const Scene& scene, int resolution, int m, uint32_t seed);
+
+template <class Tracer>
+class DirectionalGridExecutor final : public PassExecutor {
+ public:
+  DirectionalGridExecutor(const Scene& scene, Tracer tracer, const GridExecutorSettings& s, int directions,
+                          SampleSequence seq, int threads, bool keepVariance, int tileSize)
+      : scene_(scene), tracer_(tracer), settings_(s) {
+    grid_ = makeDirectionalGrid(scene, s.resolution, directions, s.seed);
+    shootPhotons(scene, s.photons, &global_, &caustic_, &photonStats_);
+    gather(0, samplesFor(s.gatherRays), s.cancel);
+    GridSample<Tracer, DirectionalGridView> sample{&scene.view(), tracer, grid_.view(), caustic_.irradianceCache().view(),
+                                         s.params};
+    camera_ = std::make_unique<CpuExecutor<GridSample<Tracer, DirectionalGridView>>>(scene.view().camera, seq, sample, threads,
+                                                                           keepVariance, "cpu", tileSize);
+  }
+  std::string deviceName() const override { return "cpu"; }
+  void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
+    if (passes_++ > 0) {
+      const int done = grid_.samplesPerDirection(), limit = samplesFor(settings_.maxGatherRays);
+      const int add = settings_.refineRays > 0 ? std::min(samplesFor(settings_.refineRays), limit - done) : 0;
+      if (add > 0) gather(done, add, nullptr);
+    }
+    camera_->runPass(s0, s1, progress, counters);
+  }
+  void readFilm(FilmSums* out) override { camera_->readFilm(out); }
+  bool restart(const Camera& cam) override { return camera_->restart(cam); }
+  bool setActivePixels(const std::vector<unsigned char>& mask) override { return camera_->setActivePixels(mask); }
+  bool keepsVariance() const override { return camera_->keepsVariance(); }
+  const DirectionalGrid& grid() const { return grid_; }
+  const PhotonShootStats& photonStats() const { return photonStats_; }
+  const GridBuildStats& gridStats() const { return stats_; }
+
+ private:
+  // The SH grid's ray budgets (gather_rays, refine_rays, max_gather_rays) are rays a point: the
+  // same budget here is that many rays over the M directions, at least one sample each.
+  int samplesFor(int rays) const { return std::max(1, rays / std::max(1, grid_.directions())); }
+
+  void gather(int first, int samples, const std::atomic<bool>* cancel) {
+    auto t0 = std::chrono::steady_clock::now();
+    const SceneView& sc = scene_.view();
+    const IrradianceCacheView &g = global_.irradianceCache().view(), &c = caustic_.irradianceCache().view();
+    const int length = std::max(samplesFor(settings_.gatherRays), samplesFor(settings_.maxGatherRays));
+    std::atomic<uint64_t> rays{0};
+    tbb::parallel_for(size_t(0), grid_.pointCount(), [&](size_t i) {
+      if (cancelRequested(cancel)) return;
+      std::vector<Color> sums(size_t(grid_.directions()));
+      int back = 0;
+      uint64_t r = 0;
+      directionalPointGather(sc, tracer_, grid_.view(), i, settings_.params.chain, g, c, settings_.seed, first, samples,
+                             length, sums.data(), &back, &r);
+      grid_.accumulate(i, sums.data(), samples, back);
+      rays += r;
+    });
+    throwIfCancelled(cancel);
+    grid_.finish();
+    stats_.points = grid_.pointCount();
+    stats_.rays += rays.load();
+    stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  const Scene& scene_;
+  Tracer tracer_;
+  GridExecutorSettings settings_;
+  int passes_ = 0;
+  DirectionalGrid grid_;
+  PhotonMap global_, caustic_;
+  PhotonShootStats photonStats_;
+  GridBuildStats stats_;
+  std::unique_ptr<CpuExecutor<GridSample<Tracer, DirectionalGridView>>> camera_;
+};
+
+}  // namespace envgi
