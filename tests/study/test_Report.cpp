@@ -33,3 +33,26 @@ TEST(StudyReport, Base64AndSvg) {
   EXPECT_EQ(lines, 2u);
   EXPECT_NE(svg.find(">a<"), std::string::npos);
 }
+
+// With two or more points-N strategies the report plots RMSE against N for each budget and
+// says, per budget, which collapsed map is best and what it beats and loses to.
+TEST(StudyReport, TheCollapsedMapSectionStatesTheCrossover) {
+  std::vector<StudyRun> runs = {
+      {"importance", 1, 0.0, 0, 0.01, 0.13}, {"product", 1, 0.0, 0, 0.01, 0.06},
+      {"points-16", 1, 0.0, 0, 0.01, 0.04},  {"points-256", 1, 0.0, 0, 0.05, 0.03},
+      {"importance", 100, 0.5, 0, 0.5, 0.0075}, {"product", 90, 0.5, 0, 0.5, 0.0036},
+      {"points-16", 50, 0.5, 0, 0.5, 0.019},    {"points-256", 11, 0.5, 0, 0.5, 0.0053}};
+  Image ref(4, 4);
+  std::string html = studyReportHtml("s.xml", runs, ref, {}, {"importance", "product", "points-16", "points-256"});
+  EXPECT_NE(html.find("RMSE against the collapsed map's N"), std::string::npos);
+  EXPECT_NE(html.find("<li>1 spp: the best collapsed map is points-256 (RMSE 0.03000); it beats importance (0.13000), "
+                      "product (0.06000).</li>"),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("<li>0.5 s: the best collapsed map is points-256 (RMSE 0.00530); it beats importance (0.00750); "
+                      "it loses to product (0.00360).</li>"),
+            std::string::npos);
+  // One collapsed map alone: no section.
+  std::string one = studyReportHtml("s.xml", runs, ref, {}, {"importance", "points-16"});
+  EXPECT_EQ(one.find("RMSE against the collapsed map's N"), std::string::npos);
+}
