@@ -571,7 +571,6 @@ bool ViewSession::renderLoop() {
           if (announce && sink_)
             sink_(ViewFrame{statusMessage("ready", fmt::format("{} ready in {:.2f} s", s.integrator, secs)), ""});
         }
-        pr.executor->watchCancel(&cutPass_);
         pixels = ActivePixels(scene_->camera.width, scene_->camera.height, s.noiseThreshold);
         pixels.attach(*pr.executor);
         std::lock_guard<std::mutex> lock(mutex_);
@@ -602,6 +601,9 @@ bool ViewSession::renderLoop() {
     }
     if (spp < limit(s.paused)) {
       try {
+        // A film's first pass is never cut: a stream of moves faster than a pass would
+        // otherwise cut every pass and show nothing until the moves stop.
+        pr.executor->watchCancel(spp == 0 ? nullptr : &cutPass_);
         pr.executor->runPass(spp, spp + 1, quiet, &counters);
       } catch (const RenderCancelled&) {
         continue;  // a pass that prepares as it goes (SPPM's photons) stopped for a change
@@ -618,8 +620,10 @@ bool ViewSession::renderLoop() {
     }
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      // A film from a camera or setting already replaced is not encoded: the next one is due.
-      send = pr.executor && frameWanted(*state_) && !state_->restart && !state_->rebuild;
+      // A film from a camera already replaced is not encoded (the next one is due), unless it
+      // is that film's first frame: while the camera keeps moving, each move's first pass shows.
+      const bool replaced = state_->restart || state_->rebuild;
+      send = pr.executor && frameWanted(*state_) && (!replaced || (sentSpp < 0 && spp > 0 && !state_->rebuild));
       if (send) {
         state_->frameRequested = false;
         state_->toneChanged = false;

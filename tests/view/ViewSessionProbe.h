@@ -58,7 +58,8 @@ inline std::unique_ptr<ViewSession> makeSession(const std::string& dir, Sink& si
   return s;
 }
 
-// Asks for frames until one satisfies pred; null after `tries` frames without one.
+// Asks for frames until one satisfies pred; null after `tries` frames without one. Other
+// messages the session hands out (status, error, hello) are passed over: pred sees frames only.
 template <class Pred>
 nlohmann::json frameWhere(ViewSession& session, Sink& sink, Pred pred, int tries = 400) {
   for (int i = 0; i < tries; ++i) {
@@ -70,7 +71,7 @@ nlohmann::json frameWhere(ViewSession& session, Sink& sink, Pred pred, int tries
     session.requestFrame();
     nlohmann::json f = sink.waitFor(n);
     if (f.is_null()) return f;
-    if (pred(f)) return f;
+    if (f.value("type", "") == "frame" && pred(f)) return f;
   }
   ADD_FAILURE() << "no such frame in " << tries;
   return nlohmann::json{};

@@ -63,7 +63,9 @@ TEST(ViewBrowser, OrbitExposureSaveInHeadlessChromium) {
             " e.dispatchEvent(new Event('input')); })()");
   EXPECT_TRUE(page.waitFor("envgiTest.lastMeta.exposure === 2", 30));
 
-  // Save: a readable EXR beside the scene, named in the page.
+  // Save: a readable EXR beside the scene, named in the page (of the full film, once the
+  // move's coarse first frame has given way to it).
+  ASSERT_TRUE(page.waitFor("envgiTest.lastMeta.width === 96", 30)) << view.log();
   page.eval("document.getElementById('save').click()");
   ASSERT_TRUE(page.waitFor("envgiTest.saved !== null", 30)) << view.log();
   std::string saved = page.eval("envgiTest.saved");
