@@ -81,9 +81,7 @@ float number(const json& j, const char* key, float lo, float hi) {
   if (!(v >= lo && v <= hi)) throw std::runtime_error(fmt::format("'{}' must be in [{}, {}]", key, lo, hi));
   return v;
 }
-}  // namespace
 
-namespace {
 // FNV-1a over the file's bytes, in hex: which scene a saved image came from.
 std::string fileHash(const std::string& path) {
   std::ifstream f(path, std::ios::binary);
@@ -92,9 +90,7 @@ std::string fileHash(const std::string& path) {
   while (f.get(c)) h = (h ^ uint8_t(c)) * 1099511628211ull;
   return fmt::format("{:016x}", h);
 }
-}  // namespace
 
-namespace {
 std::filesystem::file_time_type modifiedTime(const std::string& path) {
   std::error_code ec;
   auto t = std::filesystem::last_write_time(path, ec);
@@ -125,11 +121,12 @@ void ViewSession::adopt(std::unique_ptr<Scene> scene) {
   Vec3f centre = (sc.boundsMin + sc.boundsMax) * 0.5f;
   float dist = std::max(dot(centre - origin, fwd), 1e-2f * length(sc.boundsMax - sc.boundsMin) + 1e-3f);
   Vec3f target = origin + fwd * dist, up = normalize(t.vector(Vec3f(0.f, 1.f, 0.f)));
+  std::string hash = fileHash(scenePath_);  // read before the lock: the page's messages wait on it
   std::lock_guard<std::mutex> lock(mutex_);
   const bool fileCameraChanged = !scene_ || std::memcmp(&scene_->camera.toWorld.mat, &t.mat, sizeof t.mat) != 0;
   scene_ = std::move(scene);
   accel_ = std::move(accel);
-  sceneHash_ = fileHash(scenePath_);
+  sceneHash_ = std::move(hash);
   cameraShape_ = scene_->camera.orthographic ? lookAt(origin, target, up).inverse() * t : Transform{};
   if (fileCameraChanged) {
     state_->origin = origin;
