@@ -40,7 +40,7 @@ ENVGI_HD Color gridTrace(const SceneView& sc, const Tracer& tracer, const Ray& r
 // sees of emitters and the map is counted only after a non-delta bounce: seen directly it is
 // direct light (the pixel adds it), and seen through mirrors and glass alone it is a caustic,
 // which the caustic map gives per pixel. *backFace: the first surface was met from behind (the
-// point is inside something).
+// point may be inside something), one-sided or not.
 template <class Tracer, class HitRadiance>
 ENVGI_HD Color gridGather(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& smp, const ChainParams& cp,
                           const HitRadiance& hitRadiance, bool* backFace, uint64_t* rays) {
@@ -57,9 +57,11 @@ ENVGI_HD Color gridGather(const SceneView& sc, const Tracer& tracer, Ray ray, Sa
     SurfaceInteraction si = sc.interaction(ray, h);
     BsdfScratch textured;
     const Bsdf& bsdf = sc.bsdfAt(si, &textured);
-    if (depth == 0 && dot(si.ng, ray.d) > 0.f && !bsdf.twoSided && !bsdfTransmits(bsdf)) {
+    // The geometric side, whatever the material: a two-sided closed surface (the Buddha's) still
+    // has an inside, and its back is what a point in there sees. Only a one-sided back is black.
+    if (depth == 0 && dot(si.ng, ray.d) > 0.f && !bsdfTransmits(bsdf)) {
       *backFace = true;
-      return Color(0.f);
+      if (!bsdf.twoSided) return Color(0.f);
     }
     if (throughGlossy) L += beta * sc.emitted(si, -ray.d);
     if (isDiffuseLike(bsdf, cp.glossyThreshold)) return L + beta * hitRadiance(si, ray.d, smp, rays);
