@@ -28,6 +28,11 @@ envgi::ViewSession& session() {
 </scene>)";
     auto scene = std::make_unique<envgi::Scene>();
     envgi::loadScene(xml, {}, *scene);
+    // Every integrator a message may pick gets maps this size: the defaults (250,000 photons
+    // each) took 13 s under the sanitizers, 30 s on a loaded machine, for no more coverage.
+    scene->integrator.photon.globalPhotons = 2000;
+    scene->integrator.photon.causticPhotons = 2000;
+    scene->integrator.sppm.photonCount = 2000;
     scene->integrator.grid.globalPhotons = 2000;
     scene->integrator.grid.causticPhotons = 0;
     scene->integrator.grid.resolution = 4;
