@@ -50,24 +50,49 @@ void expectQuadrantsNear(const Image& ref, const Image& img, double tolerance) {
   EXPECT_GT(total, 0.0);
 }
 
-// The grid these tests compare with the path tracer: 16 cells across, 64 gather rays a point.
+// The indirect part of each quadrant's luminance mean, img's and the reference's, over the
+// same direct light (a 1024-spp direct render): within `tolerance` of the reference's indirect
+// light, which a grid that gathered nothing misses by all of it.
+void expectIndirectQuadrantsNear(Scene& scene, const Image& ref, const Image& img, double tolerance) {
+  const IntegratorSettings kept = scene.integrator;
+  Image direct = run(scene, IntegratorType::Direct, 1024);
+  scene.integrator = kept;
+  for (int ry = 0; ry < 16; ry += 8)
+    for (int rx = 0; rx < 16; rx += 8) {
+      double a = 0, b = 0, d = 0;
+      for (int y = ry; y < ry + 8; ++y)
+        for (int x = rx; x < rx + 8; ++x) {
+          a += luminance(ref.at(x, y)) / 64;
+          b += luminance(img.at(x, y)) / 64;
+          d += luminance(direct.at(x, y)) / 64;
+        }
+      std::printf("quadrant %d,%d: direct %.4f, indirect path %.4f grid %.4f (%+.1f%%)\n", rx, ry, d, a - d, b - d,
+                  100.0 * ((b - d) / (a - d) - 1.0));
+      EXPECT_NEAR(b - d, a - d, tolerance * (a - d)) << "quadrant " << rx << "," << ry;
+    }
+}
+
+// The grid these tests compare with the path tracer: 16 cells across, 64 gather rays a point,
+// 256 spp (at 64 the direct light's noise moved a quadrant's indirect part by up to 10%).
 Image runSmallGrid(Scene& scene) {
   scene.integrator.grid.resolution = 16;
   scene.integrator.grid.gatherRays = 64;
   scene.integrator.grid.globalPhotons = 50000;
   scene.integrator.grid.causticPhotons = 1000;
-  return run(scene, IntegratorType::Grid, 64);
+  return run(scene, IntegratorType::Grid, 256);
 }
 }  // namespace
 
 // A white ball on a coloured floor under a sky with a bright band: direct light is exact
 // (light sampling), the floor's light on the ball and the ball's on the floor come from the
-// grid. Quadrant means within 5% of a 1024-spp path tracer.
+// grid. Quadrant means within 5% of a 1024-spp path tracer, and their indirect parts within 25%
+// (the SH grid reads 10-19% low: L1's smoothing).
 TEST(GridIntegrator, MatchesPathOnASphereOnAFloor) {
   auto scene = sphereOnFloorScene();
   Image ref = run(*scene, IntegratorType::Path, 1024);
   Image grid = runSmallGrid(*scene);
   expectQuadrantsNear(ref, grid, 0.05);
+  expectIndirectQuadrantsNear(*scene, ref, grid, 0.25);
 }
 
 // Progressive refinement (the paper's grid "refined as the time budget allows"): refine_rays
@@ -259,8 +284,8 @@ TEST(GridIntegrator, BothBasesKeepLightReflectedByGlossySurfaces) {
   EXPECT_NEAR(mDir, mRef, 0.05 * mRef);
 }
 
-// The paper's basis on the diffuse sphere on a floor: quadrant means within 5% of path, as the
-// SH grid's are.
+// The paper's basis on the diffuse sphere on a floor: quadrant means within 5% of path, and their
+// indirect parts within 25% (within 10% today), as the SH grid's are.
 TEST(GridIntegrator, TheDirectionsBasisMatchesPathOnASphereOnAFloor) {
   auto scene = sphereOnFloorScene();
   Image ref = run(*scene, IntegratorType::Path, 1024);
@@ -268,4 +293,5 @@ TEST(GridIntegrator, TheDirectionsBasisMatchesPathOnASphereOnAFloor) {
   scene->integrator.grid.directions = 64;
   Image grid = runSmallGrid(*scene);
   expectQuadrantsNear(ref, grid, 0.05);
+  expectIndirectQuadrantsNear(*scene, ref, grid, 0.25);
 }
