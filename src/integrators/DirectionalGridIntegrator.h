@@ -1,5 +1,5 @@
 // The paper's grid read and filled (Section 3, steps 1-3 and 5), host and device: a grid point
-// gathers the indirect radiance arriving along each of the grid's M directions (gridGather, as
+// gathers the indirect radiance arriving along each of the grid's M directions (gatherRay, as
 // the SH grid's rays do: what a direction meets is that surface's radiance, direct light there
 // plus the photon maps), and a camera path follows mirrors and glass to the first rough surface,
 // which gets direct light with shadows (the chain's next-event estimation, the collapsed map
@@ -34,7 +34,7 @@ ENVGI_HD void directionalPointGather(const SceneView& sc, const Tracer& tracer, 
     for (int s = first; s < first + samples; ++s) {
       smp.start(uint64_t(i) * uint64_t(g.m) + uint64_t(k), uint32_t(s));
       bool isBack = false;
-      Color L = gridGather(sc, tracer, Ray{p, g.dirs[k], INFINITY}, smp, cp, hitRadiance, &isBack, rayCount);
+      Color L = gatherRay(sc, tracer, Ray{p, g.dirs[k], INFINITY}, smp, cp, hitRadiance, &isBack, rayCount);
       *back += isBack;
       if (isFiniteVec(L)) sums[k] += L * g.share[k];
     }

@@ -1,7 +1,7 @@
 // The paper's interactive method as an integrator (`grid`): camera paths follow mirrors and
 // glass to the first diffuse-like surface, which gets direct light from the map (Algorithm 1,
 // shadow rays, MIS) and indirect light from the illumination grid, trilinearly interpolated,
-// times its albedo / pi. The grid's points are filled by gridGather: rays from each point
+// times its albedo / pi. The grid's points are filled by gatherRay: rays from each point
 // that read the photon maps' precomputed irradiance one bounce away. Host and device.
 #pragma once
 
@@ -34,51 +34,7 @@ ENVGI_HD Color gridTrace(const SceneView& sc, const Tracer& tracer, const Ray& r
   return traceSpecularChain(sc, tracer, ray, smp, gp.chain, estimate, rays);
 }
 
-// Indirect radiance arriving at a grid point from direction ray.d: light that has left a
-// diffuse-like surface at least once, hitRadiance(si, wi, smp, rays) (direct light there plus
-// photon irradiance), followed through mirrors, glass and sharp glossy lobes. What the ray
-// sees of emitters and the map is counted only after a non-delta bounce: seen directly it is
-// direct light (the pixel adds it), and seen through mirrors and glass alone it is a caustic,
-// which the caustic map gives per pixel. *backFace: the first surface was met from behind (the
-// point may be inside something), one-sided or not.
-template <class Tracer, class HitRadiance>
-ENVGI_HD Color gridGather(const SceneView& sc, const Tracer& tracer, Ray ray, Sampler& smp, const ChainParams& cp,
-                          const HitRadiance& hitRadiance, bool* backFace, uint64_t* rays) {
-  Color beta(1.f), L(0.f);
-  bool throughGlossy = false;  // a non-delta bounce so far: emitters and the map now count
-  *backFace = false;
-  for (int depth = 0; depth < cp.maxDepth; ++depth) {
-    Hit h;
-    ++*rays;
-    if (!tracer.intersect(ray, &h)) {
-      if (throughGlossy && sc.hasEnvironment) L += beta * sc.env.eval(ray.d);
-      return L;
-    }
-    SurfaceInteraction si = sc.interaction(ray, h);
-    BsdfScratch textured;
-    const Bsdf& bsdf = sc.bsdfAt(si, &textured);
-    // The geometric side, whatever the material: a two-sided closed surface (the Buddha's) still
-    // has an inside, and its back is what a point in there sees. Only a one-sided back is black.
-    if (depth == 0 && dot(si.ng, ray.d) > 0.f && !bsdfTransmits(bsdf)) {
-      *backFace = true;
-      if (!bsdf.twoSided) return Color(0.f);
-    }
-    if (throughGlossy) L += beta * sc.emitted(si, -ray.d);
-    if (isDiffuseLike(bsdf, cp.glossyThreshold)) return L + beta * hitRadiance(si, ray.d, smp, rays);
-    BsdfSample bs;
-    float uc = smp.get1D();
-    Vec2f ub = smp.get2D();
-    if (!bsdfSample(bsdf, si.shading.toLocal(-ray.d), uc, ub, &bs)) return L;
-    beta *= bs.weight;
-    if (isBlack(beta)) return L;
-    throughGlossy = throughGlossy || !bs.delta;
-    Vec3f wi = si.shading.toWorld(bs.wi);
-    ray = Ray{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};
-  }
-  return L;
-}
-
-// Rays [first, first + rays) of grid point i at p: radiance gathered by gridGather, projected
+// Rays [first, first + rays) of grid point i at p: radiance gathered by gatherRay, projected
 // on L1 SH (*sum, Monte Carlo over the sphere); *back counts rays whose first hit was a back
 // face. Each point has its own Sobol sequence of `length` rays (the most it will ever get), so
 // rays cover the sphere evenly and later calls refine the same estimate.
@@ -99,7 +55,7 @@ ENVGI_HD void gridPointGather(const SceneView& sc, const Tracer& tracer, Vec3f p
     smp.start(i, uint32_t(k));
     Vec3f d = sampleUniformSphere(smp.get2D());
     bool isBack = false;
-    Color L = gridGather(sc, tracer, Ray{p, d, INFINITY}, smp, cp, hitRadiance, &isBack, rayCount);
+    Color L = gatherRay(sc, tracer, Ray{p, d, INFINITY}, smp, cp, hitRadiance, &isBack, rayCount);
     *back += isBack;
     if (!isFiniteVec(L)) continue;
     float y[4];

@@ -23,12 +23,16 @@ Color photonTrace(const SceneView& sc, const Tracer& tracer, const Ray& ray, Sam
   auto estimate = [&](const SurfaceInteraction& si, Vec3f wo, Sampler& s, uint64_t* r) {
     Color L = caustic.estimate(sc, si, wo, pp.caustic);
     if (pp.gatherSamples <= 0) return L + global.estimate(sc, si, wo, pp.global);
-    // Final gather: indirect light from the global map one bounce away. Where a gather ray
-    // meets a specular surface its light is left out (caustic paths are in the caustic map;
-    // light bouncing diffusely and then through glass onto here is lost).
+    // Final gather: indirect light from the global map one bounce away, followed through
+    // mirrors and glass (light -> diffuse -> mirror -> here is in no map: the caustic map holds
+    // only light that met nothing diffuse).
     BsdfScratch textured;
     const Bsdf& bsdf = sc.bsdfAt(si, &textured);
     Vec3f woLocal = si.shading.toLocal(wo);
+    auto hitRadiance = [&](const SurfaceInteraction& gs, Vec3f wi, Sampler& gsmp, uint64_t* gr) {
+      return gatherHitRadiance(sc, tracer, gs, wi, gsmp, pp.chain.strategy, global.irradianceCache().view(),
+                               caustic.irradianceCache().view(), gr);
+    };
     Color gather(0.f);
     for (int g = 0; g < pp.gatherSamples; ++g) {
       BsdfSample bs;
@@ -36,14 +40,9 @@ Color photonTrace(const SceneView& sc, const Tracer& tracer, const Ray& ray, Sam
       Vec2f ub = s.get2D();
       if (!bsdfSample(bsdf, woLocal, uc, ub, &bs) || bs.delta) continue;
       Vec3f wi = si.shading.toWorld(bs.wi);
-      Ray gr{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};
-      Hit gh;
-      ++*r;
-      if (!tracer.intersect(gr, &gh)) continue;  // the environment is direct light, counted already
-      SurfaceInteraction gs = sc.interaction(gr, gh);
-      if (bsdfIsDelta(sc.bsdfs[gs.bsdf])) continue;
-      gather += bs.weight * gatherHitRadiance(sc, tracer, gs, wi, s, pp.chain.strategy, global.irradianceCache().view(),
-                                                caustic.irradianceCache().view(), r);
+      bool back = false;
+      gather += bs.weight * gatherRay(sc, tracer, Ray{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY}, s,
+                                      pp.chain, hitRadiance, &back, r);
     }
     return L + gather / float(pp.gatherSamples);
   };
