@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "accel/EmbreeAccel.h"
 #include "render/Renderer.h"
@@ -123,6 +124,17 @@ inline double meanOverObject(const Scene& scene, const EmbreeAccel& accel, const
     }
   *count = n;
   return n > 0 ? sum / n : 0.0;
+}
+
+// Luminance means over the image's quadrants (row-major: top left, top right, bottom left,
+// bottom right), for images of even size.
+inline std::vector<double> quadrantMeans(const Image& img) {
+  std::vector<double> m(4, 0.0);
+  const int hw = img.width / 2, hh = img.height / 2;
+  for (int y = 0; y < 2 * hh; ++y)
+    for (int x = 0; x < 2 * hw; ++x) m[size_t(2 * (y / hh) + x / hw)] += luminance(img.at(x, y));
+  for (double& v : m) v /= double(hw) * hh;
+  return m;
 }
 
 }  // namespace envgi::test
