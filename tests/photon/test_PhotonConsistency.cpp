@@ -196,3 +196,74 @@ TEST(PhotonConsistency, GatherRaysFollowMirrorsToDiffuseSurfaces) {
     expectQuadrantsNear(run(*scene, "grid", 64), basis, g.basis == "sh" ? 0.1 : 0.03);
   }
 }
+
+namespace {
+// A white floor meeting a white wall (both one-sided, facing into the corner) under a constant
+// sky, seen from in front of the corner.
+std::unique_ptr<Scene> corner() {
+  Bsdf white;
+  white.reflectance = Color(0.8f);
+  Image sky(16, 8);
+  for (float& v : sky.rgb) v = 1.f;
+  auto s = test::sphereOnFloor(white, white, 3.f, std::move(sky), Vec3f(0, 1.2f, 3.f), Vec3f(0, 0.3f, 0), 64, 40.f);
+  s->spheres.clear();
+  s->shapes.clear();
+  s->meshes[0].transform(translate(Vec3f(0.f, 0.f, 3.f)));  // the floor ends at the wall
+  s->shapes.push_back({false, 0, 0, false, Color(0.f)});
+  TriangleMesh wall = makeRectangle();  // facing +z, at z = 0
+  wall.transform(scale(Vec3f(3.f)));
+  wall.transform(translate(Vec3f(0.f, 3.f, 0.f)));
+  s->meshes.push_back(wall);
+  s->shapes.push_back({false, 1, 0, false, Color(0.f)});
+  // A ball above the corner: light it reflects reaches the wall from above, on the floor's side.
+  s->spheres.push_back({Vec3f(0.f, 1.f, 0.9f), 0.5f, false});
+  s->shapes.push_back({true, 0, 0, false, Color(0.f)});
+  s->finalize();
+  return s;
+}
+}  // namespace
+
+// Eq. 12 in a corner, read from the global map directly (no final gather). The suspicion was
+// that photons on the wall, lit from the floor's side (here by the ball), are counted on the
+// floor and over-estimate there, since the estimate checks the side a photon came from and not
+// the surface it lies on. Measured: within 0.05 of the edge the corner reads low, -10.0%: the
+// search disc (k = 120 photons, radius about 0.07) reaches past the edge. Those wall photons
+// (8,374 of the 7 M looked at) offset a little of that: dropping them by orientation
+// (|n_photon . n| <= 0.9) took the band to -12.4%. So the estimate keeps them. Farther out
+// every band is within 2% of path.
+TEST(PhotonConsistency, ACornerReadsLowNotHigh) {
+  auto scene = corner();
+  Image ref = run(*scene, "path", 256);
+  scene->integrator.photon.globalPhotons = 400000;
+  scene->integrator.photon.causticPhotons = 0;
+  scene->integrator.photon.gatherSamples = 0;
+  Image ph = run(*scene, "photon", 16);
+  EmbreeAccel accel(*scene);
+  const Camera& c = scene->view().camera;
+  double bands[4][2] = {};
+  int counts[4] = {};
+  for (int y = 0; y < c.height; ++y)
+    for (int x = 0; x < c.width; ++x) {
+      Hit h;
+      Ray r = c.generateRay(x + 0.5f, y + 0.5f);
+      if (!accel.intersect(r, &h)) continue;
+      Vec3f p = r.o + r.d * h.t;
+      float d = std::max(p.y, p.z);  // distance to the corner line (the other is 0)
+      int band = d < 0.05f ? 0 : d < 0.1f ? 1 : d < 0.2f ? 2 : 3;
+      bands[band][0] += luminance(ref.at(x, y));
+      bands[band][1] += luminance(ph.at(x, y));
+      counts[band]++;
+    }
+  for (int b = 0; b < 4; ++b) {
+    ASSERT_GT(counts[b], 50) << "band " << b;
+    const double path = bands[b][0] / counts[b], photon = bands[b][1] / counts[b];
+    std::printf("band %d (%d px): path %.4f photon %.4f (%+.1f%%)\n", b, counts[b], path, photon,
+                100.0 * (photon / path - 1.0));
+    if (b == 0) {
+      EXPECT_LT(photon, path) << "the corner reads high";
+      EXPECT_GT(photon, 0.8 * path);
+    } else {
+      EXPECT_NEAR(photon, path, 0.02 * path) << "band " << b;
+    }
+  }
+}
