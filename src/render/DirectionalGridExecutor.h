@@ -14,17 +14,9 @@
 #include "integrators/DirectionalGridIntegrator.h"
 #include "render/Cancellation.h"
 #include "render/CpuExecutor.h"
-#include "render/IlluminationGridBuilder.h"
+#include "render/DirectionalGridBuilder.h"
 
 namespace envgi {
-
-// The M directions and their shares: the collapsed map's (Algorithm 1's draws, each 1 / (p M) of
-// the sphere) where the scene has a map, else M directions spread evenly (a spiral), 4 pi / M each.
-void gridDirections(const Scene& scene, int m, uint32_t seed, std::vector<Vec3f>* dirs, std::vector<float>* share);
-
-// A directional grid over the scene's bounds, as makeIlluminationGrid places the SH grid's points;
-// refused where it would not fit in half the machine's memory.
-DirectionalGrid makeDirectionalGrid(const Scene& scene, int resolution, int m, uint32_t seed);
 
 template <class Tracer>
 class DirectionalGridExecutor final : public PassExecutor {

@@ -45,6 +45,14 @@ struct GridBuild {
   GridBuildStats gridStats;
 };
 
+// The grid's box: the scene's bounds with half a cell of margin (so surfaces on the bounds still
+// have points on both sides), `resolution` points along the longest side. Both bases use it.
+struct GridBox {
+  Vec3f lo, hi;
+  int nx, ny, nz;
+};
+GridBox gridBox(const Scene& scene, int resolution);
+
 // A grid over the scene's bounds with `resolution` points along its longest side; refused
 // (requireGridFits) where it would not fit in half the machine's memory.
 IlluminationGrid makeIlluminationGrid(const Scene& scene, int resolution);

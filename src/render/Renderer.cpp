@@ -236,15 +236,8 @@ KernelSettings kernelSettings(const Scene& scene, const RenderOptions& opts) {
     spdlog::warn("direct integrator without emitter samples: the {} directional, point or spot light(s) add nothing "
                  "(only emitter samples reach them)",
                  scene.deltaLights.size());
-  // A compensated map density is zero where L is below its mean: only with BSDF samples beside
-  // it does every direction get covered (Karlik et al. 2019).
-  bool compensated = scene.env && scene.env->options().misCompensation;
-  bool mapDensity = k.direct.envStrategy == EnvStrategy::Alias || k.direct.envStrategy == EnvStrategy::Importance ||
-                    k.direct.envStrategy == EnvStrategy::Product || k.direct.envStrategy == EnvStrategy::Algorithm1;
-  if (k.type == SampleIntegratorType::Direct && compensated && mapDensity && k.direct.emitterSamples > 0 &&
-      k.direct.bsdfSamples == 0)
-    throw std::runtime_error("direct integrator: mis_compensation samples only the map's bright part; it needs "
-                             "bsdf_samples > 0 (or the strategy 'mis') to cover the rest");
+  // Settings changed since finalize() (a caller's, the viewer's) are held to the same rule.
+  scene.requireCompensationCovered();
   // A path's next-event estimation draws one light a bounce; the whole collapsed map at every
   // vertex is the paper's direct-light method, which direct, photon, sppm and grid take.
   if (k.type == SampleIntegratorType::Path && sn.env == EnvStrategy::PointsAll)

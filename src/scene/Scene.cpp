@@ -168,16 +168,21 @@ void Scene::requireCompensationCovered() const {
   const EnvStrategy s = findStrategy(integrator.env.strategy).env;
   // Uniform and cosine read none of the map's tables; the adaptive quadtree balances plain power.
   if (s == EnvStrategy::Uniform || s == EnvStrategy::Cosine || s == EnvStrategy::Adaptive) return;
+  const StrategyName& sn = findStrategy(integrator.env.strategy);
+  const int emitterSamples = integrator.direct.emitterSamples >= 0 ? integrator.direct.emitterSamples : sn.emitterSamples;
+  const int bsdfSamples = integrator.direct.bsdfSamples >= 0 ? integrator.direct.bsdfSamples : sn.bsdfSamples;
   std::string why;
   if (isCollapsedMap(s))
     why = "the collapsed map's lights are drawn from its density and no BSDF sample finds them";
   else if (integrator.type == IntegratorType::Photon || integrator.type == IntegratorType::Grid)
     why = std::string("the ") + integratorName(integrator.type) +
           " integrator's gathers take light samples of the map without BSDF samples";
+  else if (integrator.type == IntegratorType::Direct && emitterSamples > 0 && bsdfSamples == 0)
+    why = "the direct integrator takes light samples with bsdf_samples 0";
   if (!why.empty())
     throw std::runtime_error("mis_compensation: " + why +
                              ", so the map's dim directions would be lost; turn mis_compensation off, or use path or "
-                             "direct with BSDF samples");
+                             "direct with BSDF samples (bsdf_samples > 0, or the strategy 'mis')");
 }
 
 void Scene::finalize() {

@@ -209,6 +209,9 @@ TEST(GridIntegrator, CompensationIsRefusedWhereNoBsdfSampleCoversIt) {
   EXPECT_NE(errorOf(IntegratorType::Path, "points-draw").find("mis_compensation: the collapsed map's"),
             std::string::npos);
   EXPECT_EQ(errorOf(IntegratorType::Path, "importance"), "");
+  EXPECT_NE(errorOf(IntegratorType::Direct, "importance").find("mis_compensation: the direct integrator takes light "
+                                                               "samples with bsdf_samples 0"),
+            std::string::npos);
   EXPECT_EQ(errorOf(IntegratorType::Direct, "mis"), "");
   EXPECT_EQ(errorOf(IntegratorType::Photon, "uniform"), "") << "uniform reads none of the map's tables";
 }

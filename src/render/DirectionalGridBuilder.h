@@ -1,0 +1,21 @@
+// The paper's grid (basis = directions) before its fill: the M directions with their shares of
+// the sphere, and the grid over the scene's bounds that holds M coefficients a point.
+#pragma once
+
+#include <vector>
+
+#include "photon/DirectionalGrid.h"
+#include "render/IlluminationGridBuilder.h"
+
+namespace envgi {
+
+// The M directions and their shares of the sphere (ΔΦ_p): half drawn from the collapsed map
+// (Algorithm 1's density) where the scene has a map, the rest a spiral even over the sphere;
+// each share is 1 / (M p_mix), p_mix the two densities mixed by their counts (Eq. 5-6).
+void gridDirections(const Scene& scene, int m, uint32_t seed, std::vector<Vec3f>* dirs, std::vector<float>* share);
+
+// A directional grid over the scene's bounds, as makeIlluminationGrid places the SH grid's points;
+// refused where it would not fit in half the machine's memory.
+DirectionalGrid makeDirectionalGrid(const Scene& scene, int resolution, int m, uint32_t seed);
+
+}  // namespace envgi
