@@ -31,28 +31,36 @@ struct BsdfEvalAhead {
   bool made = false;
 };
 
-// Its sample dimensions are taken whatever happens, so sequences stay aligned across pixels.
-// `partner` is a blend's other material (sc.partnerAt(si)), evaluated beside bsdf at
-// si.partnerWeight (materials/BsdfMix.h). The kind of light is picked by uL.x (sampleLight), so
-// the dimension a choice of its own once took is skipped, as is the area light's second pair
-// where the map is the only light (the image stays the same there). uLDrawn: the light's 2D
-// draw where the caller took it ahead from a copy of smp (lightDrawOf), stepped over here;
-// productDrawn: the map's product draw for it, made ahead (sampleLight's); evalAhead: the BSDF
-// (without a partner) evaluated ahead for the direction that draw gives.
+// A light sample's draws, in the order the sampler lays them out: the dimension a choice of the
+// light's kind once took (skipped: sampleLight picks the kind by uL.x, and later draws keep
+// their dimensions), the light's pair, and the area light's second pair (skipped where the map
+// is the only light). uLAhead: the light's pair drawn elsewhere for that dimension (an
+// executor's lanes, at bounceLayout's offset), stepped over here.
+struct LightDraws {
+  Vec2f uL, uL2;
+};
+ENVGI_HD inline LightDraws drawLight(const SceneView& sc, Sampler& smp, const Vec2f* uLAhead = nullptr) {
+  LightDraws u;
+  smp.skip1D();
+  if (uLAhead) u.uL = *uLAhead, smp.skip2D();
+  else u.uL = smp.get2D();
+  u.uL2 = smp.get2DIf(!(sc.envSelectProb() == 1.f));  // sampleLight takes the map for any uL then
+  return u;
+}
+
+// One light sample from the draws u. `partner` is a blend's other material (sc.partnerAt(si)),
+// evaluated beside bsdf at si.partnerWeight (materials/BsdfMix.h). productDrawn: the map's
+// product draw for u.uL, made ahead (sampleLight's); evalAhead: the BSDF (without a partner)
+// evaluated ahead for the direction that draw gives.
 ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
                                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
-                                        MisHeuristic heuristic, Sampler& smp, const Bsdf* partner = nullptr,
-                                        const Vec2f* uLDrawn = nullptr, const ProductDraw* productDrawn = nullptr,
+                                        MisHeuristic heuristic, const LightDraws& u, const Bsdf* partner = nullptr,
+                                        const ProductDraw* productDrawn = nullptr,
                                         const BsdfEvalAhead* evalAhead = nullptr) {
   LightSampleLd out;
-  const bool mapOnly = sc.envSelectProb() == 1.f;  // sampleLight then takes the map for any uL
-  smp.skip1D();
-  Vec2f uL;
-  if (uLDrawn) uL = *uLDrawn, smp.skip2D();
-  else uL = smp.get2D();
-  Vec2f uL2 = smp.get2DIf(!mapOnly);
   LightSample ls;
-  if (bsdfMixIsDelta(bsdf, partner) || !sampleLight(sc, si, axis, strategy, uL, uL2, &ls, productDrawn)) return out;
+  if (bsdfMixIsDelta(bsdf, partner) || !sampleLight(sc, si, axis, strategy, u.uL, u.uL2, &ls, productDrawn))
+    return out;
   Vec3f wiLocal = si.shading.toLocal(ls.dir);
   float bsdfPdfOfLight;
   Color f;
@@ -82,29 +90,6 @@ ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceIntera
   return out;
 }
 
-// A 2D draw made ahead (the CPU's RoundLanes::drawAhead, a round's draws in vector lanes) for
-// the dimension pair that starts at dim; taken where the sampler stands there, drawn afresh
-// anywhere else, so an executor that guesses the dimension wrong loses time, never the image.
-struct Draw2DAhead {
-  Vec2f u;
-  uint32_t dim = ~0u;
-};
-ENVGI_HD inline Vec2f get2DOrAhead(Sampler& smp, const Draw2DAhead* ahead) {
-  if (ahead && ahead->dim == smp.dim) {
-    smp.skip2D();
-    return ahead->u;
-  }
-  return smp.get2D();
-}
-
-// The light's 2D draw prepareLd will take from smp as it stands, taken from a copy (or the
-// draw made ahead for that dimension, if it is one: get2DOrAhead).
-ENVGI_HD inline Vec2f lightDrawOf(const Sampler& smp, const Draw2DAhead* ahead = nullptr) {
-  Sampler peek = smp;
-  peek.skip1D();
-  return get2DOrAhead(peek, ahead);
-}
-
 // The sample's contribution once its shadow ray's answer is known.
 ENVGI_HD inline Color resolvedLd(const LightSampleLd& ld, bool occluded) {
   return ld.needsRay && !occluded ? ld.value : Color(0.f);
@@ -115,24 +100,34 @@ ENVGI_HD inline Color resolvedLd(const LightSampleLd& ld, bool occluded) {
 struct BsdfSampleAhead {
   BsdfSample s;
   bool ok = false;    // bsdfSample's return
-  bool made = false;  // s and ok hold bsdfSample's answer for the draw ahead (Draw2DAhead)
+  bool made = false;  // s and ok hold bsdfSample's answer for the bounce's BSDF draws
 };
 
-// A bounce's BSDF draw as path and direct take it: uc only where bsdfSample reads it beside ub
-// (skipped, not drawn, elsewhere, so later draws keep their dimensions), and the lobe from ub
-// where the BSDF can take it from there (bsdfLobeFromU).
-// ubAhead: the pair's draw made ahead, if any (get2DOrAhead); sampled: bsdfSample's answer for
-// it, if that was worked out ahead, taken where the draw is (it is uc-free: sampleRoughPlastic's).
-ENVGI_HD inline bool drawBsdfSample(const Bsdf& bsdf, Vec3f woLocal, Sampler& smp, BsdfSample* bs,
-                                    const Draw2DAhead* ubAhead = nullptr, const BsdfSampleAhead* sampled = nullptr) {
-  float uc = smp.get1DIf(bsdfReadsUcBesideU(bsdf));
-  if (sampled && sampled->made && ubAhead && ubAhead->dim == smp.dim) {
-    smp.skip2D();
+// A bounce's BSDF draws as path and direct take them: uc only where bsdfSample reads it beside
+// ub (skipped, not drawn, elsewhere, so later draws keep their dimensions), then the pair.
+// ubAhead: the pair drawn elsewhere for that dimension (an executor's lanes), stepped over here.
+struct BsdfDraws {
+  float uc = 0.f;
+  Vec2f ub;
+};
+ENVGI_HD inline BsdfDraws drawBsdf(const Bsdf& bsdf, Sampler& smp, const Vec2f* ubAhead = nullptr) {
+  BsdfDraws u;
+  u.uc = smp.get1DIf(bsdfReadsUcBesideU(bsdf));
+  if (ubAhead) u.ub = *ubAhead, smp.skip2D();
+  else u.ub = smp.get2D();
+  return u;
+}
+
+// The BSDF sampled from the draws u, the lobe from ub where the BSDF can take it from there
+// (bsdfLobeFromU). sampled: bsdfSample's answer for these draws, where it was worked out
+// ahead (uc-free: sampleRoughPlastic's).
+ENVGI_HD inline bool drawBsdfSample(const Bsdf& bsdf, Vec3f woLocal, const BsdfDraws& u, BsdfSample* bs,
+                                    const BsdfSampleAhead* sampled = nullptr) {
+  if (sampled && sampled->made) {
     *bs = sampled->s;
     return sampled->ok;
   }
-  Vec2f ub = get2DOrAhead(smp, ubAhead);
-  return bsdfSample(bsdf, woLocal, uc, ub, bs, true);
+  return bsdfSample(bsdf, woLocal, u.uc, u.ub, bs, true);
 }
 
 // Traces the sample's shadow ray, if it has one (counted in *rayCount): whether it is blocked.
@@ -149,7 +144,7 @@ template <class Tracer>
 ENVGI_HD Color sampleLd(const SceneView& sc, const Tracer& tracer, const SurfaceInteraction& si, const Bsdf& bsdf,
                         Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB, MisHeuristic heuristic,
                         Sampler& smp, uint64_t* rayCount, const Bsdf* partner = nullptr) {
-  LightSampleLd ld = prepareLd(sc, si, bsdf, woLocal, axis, strategy, nE, nB, heuristic, smp, partner);
+  LightSampleLd ld = prepareLd(sc, si, bsdf, woLocal, axis, strategy, nE, nB, heuristic, drawLight(sc, smp), partner);
   return resolvedLd(ld, shadowRayBlocked(tracer, ld, rayCount));
 }
 

@@ -38,15 +38,29 @@ ENVGI_HD inline PathState pathBegin(const Ray& ray) {
   return {ray, Color(0.f), Color(1.f), 1.f, 0.f, true, ray.o, Vec3f(0.f, 0.f, 1.f), 1};
 }
 
+// Where a bounce's draws lie, in dimensions past the sampler's position as pathShade begins
+// (drawBounce's order): with a light sample, the light's pair at 1 (after the light kind's old
+// dimension) and the area light's second pair, then the BSDF's 1D draw and its pair; without,
+// the BSDF's first. Roulette's draw follows. An executor that draws a round's pairs in lanes
+// (RoundLanes) reads the offsets here, the one place they are written.
+struct BounceLayout {
+  uint32_t light, bsdf;  // the light's pair, the BSDF's pair
+};
+ENVGI_HD inline BounceLayout bounceLayout(const PathParams& pp) {
+  return pp.lightSample ? BounceLayout{1u, 6u} : BounceLayout{1u, 1u};
+}
+
 // What an executor works out for a hit before shading it (CPU: renderTileByBounce, which walks
-// a round's map draws level by level first): the interaction, and the light's 2D draw where
-// the path goes on to next-event estimation. pathShade then takes them instead of redoing them.
+// a round's map draws level by level first): the interaction, the light's and the BSDF's 2D
+// draws where it drew them in lanes (at bounceLayout's offsets), and work done with them.
+// pathShade then takes them instead of redoing them.
 struct ShadeAhead {
   SurfaceInteraction si;
+  bool lightDrawn = false;  // uL holds the light's pair (the path goes on to next-event estimation)
   Vec2f uL;
-  bool drawn = false;  // uL holds prepareLd's draw
-  Draw2DAhead ub;      // the BSDF's pair, where it was drawn ahead (pathBsdfDrawOffset)
-  BsdfSampleAhead bs;  // and the BSDF's sample for it, where that was worked out ahead
+  bool bsdfDrawn = false;  // ub holds the BSDF's pair
+  Vec2f ub;
+  BsdfSampleAhead bs;  // the BSDF's sample for ub, where that was worked out ahead
   BsdfEvalAhead ev;    // the BSDF at the product draw's direction, where that was worked out ahead
   // The map's product draw for uL, where the executor walked it to its end (aheadDraw).
   bool productAhead = false;
@@ -56,6 +70,24 @@ struct ShadeAhead {
   bool escaped = false;
   Vec2f uv;
 };
+
+// A bounce's random numbers: the light sample's, the BSDF sample's and roulette's.
+struct BounceDraws {
+  LightDraws light;
+  BsdfDraws bsdf;
+  float rr = 0.f;
+};
+// The one place a bounce's draws are taken from the sampler, in bounceLayout's order; each is
+// taken only where the bounce uses it (roulette's from rrDepth on). ahead: pairs drawn in lanes.
+ENVGI_HD inline BounceDraws drawBounce(const SceneView& sc, const Bsdf& bsdf, const PathParams& pp, int depth,
+                                       Sampler& smp, const ShadeAhead* ahead) {
+  BounceDraws u;
+  if (pp.lightSample) u.light = drawLight(sc, smp, ahead && ahead->lightDrawn ? &ahead->uL : nullptr);
+  if (!pp.bsdfSample) return u;
+  u.bsdf = drawBsdf(bsdf, smp, ahead && ahead->bsdfDrawn ? &ahead->ub : nullptr);
+  if (depth >= pp.rrDepth) u.rr = smp.get1D();
+  return u;
+}
 
 // Next-event estimation's shadow ray traced at once, its contribution added to the path
 // (pathStep's way; an executor that traces many paths' shadow rays together keeps ld and the
@@ -141,17 +173,18 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   Vec3f woLocal = si.shading.toLocal(wo);
   Vec3f axis = envSamplingAxis(si, wo, bsdf);
 
+  const BounceDraws u = drawBounce(sc, bsdf, pp, depth, smp, ahead);
+
   // Next-event estimation, weighted against this bounce's BSDF sample.
   if (pp.lightSample)
-    shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, pp.bsdfSample ? 1.f : 0.f, MisHeuristic::Power, smp, partner,
-                     ahead && ahead->drawn ? &ahead->uL : nullptr,
-                     ahead && ahead->productAhead ? &ahead->product : nullptr, ahead ? &ahead->ev : nullptr),
+    shadow(prepareLd(sc, si, bsdf, woLocal, axis, pp.envStrategy, 1.f, pp.bsdfSample ? 1.f : 0.f, MisHeuristic::Power,
+                     u.light, partner, ahead && ahead->productAhead ? &ahead->product : nullptr,
+                     ahead ? &ahead->ev : nullptr),
            st);
   if (!pp.bsdfSample) return false;
 
   BsdfSample bs;
-  if (!drawBsdfSample(bsdf, woLocal, smp, &bs, ahead ? &ahead->ub : nullptr, ahead ? &ahead->bs : nullptr))
-    return false;
+  if (!drawBsdfSample(bsdf, woLocal, u.bsdf, &bs, ahead ? &ahead->bs : nullptr)) return false;
   if (partner) bsdfMixReweight(*partner, si.partnerWeight, woLocal, &bs);
   Vec3f wi = si.shading.toWorld(bs.wi);
   st->beta *= bs.weight;
@@ -165,7 +198,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   st->ray.d = wi;
   st->ray.tMax = INFINITY;
   st->depth = depth + 1;
-  return depth < pp.rrDepth || russianRoulette(&st->beta, smp.get1D(), kRouletteMaxSurvival, st->etaScale);
+  return depth < pp.rrDepth || russianRoulette(&st->beta, u.rr, kRouletteMaxSurvival, st->etaScale);
 }
 
 // What pathShade will read from the map for a path whose ray escaped and meets the map at uv,
@@ -175,28 +208,25 @@ inline void pathPrefetchEscape(const SceneView& sc, const PathState& st, const P
     sc.env.prefetchEvalWithPdf(pp.envStrategy, uv, st.prevAxis);
 }
 
-// Where pathShade's 2D draws at a hit start, in dimensions past the sampler's position there:
-// prepareLd skips one, then draws the light's pair (and the area light's, or skips it);
-// drawBsdfSample takes uc or skips it, then the BSDF's pair. For an executor that draws a
-// round's pairs ahead (RoundLanes::drawAhead): a pair drawn for the wrong dimension is not
-// taken (get2DOrAhead), so these cost time if they drift from pathShade, never the image.
-ENVGI_HD inline uint32_t pathLightDrawOffset() { return 1u; }
-ENVGI_HD inline uint32_t pathBsdfDrawOffset(const PathParams& pp) { return pp.lightSample ? 6u : 1u; }
-
 // pathShade's first steps for a path whose ray hit, done ahead into *ahead (CPU only): its
-// interaction and, where it goes on to next-event estimation, its light draw (uL: that draw made
-// ahead, if it was). Where that draw is the product's, *draw gets the first level of its loads
-// (CosineProductView::aheadLevel0) and it returns true.
+// interaction and, where it goes on to next-event estimation, its light pair (uL: that pair
+// drawn in lanes, if it was; else from a copy of smp). Where that draw is the product's, *draw
+// gets the first level of its loads (CosineProductView::aheadLevel0) and it returns true.
 inline bool pathShadeAhead(const SceneView& sc, const PathState& st, const Hit& h, const Sampler& smp,
                            const PathParams& pp, ShadeAhead* ahead, ProductDrawAhead* draw,
-                           const Draw2DAhead* uL = nullptr) {
+                           const Vec2f* uL = nullptr) {
   ahead->si = sc.interaction(st.ray, h);
   ahead->productAhead = false;
   ahead->bs.made = false;
   ahead->ev.made = false;
-  ahead->drawn = pp.lightSample && !(pp.maxDepth >= 0 && st.depth >= pp.maxDepth);
-  if (!ahead->drawn) return false;
-  ahead->uL = lightDrawOf(smp, uL);
+  ahead->lightDrawn = pp.lightSample && !(pp.maxDepth >= 0 && st.depth >= pp.maxDepth);
+  if (!ahead->lightDrawn) return false;
+  if (uL) {
+    ahead->uL = *uL;
+  } else {
+    Sampler peek = smp;
+    ahead->uL = drawLight(sc, peek).uL;
+  }
   // The material's own entry, untextured: its type is all that is asked of it here.
   const Bsdf& bsdf = sc.bsdfs[ahead->si.bsdf];
   Vec2f u = ahead->uL;

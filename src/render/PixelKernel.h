@@ -82,7 +82,7 @@ struct SampleIntegrator {
   void prefetchEscape(const PathState& st, Vec2f uv) const { pathPrefetchEscape(*scene, st, shadedPath(), uv); }
   // shade()'s first steps for a hit, done ahead (pathShadeAhead; CPU only).
   bool shadeAhead(const PathState& st, const Hit& h, const Sampler& smp, ShadeAhead* ahead, ProductDrawAhead* draw,
-                  const Draw2DAhead* uL = nullptr) const {
+                  const Vec2f* uL = nullptr) const {
     return pathShadeAhead(*scene, st, h, smp, shadedPath(), ahead, draw, uL);
   }
 };
@@ -283,7 +283,7 @@ inline void sampleBsdfsInLanes(const SceneView& sc, const PathParams& pp, TileBa
   }
   RoundLanes& lanes = b->lanes;
   byMaterial(
-      b, count, [&](int n, int k) { lanes.setBsdfDraw(n, aheadWo(b, k), b->ahead[k].ub.u); },
+      b, count, [&](int n, int k) { lanes.setBsdfDraw(n, aheadWo(b, k), b->ahead[k].ub); },
       [&](int material, int n) { lanes.sampleRoughPlastic(sc.bsdfs[material], n); },
       [&](int j, int k) {
         BsdfSampleAhead& s = b->ahead[k].bs;
@@ -483,17 +483,17 @@ void renderTileByBounce(const Camera& cam, const SampleSequence& seq, const Inte
       for (int i = 0; i < live; ++i)
         if (b->found[b->active[i]]) b->hitting[hits++] = b->active[i];
       const PathParams& pp = integ.shadedPath();
-      const uint32_t lightAt = pathLightDrawOffset(), bsdfAt = pathBsdfDrawOffset(pp);
+      const BounceLayout layout = bounceLayout(pp);
       if (inLanes) {
         for (int j = 0; j < hits; ++j) lanes.setSampler(j, b->sampler[b->hitting[j]]);
-        lanes.drawAhead(first, hits, lightAt, bsdfAt);
+        lanes.drawAhead(first, hits, layout.light, layout.bsdf);
       }
       int draws = 0;
       for (int j = 0; j < hits; ++j) {
         const int k = b->hitting[j];
-        Draw2DAhead uL;
-        if (inLanes) uL = lanes.lightDraw(j, lightAt);
-        b->ahead[k].ub = inLanes ? lanes.bsdfDraw(j, bsdfAt) : Draw2DAhead{};
+        const Vec2f uL = inLanes ? lanes.lightDraw(j) : Vec2f();
+        b->ahead[k].bsdfDrawn = inLanes;
+        if (inLanes) b->ahead[k].ub = lanes.bsdfDraw(j);
         if (integ.shadeAhead(b->state[k], b->hit[k], b->sampler[k], &b->ahead[k], &b->draw[k], inLanes ? &uL : nullptr))
           b->drawing[draws++] = k;
       }

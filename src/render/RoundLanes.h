@@ -67,12 +67,12 @@ struct RoundLanes {
   Ray rayOf(int i) const { return Ray{Vec3f(ox[i], oy[i], oz[i]), Vec3f(dx[i], dy[i], dz[i]), tMax[i]}; }
 
   // A round's hits: lane j's sampler, and the two 2D draws pathShade will make there, at
-  // lightAt and bsdfAt dimensions past its position (pathLightDrawOffset, pathBsdfDrawOffset),
-  // for sample first.index (first as in make()).
+  // lightAt and bsdfAt dimensions past its position (bounceLayout's offsets), for sample
+  // first.index (first as in make()).
   void setSampler(int j, const Sampler& smp) { hash[j] = smp.pixelHash, dims[j] = smp.dim; }
   void drawAhead(const Sampler& first, int n, uint32_t lightAt, uint32_t bsdfAt);
-  Draw2DAhead lightDraw(int j, uint32_t lightAt) const { return {{lightU0[j], lightU1[j]}, dims[j] + lightAt}; }
-  Draw2DAhead bsdfDraw(int j, uint32_t bsdfAt) const { return {{bsdfU0[j], bsdfU1[j]}, dims[j] + bsdfAt}; }
+  Vec2f lightDraw(int j) const { return {lightU0[j], lightU1[j]}; }
+  Vec2f bsdfDraw(int j) const { return {bsdfU0[j], bsdfU1[j]}; }
 
   // Lanes [0, n): where each direction (dx, dy, dz) meets the map, as EnvironmentMapView::eval
   // finds it. The camera round's rays, or a round's escaped rays gathered there.

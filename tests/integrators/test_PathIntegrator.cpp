@@ -3,9 +3,9 @@
 // pathShade doing them itself: the same light sample, the same next ray and the same sampler
 // position, to the bit, at every bounce, on scenes that take each branch (the product's draw,
 // an area light's share, glass, a blend's partner, a textured material). With Sobol's draws,
-// the light's and the BSDF's pairs are drawn ahead too, at pathLightDrawOffset and
-// pathBsdfDrawOffset past the sampler (RoundLanes::drawAhead); on the buddha, a wrong pair put
-// there changes the path: the offsets are where pathShade draws.
+// the light's and the BSDF's pairs are drawn ahead too, at bounceLayout's offsets past the
+// sampler (RoundLanes::drawAhead), and pathShade takes them unchecked: they are drawBounce's
+// own draws to the bit, and on the buddha a wrong pair put there changes the path.
 #include <gtest/gtest.h>
 
 #include <memory>
@@ -36,10 +36,10 @@ void expectSameLd(const LightSampleLd& a, const LightSampleLd& b, const std::str
 }
 
 // smp's 2D draw at dimension dim.
-Draw2DAhead drawAt(const Sampler& smp, uint32_t dim) {
+Vec2f drawAt(const Sampler& smp, uint32_t dim) {
   Sampler at = smp;
   at.dim = dim;
-  return {at.get2D(), dim};
+  return at.get2D();
 }
 
 }  // namespace
@@ -75,10 +75,21 @@ TEST(PathIntegrator, ShadingWithItsFirstStepsDoneAheadIsTheSame) {
             ShadeAhead ahead;
             ProductDrawAhead draw;
             const ShadeAhead* pre = nullptr;
-            Draw2DAhead uL;
+            Vec2f uL;
             if (found && sobol) {
-              uL = drawAt(smp, smp.dim + pathLightDrawOffset());
-              ahead.ub = drawAt(smp, smp.dim + pathBsdfDrawOffset(k.path));
+              const BounceLayout layout = bounceLayout(k.path);
+              uL = drawAt(smp, smp.dim + layout.light);
+              ahead.ub = drawAt(smp, smp.dim + layout.bsdf);
+              ahead.bsdfDrawn = true;
+              // The layout is where drawBounce draws.
+              Sampler sd = smp;
+              BsdfScratch textured;
+              const BounceDraws u =
+                  drawBounce(sc, sc.bsdfAt(sc.interaction(st.ray, h), &textured), k.path, st.depth, sd, nullptr);
+              ASSERT_EQ(u.light.uL.x, uL.x) << name;
+              ASSERT_EQ(u.light.uL.y, uL.y) << name;
+              ASSERT_EQ(u.bsdf.ub.x, ahead.ub.x) << name;
+              ASSERT_EQ(u.bsdf.ub.y, ahead.ub.y) << name;
             }
             if (found) {
               productDraws += pathShadeAhead(sc, st, h, smp, k.path, &ahead, &draw, sobol ? &uL : nullptr);
@@ -89,7 +100,7 @@ TEST(PathIntegrator, ShadingWithItsFirstStepsDoneAheadIsTheSame) {
               PathState c = st;
               Sampler sc2 = smp;
               ShadeAhead wrong = ahead;
-              wrong.ub.u = Vec2f(0.5f * (ahead.ub.u.x + 0.37f), 1.f - ahead.ub.u.y);
+              wrong.ub = Vec2f(0.5f * (ahead.ub.x + 0.37f), 1.f - ahead.ub.y);
               LightSampleLd ldc;
               const bool gc = pathShade(sc, &c, found, h, sc2, k.path, KeepLd{&ldc}, &wrong);
               Sampler sa2 = smp;
