@@ -68,7 +68,7 @@ def bsdfs():
                         f'<bsdf type="roughdielectric"><float name="int_ior" value="{ior}"/><float name="alpha" value="{a}"/>'
                         '<string name="distribution" value="ggx"/></bsdf>'))
     out.append(('conductor none', '<bsdf type="conductor"><string name="material" value="none"/></bsdf>'))
-    # The first five, and a few of the other materials Mitsuba's conductor names (stop 50).
+    # The first five, and a few of the other materials Mitsuba's conductor names.
     for m in ('Au', 'Ag', 'Al', 'Cu', 'Cr', 'W', 'Ni_palik', 'TiN', 'Cu_palik', 'Hg_palik', 'a-C'):
         out.append((f'conductor {m}', f'<bsdf type="conductor"><string name="material" value="{m}"/></bsdf>'))
     for a in (0.1, 0.3, 0.6):
@@ -359,7 +359,7 @@ def main():
     variant('anisotropic sphere (brushed, alone)', 'brushed',
             lambda t: re.sub(r'<shape type="(rectangle|cube)">.*?</shape>', '', t, flags=re.S).replace(
                 '<integrator type="path">', '<integrator type="path"><boolean name="hide_emitters" value="true"/>'))
-    # A textured area light drawn by its texture (stop 50): the screen showing bright letters on
+    # A textured area light drawn by its texture: the screen showing bright letters on
     # a dark panel, the map removed so that the screen lights the room alone.
     variant('textured-light, the sign alone', 'textured-light',
             lambda t: re.sub(r'<emitter type="envmap">.*?</emitter>', '', t, flags=re.S).replace(
@@ -385,7 +385,7 @@ def main():
                 '<emitter type="spot"><transform name="to_world"><lookat origin="-0.5, 1.8, 0.8" target="-0.3, 0, -0.5" '
                 'up="0, 1, 0"/></transform><float name="cutoff_angle" value="25"/><rgb name="intensity" value="3, 2.5, 2"/>'
                 '</emitter></scene>'))
-    # The Cornell box's light swapped for other emitters (stop 37). A sphere light: shadow rays
+    # The Cornell box's light swapped for other emitters. A sphere light: shadow rays
     # that came in at a grazing angle hit the light itself (-4.6%, z -7.3, before the fix). A
     # square facing up into the ceiling, with no BSDF: Mitsuba makes that black, not grey
     # (+4.8%, z +11.4, before).
@@ -408,7 +408,7 @@ def main():
     variant('buddha, map rotated', 'buddha',
             lambda t: t.replace('<float name="scale" value="25"/>', '<float name="scale" value="25"/><transform '
                                 'name="to_world"><rotate y="1" angle="110"/><rotate x="1" angle="30"/></transform>'))
-    # direct with one kind of sample (stop 66 runs these as one-bounce paths): light samples
+    # direct with one kind of sample (the CPU runs these as one-bounce paths): light samples
     # only, by the product density, and BSDF samples only, against Mitsuba's direct with the
     # same counts.
     one_light = '<integer name="emitter_samples" value="1"/>'

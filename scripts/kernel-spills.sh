@@ -2,7 +2,7 @@
 # Registers, stack frame and spills of the path kernel (regenKernel over SampleIntegrator<BvhTracer>)
 # as ptxas reports them, for sm_90, without a GPU: the kernel alone is compiled (about 2 minutes)
 # for each resident-threads count given (ENVGI_CUDA_THREADS_PER_SM; default 1536, the build's;
-# docs/gpu.md, stop 55). The figures are bytes of spill code (static), not traffic.
+# docs/gpu.md). The figures are bytes of spill code (static), not traffic.
 #
 #   bash scripts/kernel-spills.sh [SOURCE_TREE] [THREADS_PER_SM ...]
 set -euo pipefail

@@ -28,7 +28,7 @@ std::vector<uint32_t> pixelsToWarp(const EnvironmentMapView& v) {
       // Nor below 1e-15 or above 1e15: the warp squares lattice values (sampleLinear) and takes
       // ratios of their sums, which lose their digits to underflow near FLT_MIN (a draw's density
       // differed from pdf()'s by 1.6% on a map of 1e-43 texels: fuzz_envmap) and overflow to
-      // infinity past 1.8e19 (by 3.7x next to texels of 1e30, stop 52). Such a pixel is drawn
+      // infinity past 1.8e19 (by 3.7x next to texels of 1e30). Such a pixel is drawn
       // uniformly inside, as a flat one is; a measured sun (about 1.6e9) stays well inside.
       if (hi > 2.f * lo && hi >= 1e-15f && hi <= 1e15f) bits[i >> 5] |= 1u << (i & 31);
     }

@@ -32,7 +32,7 @@ bool hasMachineCodeFor(int major, int minor);
 // caps their registers so that this many fit (40 a thread). They wait on memory and instruction
 // fetch, so more warps beat fewer spills: on an H200, path 420 -> 611 M samples/s and SPPM
 // 3.5 -> 2.7 ms a pass. The grid's one-thread-a-pixel kernel lost 20% so capped, and keeps its
-// registers (docs/gpu.md, stop 31).
+// registers (docs/gpu.md).
 // The build may set another count (CMake's ENVGI_CUDA_THREADS_PER_SM, for A/B runs).
 #ifndef ENVGI_CUDA_THREADS_PER_SM
 #define ENVGI_CUDA_THREADS_PER_SM 1536

@@ -48,7 +48,7 @@ ENVGI_INLINE float areaLightPdf(const SceneView& sc, int light, Vec3f p, Vec3f l
 
 // sampleLight's choice of a delta or an area light (u.x at or past the map's share pe). Out of
 // line on the GPU: most scenes are lit by the map alone, and this code in the path kernel's hot
-// loop cost instruction fetch (docs/gpu.md, stop 54).
+// loop cost instruction fetch (docs/gpu.md).
 inline ENVGI_HD_NOINLINE bool sampleDeltaOrAreaLight(const SceneView& sc, const SurfaceInteraction& si, float pe,
                                                      Vec2f u, Vec2f u2, LightSample* ls) {
   const float uSel = u.x;

@@ -8,7 +8,7 @@
 namespace envgi {
 
 // b's part, out of line on the GPU: only blends reach it, and a second inlined copy of
-// bsdfEvalPdf would grow every kernel that shades (as texturedCopy, docs/gpu.md stop 54).
+// bsdfEvalPdf would grow every kernel that shades (as texturedCopy, docs/gpu.md).
 inline ENVGI_HD_NOINLINE Color bsdfPartnerEvalPdf(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
   return bsdfEvalPdf(b, wo, wi, pdf);
 }

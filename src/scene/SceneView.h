@@ -236,7 +236,7 @@ struct SceneView {
   ENVGI_HD int blendChoice(int index, Vec2f uv, const Ray& ray, int geomId, uint32_t crossing) const {
     return bsdfIsBlend(bsdfs[index]) ? blendChoiceOf(index, uv, ray, geomId, crossing) : index;
   }
-  // blendChoice's walk down nested blends, out of line on the GPU (docs/gpu.md, stop 54).
+  // blendChoice's walk down nested blends, out of line on the GPU (docs/gpu.md).
   ENVGI_HD_NOINLINE int blendChoiceOf(int index, Vec2f uv, const Ray& ray, int geomId, uint32_t crossing) const {
     for (int level = 0; level < kMaxBlendDepth && bsdfIsBlend(bsdfs[index]); ++level) {
       const Bsdf& b = bsdfs[index];
@@ -342,7 +342,7 @@ struct SceneView {
     return texturedCopy(index, uv, dpdu, dpdv, scratch);
   }
   // bsdfAt's copy of a textured material. Out of line on the GPU, as the rarer branches of the
-  // path kernel are, to keep its hot code small (docs/gpu.md, stop 54).
+  // path kernel are, to keep its hot code small (docs/gpu.md).
   ENVGI_HD_NOINLINE const Bsdf& texturedCopy(int index, Vec2f uv, Vec2f dpdu, Vec2f dpdv, BsdfScratch* scratch) const {
     Bsdf* copy = new (scratch->bytes) Bsdf(bsdfAt(index, uv));
     if (copy->bumpTexture >= 0)

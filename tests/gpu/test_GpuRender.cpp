@@ -353,7 +353,7 @@ TEST(GpuRender, BuildHasMachineCodeForTheDevice) {
 }
 
 // The path kernel's registers decide how many paths an SM keeps in flight. Copying each hit's
-// material whole (textures, stop 26) took it from 117 to 179 registers on sm_90, from 4 blocks
+// material whole (textures) took it from 117 to 179 registers on sm_90, from 4 blocks
 // an SM to 3; reading it in place took an H200 from 336 to 405 M samples/s. Nothing else noticed.
 TEST(GpuRender, PathKernelKeepsItsOccupancy) {
   gpu::KernelOccupancy o = gpu::pathKernelOccupancy(0);
