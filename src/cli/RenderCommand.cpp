@@ -82,6 +82,9 @@ void runRender(const RenderArgs& a) {
   auto requireImageName = [](const std::string& path, const std::string& what) {
     return requireOutputExtension(path, {".exr", ".pfm", ".hdr", ".png"}, what);
   };
+  // Its folders are made as study makes its own: `-o out/x.exr` on a fresh checkout works.
+  makeParentDirectories(a.output);
+  if (!a.sampleMap.empty()) makeParentDirectories(a.sampleMap);
   std::string ext = requireImageName(a.output, "output");
   // What the render writes at each checkpoint and at the end: the image and, with --png, the
   // tone-mapped PNG beside it.

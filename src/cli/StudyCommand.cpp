@@ -96,8 +96,17 @@ void applyStrategy(const std::string& name, Scene& scene) {
     scene.integrator.env.pointCount = int(n);
     return;
   }
-  if (isCollapsedMap(findStrategy(name).env))
-    throw std::runtime_error("strategy '" + name + "': name its size, " + name + "-N");
+  const StrategyName* known = nullptr;
+  for (const StrategyName& n : kStrategyNames)
+    if (name == n.name) known = &n;
+  if (!known) {
+    // The study's own names: the collapsed map's strategies take their size in the name.
+    std::string list;
+    for (const StrategyName& n : kStrategyNames)
+      list += (list.empty() ? "" : ", ") + std::string(n.name) + (isCollapsedMap(n.env) ? "-N" : "");
+    throw std::runtime_error("unknown strategy '" + name + "' (" + list + ")");
+  }
+  if (isCollapsedMap(known->env)) throw std::runtime_error("strategy '" + name + "': name its size, " + name + "-N");
   scene.integrator.setStrategy(name);
 }
 
@@ -272,6 +281,10 @@ void runStudy(const StudyArgs& a) {
           "points-draw-N",
           s));
   }
+  // Every strategy draws the same light where there is no map: the runs would differ in name only.
+  if (!scene.env)
+    throw std::runtime_error("study: '" + a.scene + "' has no environment map, so every strategy renders the same "
+                             "image; the study compares ways of sampling one (add an <emitter type=\"envmap\">)");
   scene.finalize();
   bool cuda = chooseCuda(a.device);
   EmbreeAccel accel(scene);

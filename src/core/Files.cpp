@@ -37,6 +37,16 @@ void requireWritableDirectoryOf(const std::string& path) {
     throw std::runtime_error("cannot write '" + path + "': directory '" + dir.string() + "' is not writable");
 }
 
+void makeParentDirectories(const std::string& path) {
+  const fs::path dir = fs::path(path).parent_path();
+  if (dir.empty() || fs::is_directory(dir)) return;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec || !fs::is_directory(dir))
+    throw std::runtime_error("cannot write '" + path + "': cannot make the folder '" + dir.string() + "'" +
+                             (ec ? ": " + ec.message() : ""));
+}
+
 void writeFileAtomically(const std::string& path, const std::string& content) {
   requireWritableDirectoryOf(path);
   fs::path tmp = temporarySibling(path, "");

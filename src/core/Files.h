@@ -18,6 +18,10 @@ void renameIntoPlace(const std::string& tmp, const std::string& path);
 // call it before long work, so that a mistyped folder does not cost a render its samples.
 void requireWritableDirectoryOf(const std::string& path);
 
+// Makes the folders an output at path needs, as `study -o a/b/c` makes its own; throws naming
+// the path where one cannot be made (a file in the way, no permission).
+void makeParentDirectories(const std::string& path);
+
 // Writes `content` to a hidden temporary file beside `path`, then renames it into place.
 void writeFileAtomically(const std::string& path, const std::string& content);
 

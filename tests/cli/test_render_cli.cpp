@@ -116,13 +116,21 @@ TEST(CliRender, ErrorsLeaveNoOutput) {
   EXPECT_NE(runCli("render " + scene + " -o " + out + " --strategy nonsense").code, 0);
   EXPECT_NE(runCli("render " + scene + " -o " + out + " -D broken").code, 0);
   EXPECT_FALSE(fs::exists(out));
-  // A folder that is not there is said before the render, not after it (no progress bar ran).
-  CliResult noDir = runCli("render " + scene + " -o " + d.file("missing/x.exr"));
+  // The output's folders are made, as study makes its own (the README's `-o out/x.exr` on a
+  // fresh checkout); one that cannot be made (a file in the way) is said before the render.
+  CliResult newDir = runCli("render " + scene + " -o " + d.file("made/here/x.exr") + " --png --sample-map " +
+                            d.file("maps/spp.png") + " --noise-threshold 0.5");
+  EXPECT_EQ(newDir.code, 0) << newDir.output;
+  EXPECT_TRUE(fs::exists(d.file("made/here/x.exr")));
+  EXPECT_TRUE(fs::exists(d.file("made/here/x.png")));
+  EXPECT_TRUE(fs::exists(d.file("maps/spp.png")));
+  std::ofstream(d.file("afile")) << "x";
+  CliResult noDir = runCli("render " + scene + " -o " + d.file("afile/x.exr"));
   EXPECT_EQ(noDir.code, 1) << noDir.output;
-  EXPECT_NE(noDir.output.find("missing/x.exr': directory does not exist"), std::string::npos) << noDir.output;
+  EXPECT_NE(noDir.output.find("afile/x.exr': cannot make the folder"), std::string::npos) << noDir.output;
   EXPECT_EQ(noDir.output.find("100%"), std::string::npos) << noDir.output;
-  CliResult noMapDir = runCli("render " + scene + " -o " + out + " --sample-map " + d.file("missing/spp.png"));
-  EXPECT_NE(noMapDir.output.find("directory does not exist"), std::string::npos) << noMapDir.output;
+  CliResult noMapDir = runCli("render " + scene + " -o " + out + " --sample-map " + d.file("afile/spp.png"));
+  EXPECT_NE(noMapDir.output.find("cannot make the folder"), std::string::npos) << noMapDir.output;
   EXPECT_FALSE(fs::exists(out));
   // A misspelt property (here the sphere's radius) is one error line naming the nearest name.
   std::string text;

@@ -166,7 +166,17 @@ TEST(StudyCli, BadInputIsOneErrorLine) {
     EXPECT_NE(r.output.find("envgi: error: "), std::string::npos) << r.output;
     EXPECT_NE(r.output.find(text), std::string::npos) << r.output;
   };
-  expectError("--strategies uniform,magic", "unknown strategy 'magic'");
+  // The study's own names: points-N and points-draw-N, never the bare names it refuses.
+  expectError("--strategies uniform,magic", "unknown strategy 'magic' (uniform, cosine, importance, alias, "
+                                            "importance-bilinear, adaptive, bsdf, mis, points-N, product, points-draw-N)");
+  // A scene without a map: every strategy would render the same image under its own name.
+  {
+    CliResult r = runCli("study " + std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml -o " + d.file("s") +
+                         " -D res=16 --reference-spp 4");
+    EXPECT_EQ(r.code, 1) << r.output;
+    EXPECT_NE(r.output.find("has no environment map, so every strategy renders the same image"), std::string::npos)
+        << r.output;
+  }
   expectError("--spp ,", "--spp is empty");
   expectError("--spp 4,x", "not a positive sample count");
   expectError("--time 0", "not a positive number of seconds");
