@@ -40,6 +40,12 @@ std::string requireOutputExtension(const std::string& path, const std::vector<st
 // means nothing (a render's PNG against its own EXR gave RMSE 0.82).
 void requireRadianceImage(const std::string& path, const std::string& who);
 
+// A command that ends with a status of its own, its work done and said (a render stopped by
+// SIGINT or SIGTERM: 128 + the signal, the shell's convention, after writing what it finished).
+struct ExitStatus {
+  int code;
+};
+
 // -D name=value pairs into a map; throws on a pair without '='.
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds);
 

@@ -30,6 +30,7 @@ namespace envgi::cli {
 namespace {
 
 std::atomic<bool> g_cancel{false};
+std::atomic<int> g_signal{0};  // the first stopping signal, for the exit status
 // The first SIGINT or SIGTERM asks the render to stop after the tiles in flight (the first pass,
 // and a GPU's, after the pass) and write what is finished; a second one ends the process at
 // once, as the signal's default would.
@@ -39,6 +40,7 @@ extern "C" void onInterrupt(int sig) {
     std::raise(sig);
     return;
   }
+  g_signal = sig;
   static const char msg[] = "\nenvgi: stopping after the tiles in flight, keeping every finished sample (again to stop now)\n";
   ssize_t ignored = write(2, msg, sizeof(msg) - 1);  // async-signal-safe, unlike the logger
   (void)ignored;
@@ -129,6 +131,12 @@ void runRender(const RenderArgs& a) {
     spdlog::warn("the film's pixel_format has alpha, which {} cannot hold: it gets RGB", a.output);
   scene.finalize();
   bool cuda = chooseCuda(a.device);
+  if (cuda && a.device == "auto") {
+    if (const std::string why = gpu::whyNotOnCuda(scene); !why.empty()) {
+      spdlog::info("device: CPU ({})", why);
+      cuda = false;
+    }
+  }
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   spdlog::info("scene {}: {} triangles, {} spheres, {} area-light primitives{}{}, {:.1f} MB of geometry, loaded in {:.2f} s",
                a.scene, scene.triangleCount(), scene.spheres.size(), scene.lightCount(),
@@ -287,6 +295,8 @@ void runRender(const RenderArgs& a) {
   std::vector<std::string> written;
   for (const std::string& image : images) written.push_back(fs::absolute(image).string());
   spdlog::info("wrote {}", fmt::join(written, " and "));
+  // A script must tell a stopped render from a finished one: 130 (SIGINT) or 143 (SIGTERM).
+  if (st.cancelled && g_signal > 0) throw ExitStatus{128 + g_signal.load()};
 }
 
 }  // namespace

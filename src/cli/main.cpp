@@ -36,6 +36,8 @@ int main(int argc, char** argv) {
     return app.exit(e);
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
+  } catch (const envgi::cli::ExitStatus& e) {
+    return e.code;
   } catch (const CLI::ParseError& e) {
     // One line, like every other error; --help has the details.
     std::fprintf(stderr, "envgi: error: %s (see envgi --help)\n", e.what());

@@ -71,6 +71,10 @@ std::unique_ptr<PassExecutor> makeCudaGridExecutor(const Scene& scene, const Bvh
                                                    SampleSequence seq, int gpu, bool keepVariance,
                                                    size_t* deviceBytes = nullptr);
 
+// Why the scene's integrator cannot render on a GPU ("" where it can): prepareCudaRender
+// refuses it with this, and `--device auto` renders it on the CPU instead.
+std::string whyNotOnCuda(const Scene& scene);
+
 // The scene's integrator on GPU `gpu`, as prepareRender does it on the CPU: path, direct, sppm
 // and grid wholly there; photon traces its maps there and needs accel for the rest.
 PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const EmbreeAccel* accel, RenderOptions opts,

@@ -8,6 +8,12 @@
 
 namespace envgi::gpu {
 
+std::string whyNotOnCuda(const Scene& scene) {
+  if (scene.integrator.type == IntegratorType::Grid && scene.integrator.grid.basis == "directions")
+    return "the grid's basis 'directions' (the paper's M coefficients) runs on the CPU only";
+  return "";
+}
+
 PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const EmbreeAccel* accel, RenderOptions opts,
                                  int gpu, size_t* deviceBytes) {
   requireFilmFits(scene.view().camera, opts, physicalMemoryBytes());  // its host copy, before the device's
@@ -26,9 +32,8 @@ PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const Embre
       pr.spp = sppmPasses(scene, opts);
       break;
     case IntegratorType::Grid: {
-      if (scene.integrator.grid.basis == "directions")
-        throw std::runtime_error("the grid's basis 'directions' (the paper's M coefficients) runs on the CPU only: "
-                                 "--device cpu, or basis 'sh' on the GPU");
+      if (const std::string why = whyNotOnCuda(scene); !why.empty())
+        throw std::runtime_error(why + ": --device cpu, or basis 'sh' on the GPU");
       SequenceAndSpp q = gridSequence(scene, opts);
       pr.executor = makeCudaGridExecutor(scene, bvh, gridExecutorSettings(scene, opts), q.sequence, gpu,
                                          opts.keepsVariance(), &bytes);
