@@ -130,6 +130,10 @@ void runRender(const RenderArgs& a) {
   if (scene.filmAlpha && ext != ".exr" && ext != ".png")
     spdlog::warn("the film's pixel_format has alpha, which {} cannot hold: it gets RGB", a.output);
   scene.finalize();
+  // An emitter envgi ignored (the log said which) leaves a black image: say so, as photons does.
+  if (!scene.env && scene.lightCount() == 0 && scene.deltaLights.empty() && !a.aovGiven)
+    throw std::runtime_error("the scene emits no light (no environment map, area light, or directional, point or spot "
+                             "light envgi renders): its image would be black");
   bool cuda = chooseCuda(a.device);
   if (cuda && a.device == "auto") {
     if (const std::string why = gpu::whyNotOnCuda(scene); !why.empty()) {

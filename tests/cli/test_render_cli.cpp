@@ -42,8 +42,6 @@ std::string tinyScene(const TempDir& d, int res, int spp) {
   return path;
 }
 
-// `envgi render ARGS` in the background, its output to log, sent SIGINT after 1.5 s: whether it
-// ended within `seconds` (if not, it is killed).
 // `envgi render args` (split at spaces), its output to log; after 1.5 s, signal sig. Whether it
 // ended within `seconds` of that, and (*status) its exit status (-1 if a signal ended it).
 bool interruptedRender(const std::string& args, const std::string& log, double seconds, int* status = nullptr,
@@ -171,6 +169,24 @@ TEST(CliRender, ErrorsLeaveNoOutput) {
   size_t files = 0;
   for (auto& e : fs::directory_iterator(d.path)) files += e.path().filename().string().find(".tmp") != std::string::npos;
   EXPECT_EQ(files, 0u);
+}
+
+// A scene whose only emitter envgi does not support (sunsky, sky, projector) has no light: the
+// render is an error naming that, where it drew a black image and exited 0 after a warning.
+TEST(CliRender, ASceneWithoutLightIsAnError) {
+  TempDir d;
+  std::string text = slurp(tinyScene(d, 8, 1));
+  const size_t at = text.find("<emitter"), end = text.find("</emitter>") + 10;
+  text.replace(at, end - at, R"(<emitter type="sunsky"/>)");
+  std::ofstream(d.file("sunsky.xml")) << text;
+  CliResult r = runCli("render " + d.file("sunsky.xml") + " -o " + d.file("black.exr"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("emitter type 'sunsky' is not supported"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("envgi: error: the scene emits no light"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(d.file("black.exr")));
+  // Its AOVs alone need no light.
+  CliResult aovs = runCli("render " + d.file("sunsky.xml") + " -o " + d.file("aovs.exr") + " --aov dd:depth");
+  EXPECT_EQ(aovs.code, 0) << aovs.output;
 }
 
 // SIGINT or SIGTERM during a long render: the finished passes are written, and the exit status
