@@ -6,7 +6,49 @@
 #include <exception>
 #include <new>
 
+#include <string>
+#include <vector>
+
 #include "cli/Commands.h"
+#include "scene/MitsubaPlugins.h"
+
+namespace {
+
+// What a parse error misses for a misspelt word: the command or option not known, and the
+// nearest known name (as XML properties get: " (did you mean 'render'?)").
+std::string nearestNameHint(CLI::App& app, int argc, char** argv) {
+  std::vector<std::string> commands;
+  for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) commands.push_back(sub->get_name());
+  CLI::App* command = nullptr;
+  for (int i = 1; i < argc && !command; ++i) {
+    const std::string word = argv[i];
+    if (word.empty() || word[0] == '-') continue;
+    for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+      if (sub->get_name() == word) command = sub;
+    if (!command) return "; unknown command '" + word + "'" + envgi::didYouMean(word, commands);
+  }
+  if (!command) return "";
+  std::vector<std::string> options;
+  for (const CLI::App* a : {static_cast<const CLI::App*>(&app), static_cast<const CLI::App*>(command)})
+    for (const CLI::Option* o : a->get_options()) {
+      for (const std::string& l : o->get_lnames()) options.push_back("--" + l);
+      for (const std::string& n : o->get_snames()) options.push_back("-" + n);
+    }
+  for (int i = 1; i < argc; ++i) {
+    std::string word = argv[i];
+    if (word.size() < 2 || word[0] != '-' || (word[1] >= '0' && word[1] <= '9') || word[1] == '.') continue;
+    word = word.substr(0, word.find('='));
+    bool known = false;
+    for (const std::string& o : options) known = known || o == word;
+    // -D name=value and the like: a short option's value may follow it in the same word.
+    if (!known && word.size() > 2 && word[1] != '-')
+      for (const std::string& o : options) known = known || (o.size() == 2 && word.rfind(o, 0) == 0);
+    if (!known) return "; unknown option '" + word + "'" + envgi::didYouMean(word, options);
+  }
+  return "";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"envgi: global illumination from HDR environment maps"};
@@ -40,7 +82,7 @@ int main(int argc, char** argv) {
     return e.code;
   } catch (const CLI::ParseError& e) {
     // One line, like every other error; --help has the details.
-    std::fprintf(stderr, "envgi: error: %s (see envgi --help)\n", e.what());
+    std::fprintf(stderr, "envgi: error: %s%s (see envgi --help)\n", e.what(), nearestNameHint(app, argc, argv).c_str());
     return 2;
   } catch (const std::bad_alloc&) {
     // An allocation the system refused (past a ulimit, or far larger than its memory) is one

@@ -171,6 +171,23 @@ TEST(CliRender, ErrorsLeaveNoOutput) {
   EXPECT_EQ(files, 0u);
 }
 
+// A misspelt command or option gets the nearest name, as a misspelt XML property does.
+TEST(CliRender, AMisspeltCommandOrOptionNamesTheNearest) {
+  TempDir d;
+  const std::string scene = tinyScene(d, 8, 1);
+  CliResult command = runCli("rendr " + scene);
+  EXPECT_EQ(command.code, 2) << command.output;
+  EXPECT_NE(command.output.find("unknown command 'rendr' (did you mean 'render'?)"), std::string::npos)
+      << command.output;
+  CliResult option = runCli("render " + scene + " -o " + d.file("x.exr") + " --sp 4");
+  EXPECT_EQ(option.code, 2) << option.output;
+  EXPECT_NE(option.output.find("unknown option '--sp' (did you mean '--spp'?)"), std::string::npos) << option.output;
+  EXPECT_FALSE(fs::exists(d.file("x.exr")));
+  // Known options with values, -D pairs and negative numbers are not taken for misspellings.
+  CliResult bad = runCli("render " + scene + " -o " + d.file("x.exr") + " -D spp=2 --seed -5");
+  EXPECT_EQ(bad.output.find("unknown option"), std::string::npos) << bad.output;
+}
+
 // A scene whose only emitter envgi does not support (sunsky, sky, projector) has no light: the
 // render is an error naming that, where it drew a black image and exited 0 after a warning.
 TEST(CliRender, ASceneWithoutLightIsAnError) {
