@@ -130,6 +130,13 @@ void runRender(const RenderArgs& a) {
   if (scene.filmAlpha && ext != ".exr" && ext != ".png")
     spdlog::warn("the film's pixel_format has alpha, which {} cannot hold: it gets RGB", a.output);
   scene.finalize();
+  // Options that change nothing here are said, not silently dropped.
+  if (!a.strategy.empty() && !scene.env)
+    spdlog::warn("--strategy {}: the scene has no environment map, so no strategy draws from one", a.strategy);
+  if ((a.points > 0 || !a.pointMethod.empty()) && !isCollapsedMap(findStrategy(scene.integrator.env.strategy).env))
+    spdlog::warn("--points and --point-method shape the collapsed map, which strategy '{}' does not use (points or "
+                 "points-draw do)",
+                 scene.integrator.env.strategy);
   // An emitter envgi ignored (the log said which) leaves a black image: say so, as photons does.
   if (!scene.env && scene.lightCount() == 0 && scene.deltaLights.empty() && !a.aovGiven)
     throw std::runtime_error("the scene emits no light (no environment map, area light, or directional, point or spot "

@@ -188,6 +188,27 @@ TEST(CliRender, AMisspeltCommandOrOptionNamesTheNearest) {
   EXPECT_EQ(bad.output.find("unknown option"), std::string::npos) << bad.output;
 }
 
+// Options that change nothing on the scene are warned about: a strategy without a map, the
+// collapsed map's size without a strategy that uses it.
+TEST(CliRender, IgnoredOptionsAreSaid) {
+  TempDir d;
+  std::string text = slurp(tinyScene(d, 8, 1));
+  const size_t at = text.find("<emitter"), end = text.find("</emitter>") + 10;
+  text.replace(at, end - at, R"(<shape type="sphere"><point name="center" value="0,3,0"/><emitter type="area"><rgb name="radiance" value="5"/></emitter></shape>)");
+  std::ofstream(d.file("lamp.xml")) << text;
+  CliResult strategy = runCli("render " + d.file("lamp.xml") + " -o " + d.file("a.exr") + " --strategy importance");
+  EXPECT_EQ(strategy.code, 0) << strategy.output;
+  EXPECT_NE(strategy.output.find("--strategy importance: the scene has no environment map"), std::string::npos)
+      << strategy.output;
+  CliResult points = runCli("render " + tinyScene(d, 8, 1) + " -o " + d.file("b.exr") + " --points 8");
+  EXPECT_EQ(points.code, 0) << points.output;
+  EXPECT_NE(points.output.find("which strategy 'product' does not use"), std::string::npos) << points.output;
+  CliResult used = runCli("render " + tinyScene(d, 8, 1) + " -o " + d.file("c.exr") + " --points 8 --strategy points "
+                          "--integrator direct");
+  EXPECT_EQ(used.code, 0) << used.output;
+  EXPECT_EQ(used.output.find("does not use"), std::string::npos) << used.output;
+}
+
 // A scene whose only emitter envgi does not support (sunsky, sky, projector) has no light: the
 // render is an error naming that, where it drew a black image and exited 0 after a warning.
 TEST(CliRender, ASceneWithoutLightIsAnError) {
