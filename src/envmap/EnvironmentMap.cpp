@@ -153,7 +153,9 @@ EnvironmentMap EnvironmentMap::loadProbe(const std::string& path, ProbeLayout la
     spdlog::warn("light probe '{}': {} NaN, infinite or negative channel values replaced with 0", path, invalid);
   spdlog::info("light probe '{}' ({}, {}x{}) resampled to a {}x{} lat-long map", path, probeLayoutName(layout),
                probe.width, probe.height, map.width, map.height);
-  return EnvironmentMap(std::move(map), opts, path);
+  EnvironmentMap env(std::move(map), opts, path);
+  env.invalid_ += invalid;  // the probe's, replaced before resampling: stats() reports them too
+  return env;
 }
 
 EnvironmentMap EnvironmentMap::loadLayout(const std::string& path, const std::string& layout,

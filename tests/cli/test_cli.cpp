@@ -110,6 +110,11 @@ TEST(CliEnvmap, ConvertMakesALatLongMapOfAProbe) {
   CliResult probeInfo = runCli("envmap info " + probe + " --layout angular");
   ASSERT_EQ(probeInfo.code, 0) << probeInfo.output;
   EXPECT_NE(probeInfo.output.find("size:           256 x 128"), std::string::npos) << probeInfo.output;
+  // The probe's invalid values, replaced before it is resampled, are the ones info counts (it
+  // had warned of 2764, then printed 0).
+  EXPECT_NE(probeInfo.output.find("2764 NaN, infinite or negative channel values replaced"), std::string::npos)
+      << probeInfo.output;
+  EXPECT_NE(probeInfo.output.find("invalid values: 2764\n"), std::string::npos) << probeInfo.output;
   CliResult plot = runCli("envmap plot " + probe + " --layout mirrorball -n 50 -o " + d.file("p.png"));
   ASSERT_EQ(plot.code, 0) << plot.output;
   EXPECT_TRUE(fs::exists(d.file("p.png")));
