@@ -408,12 +408,19 @@ class Loader {
     } else if (tag == "texture") {
       nameTopLevel(f, n, texture(f, n), textureIds_, "texture");
     } else if (tag == "medium" || tag == "phase") {
-      warnOnce(fmt::format("{}:{}: <{}> is not supported and was ignored", f->path, f->lineOf(n.offset_debug()), tag));
+      ignoreMedium(f, n);
     } else {
       const std::vector<std::string> elements = {"default", "include", "integrator", "sensor", "emitter",
                                                  "shape",   "bsdf",    "texture",    "medium", "phase"};
       fail(f, n, fmt::format("unknown element <{}>{}", tag, didYouMean(tag, elements, "<", ">")));
     }
+  }
+
+  // Participating media are not rendered: a <medium> (or <phase>) anywhere, and a shape's
+  // <ref name="interior|exterior">, are one warning each, and the scene renders without them.
+  void ignoreMedium(const SourceFile* f, pugi::xml_node n) {
+    warnOnce(fmt::format("{}:{}: <{}>: participating media are not supported and were ignored", f->path,
+                         f->lineOf(n.offset_debug()), n.name()));
   }
 
   void integrator(const SourceFile* f, pugi::xml_node n) {
@@ -1376,6 +1383,10 @@ class Loader {
       if (tag == "bsdf") {
         if (entry.bsdf >= 0) fail(f, c, "a shape has at most one BSDF");
         entry.bsdf = bsdf(f, c);
+      } else if (tag == "medium" || tag == "phase" ||
+                 (tag == "ref" && (std::string(c.attribute("name").as_string()) == "interior" ||
+                                   std::string(c.attribute("name").as_string()) == "exterior"))) {
+        ignoreMedium(f, c);
       } else if (tag == "ref") {
         checkAttrs(f, c, {"id", "name"});
         auto it = bsdfIds_.find(attr(f, c, "id"));

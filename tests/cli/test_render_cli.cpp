@@ -209,6 +209,27 @@ TEST(CliRender, IgnoredOptionsAreSaid) {
   EXPECT_EQ(used.output.find("does not use"), std::string::npos) << used.output;
 }
 
+// Participating media, which envgi does not render, are one warning wherever they appear: at
+// the top level, nested in a shape, or referred to as a shape's interior (once "unexpected
+// <medium> in <shape>" and "unknown BSDF id 'fog'").
+TEST(CliRender, MediaAreAWarningWhereverTheyAppear) {
+  TempDir d;
+  std::string text = slurp(tinyScene(d, 8, 1));
+  text.replace(text.find("<shape type=\"sphere\">"), 22,
+               R"(<medium type="homogeneous" id="fog"/>
+  <shape type="sphere"><ref name="interior" id="fog"/>
+    <medium type="homogeneous" name="exterior"/>)");
+  std::ofstream(d.file("fog.xml")) << text;
+  CliResult r = runCli("render " + d.file("fog.xml") + " -o " + d.file("fog.exr"));
+  EXPECT_EQ(r.code, 0) << r.output;
+  size_t warnings = 0;
+  for (size_t at = r.output.find("participating media are not supported"); at != std::string::npos;
+       at = r.output.find("participating media are not supported", at + 1))
+    ++warnings;
+  EXPECT_EQ(warnings, 3u) << r.output;
+  EXPECT_TRUE(fs::exists(d.file("fog.exr")));
+}
+
 // A scene whose only emitter envgi does not support (sunsky, sky, projector) has no light: the
 // render is an error naming that, where it drew a black image and exited 0 after a warning.
 TEST(CliRender, ASceneWithoutLightIsAnError) {
