@@ -51,6 +51,11 @@ void runCompare(const CompareArgs& a) {
     fmt::print("{:<40} {:>10.5f} {:>10.5f} {:>10.5f} {:>12.5f} {:>10}\n", a.images[i], rows[i].mean, e.rmse, e.relMse,
                e.worstRegionRmse, rows[i].nonFinite);
   }
+  // What the columns are, on stderr so that the table on stdout stays one row an image for scripts.
+  fmt::print(stderr,
+             "mean: of the pixels' luminance; RMSE: over every pixel and channel; relMSE: the mean of (a - r)^2 / "
+             "(r^2 + 0.01); worst-region: the largest RMSE of a 4 x 4 grid of regions (local error); non-finite: NaN "
+             "or infinite values\n");
 }
 }  // namespace
 

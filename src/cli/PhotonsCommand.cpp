@@ -66,7 +66,9 @@ void runPhotons(const PhotonsArgs& a) {
   draw(global, Color(1.f, 0.55f, 0.15f));
   draw(caustic, Color(0.2f, 0.85f, 1.f));
   saveImage(img, a.output);
-  spdlog::info("wrote {} with {} visible photons", std::filesystem::absolute(a.output).string(), drawn);
+  spdlog::info("wrote {} with {} visible photons: global photons orange, caustic photons cyan, over a dimmed "
+               "direct-light render",
+               std::filesystem::absolute(a.output).string(), drawn);
 }
 
 }  // namespace

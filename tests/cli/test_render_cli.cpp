@@ -439,6 +439,7 @@ TEST(CliPhotons, DrawsPhotonsAndRejectsBadInput) {
   std::string scene = std::string(ENVGI_SOURCE_DIR) + "/scenes/cornell-box.xml";
   CliResult r = runCli("photons " + scene + " -o " + d.file("p.png") + " -D res=64 --global 2000 --caustic 2000");
   ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("global photons orange, caustic photons cyan"), std::string::npos) << r.output;
   EXPECT_GT(fs::file_size(d.file("p.png")), 500u);
   EXPECT_NE(r.output.find("caustic photons"), std::string::npos) << r.output;
   CliResult bad = runCli("photons " + scene + " -o " + d.file("p.txt"));
@@ -914,6 +915,7 @@ TEST(CliCompare, ErrorsAgainstAReference) {
   }
   ASSERT_EQ(rmse.size(), 2u) << r.output;
   EXPECT_EQ(rmse[0], 0.0);
+  EXPECT_NE(r.output.find("worst-region: the largest RMSE of a 4 x 4 grid of regions"), std::string::npos) << r.output;
   EXPECT_GT(rmse[1], 0.0);
   CliResult bad = runCli("compare " + d.file("a.pfm") + " " + d.file("c.pfm"));
   EXPECT_NE(bad.code, 0);
