@@ -3,6 +3,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstring>
+#include <functional>
+#include <iterator>
 #include <cmath>
 #include <map>
 #include <set>
@@ -31,6 +34,24 @@ namespace {
 
 const char* kColours[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf"};
 
+// A series' colour from its name alone, so a strategy keeps its colour from one report to the
+// next: the render strategies a colour each; the collapsed map's sizes a ramp by log2 N (green
+// for points-N, brown for points-draw-N); any other name by its hash.
+std::string seriesColour(const std::string& name) {
+  static const char* kNamed[] = {"uniform", "cosine", "bsdf", "adaptive", "importance", "alias", "mis", "product",
+                                 "importance-bilinear"};
+  for (size_t i = 0; i < std::size(kNamed); ++i)
+    if (name == kNamed[i]) return kColours[i];
+  for (const char* base : {"points-draw-", "points-"}) {
+    if (name.rfind(base, 0) != 0) continue;
+    const double n = std::atof(name.c_str() + std::strlen(base));
+    const double t = std::clamp(std::log2(std::max(n, 1.0)) / 14.0, 0.0, 1.0);  // N from 1 to 16384
+    const bool draw = std::string(base) == "points-draw-";
+    return fmt::format("hsl({},{}%,{:.0f}%)", draw ? 30 : 150, draw ? 55 : 60, 75.0 - 55.0 * t);
+  }
+  return kColours[std::hash<std::string>{}(name) % std::size(kColours)];
+}
+
 std::string escape(const std::string& s) {
   std::string o;
   for (char c : s) o += c == '<' ? std::string("&lt;") : c == '>' ? std::string("&gt;") : c == '&' ? std::string("&amp;") : std::string(1, c);
@@ -41,21 +62,39 @@ std::string pngDataUri(const Image& img) {
   return "data:image/png;base64," + base64(encodePng(img.width, img.height, toneMapImage(img, {})));
 }
 
-// |L(a) - L(ref)| / (L(ref) + 0.05) through a dark-blue, green, yellow, red ramp (0 to 1).
+// The error maps' ramp: dark blue (0), green, yellow, red (1).
+Color errorRamp(float e) {
+  return Color(std::clamp(2.f * e - 0.5f, 0.f, 1.f), std::clamp(e < 0.75f ? 1.6f * e : 4.f * (1.f - e), 0.f, 1.f),
+               std::clamp(0.6f - 1.5f * e, 0.f, 1.f));
+}
+
+// |L(a) - L(ref)| / (L(ref) + 0.05) through errorRamp (0 to 1).
 std::string errorMapDataUri(const Image& a, const Image& ref) {
   std::vector<unsigned char> rgb(size_t(a.width) * a.height * 3);
   for (int y = 0; y < a.height; ++y)
     for (int x = 0; x < a.width; ++x) {
       float la = luminance(a.at(x, y)), lr = luminance(ref.at(x, y));
-      float e = std::clamp(std::fabs(la - lr) / (lr + 0.05f), 0.f, 1.f);
-      float r = std::clamp(2.f * e - 0.5f, 0.f, 1.f), g = std::clamp(e < 0.75f ? 1.6f * e : 4.f * (1.f - e), 0.f, 1.f),
-            b = std::clamp(0.6f - 1.5f * e, 0.f, 1.f);
+      const Color c = errorRamp(std::clamp(std::fabs(la - lr) / (lr + 0.05f), 0.f, 1.f));
       unsigned char* p = &rgb[(size_t(y) * a.width + x) * 3];
-      p[0] = (unsigned char)(r * 255.f);
-      p[1] = (unsigned char)(g * 255.f);
-      p[2] = (unsigned char)(b * 255.f);
+      for (int k = 0; k < 3; ++k) p[k] = (unsigned char)(c[k] * 255.f);
     }
   return "data:image/png;base64," + base64(encodePng(a.width, a.height, rgb));
+}
+
+// The error maps' colour bar: the ramp from 0 to 1 with its ticks, as an SVG element.
+std::string errorColourBar() {
+  std::string o = R"s(<svg xmlns="http://www.w3.org/2000/svg" width="320" height="40" font-family="sans-serif" )s"
+                  R"s(font-size="12"><defs><linearGradient id="errorRamp">)s";
+  for (int i = 0; i <= 8; ++i) {
+    const Color c = errorRamp(float(i) / 8.f);
+    o += fmt::format(R"s(<stop offset="{:.3f}" stop-color="rgb({},{},{})"/>)s", i / 8.0, int(c.x * 255.f),
+                     int(c.y * 255.f), int(c.z * 255.f));
+  }
+  o += R"s(</linearGradient></defs><rect x="10" y="4" width="300" height="14" fill="url(#errorRamp)"/>)s";
+  for (int i = 0; i <= 4; ++i)
+    o += fmt::format(R"s(<text x="{}" y="34" text-anchor="middle">{:g}{}</text>)s", 10 + 75 * i, i / 4.0,
+                     i == 4 ? " or more" : "");
+  return o + "</svg>";
 }
 
 double median(std::vector<double> v) {
@@ -99,7 +138,7 @@ std::string svgLogLogPlot(const std::string& title, const std::string& xLabel, c
   o += fmt::format(R"s(<text x="{}" y="{}" text-anchor="middle">{}</text>)s", L + (W - L - R) / 2, H - 10, escape(xLabel));
   o += fmt::format(R"s(<text x="14" y="{}" transform="rotate(-90 14 {})" text-anchor="middle">{}</text>)s", T + (H - T - B) / 2, T + (H - T - B) / 2, escape(yLabel));
   for (size_t s = 0; s < xs.size(); ++s) {
-    const char* c = kColours[s % 10];
+    const std::string c = seriesColour(names[s]);
     std::string pts;
     for (size_t i = 0; i < xs[s].size(); ++i)
       if (xs[s][i] > 0 && ys[s][i] > 0) pts += fmt::format("{:.1f},{:.1f} ", px(xs[s][i]), py(ys[s][i]));
@@ -243,7 +282,8 @@ std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun
   for (const StudyImage& im : images)
     h += fmt::format("<figure><img src=\"{}\"><figcaption>{} @ {} spp</figcaption></figure>", pngDataUri(im.image),
                      escape(im.strategy), im.spp);
-  h += "</div><h3>Relative error |L - L<sub>ref</sub>| / (L<sub>ref</sub> + 0.05), 0 (blue) to 1 (red)</h3><div>";
+  h += "</div><h3>Relative error |L - L<sub>ref</sub>| / (L<sub>ref</sub> + 0.05), 0 (blue) to 1 (red)</h3>" +
+       errorColourBar() + "<div>";
   for (const StudyImage& im : images)
     h += fmt::format("<figure><img src=\"{}\"><figcaption>{} @ {} spp</figcaption></figure>",
                      errorMapDataUri(im.image, reference), escape(im.strategy), im.spp);

@@ -34,6 +34,43 @@ TEST(StudyReport, Base64AndSvg) {
   EXPECT_NE(svg.find(">a<"), std::string::npos);
 }
 
+namespace {
+// The stroke colour of the polyline of the series drawn `index`-th.
+std::string strokeOf(const std::string& svg, int index) {
+  size_t p = svg.find("<polyline");
+  for (int i = 0; i < index; ++i) p = svg.find("<polyline", p + 1);
+  const size_t s = svg.find("stroke=\"", p) + 8;
+  return svg.substr(s, svg.find('"', s) - s);
+}
+}  // namespace
+
+// A strategy keeps its colour from one report to the next, whatever else the report holds
+// (it once took the colour of its place in the list); the collapsed map's sizes differ.
+TEST(StudyReport, AStrategyKeepsItsColourAcrossReports) {
+  const std::string one = svgLogLogPlot("t", "x", "y", {"uniform", "product"}, {{1, 4}, {1, 4}}, {{1, 0.5}, {1, 0.4}});
+  const std::string two = svgLogLogPlot("t", "x", "y", {"product"}, {{1, 4}}, {{1, 0.4}});
+  EXPECT_EQ(strokeOf(one, 1), strokeOf(two, 0));
+  EXPECT_NE(strokeOf(one, 0), strokeOf(one, 1));
+  const std::string points =
+      svgLogLogPlot("t", "x", "y", {"points-16", "points-256", "points-draw-16"}, {{1}, {1}, {1}}, {{1}, {1}, {1}});
+  EXPECT_NE(strokeOf(points, 0), strokeOf(points, 1));
+  EXPECT_NE(strokeOf(points, 0), strokeOf(points, 2));
+}
+
+// The error maps come with their colour bar.
+TEST(StudyReport, TheErrorMapsHaveAColourBar) {
+  Image ref(4, 4), img(4, 4);
+  for (float& v : ref.rgb) v = 0.5f;
+  const std::string html = studyReportHtml("scene.xml", {{"uniform", 1, 0.0, 0, 0.1, 0.2, 0.3, 0.4}}, ref,
+                                           {{"uniform", 1, img}}, {"uniform"});
+  const size_t heading = html.find("Relative error");
+  ASSERT_NE(heading, std::string::npos);
+  const size_t bar = html.find("linearGradient id=\"errorRamp\"", heading);
+  ASSERT_NE(bar, std::string::npos);
+  EXPECT_LT(bar, html.find("<img", heading)) << "the bar comes before the maps";
+  EXPECT_NE(html.find("1 or more", bar), std::string::npos);
+}
+
 // With two or more points-N strategies the report plots RMSE against N for each budget and
 // says, per budget, which collapsed map is best and what it beats and loses to.
 TEST(StudyReport, TheCollapsedMapSectionStatesTheCrossover) {
