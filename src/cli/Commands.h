@@ -15,6 +15,7 @@ void addRenderCommand(CLI::App& app);
 void addPhotonsCommand(CLI::App& app);
 void addStudyCommand(CLI::App& app);
 void addCompareCommand(CLI::App& app);
+void addImageCommands(CLI::App& app);
 void addViewCommand(CLI::App& app);
 
 // Option checks whose errors read as sentences ("--spp must be at least 1, not 0"); CLI11's

@@ -53,7 +53,7 @@ void runCompare(const CompareArgs& a) {
   }
   // What the columns are, on stderr so that the table on stdout stays one row an image for scripts.
   fmt::print(stderr,
-             "mean: of the pixels' luminance; RMSE: over every pixel and channel; relMSE: the mean of (a - r)^2 / "
+             "mean: of every pixel and channel; RMSE: over every pixel and channel; relMSE: the mean of (a - r)^2 / "
              "(r^2 + 0.01); worst-region: the largest RMSE of a 4 x 4 grid of regions (local error); non-finite: NaN "
              "or infinite values\n");
 }

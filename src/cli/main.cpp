@@ -69,6 +69,7 @@ int main(int argc, char** argv) {
   envgi::cli::addPhotonsCommand(app);
   envgi::cli::addStudyCommand(app);
   envgi::cli::addCompareCommand(app);
+  envgi::cli::addImageCommands(app);
   envgi::cli::addViewCommand(app);
   try {
     app.parse(argc, argv);

@@ -10,6 +10,7 @@
 #include <map>
 #include <set>
 
+#include "image/FalseColour.h"
 #include "study/ErrorMetrics.h"
 
 namespace envgi {
@@ -62,19 +63,12 @@ std::string pngDataUri(const Image& img) {
   return "data:image/png;base64," + base64(encodePng(img.width, img.height, toneMapImage(img, {})));
 }
 
-// The error maps' ramp: dark blue (0), green, yellow, red (1).
-Color errorRamp(float e) {
-  return Color(std::clamp(2.f * e - 0.5f, 0.f, 1.f), std::clamp(e < 0.75f ? 1.6f * e : 4.f * (1.f - e), 0.f, 1.f),
-               std::clamp(0.6f - 1.5f * e, 0.f, 1.f));
-}
-
 // |L(a) - L(ref)| / (L(ref) + 0.05) through errorRamp (0 to 1).
 std::string errorMapDataUri(const Image& a, const Image& ref) {
   std::vector<unsigned char> rgb(size_t(a.width) * a.height * 3);
   for (int y = 0; y < a.height; ++y)
     for (int x = 0; x < a.width; ++x) {
-      float la = luminance(a.at(x, y)), lr = luminance(ref.at(x, y));
-      const Color c = errorRamp(std::clamp(std::fabs(la - lr) / (lr + 0.05f), 0.f, 1.f));
+      const Color c = errorRamp(relativeLuminanceError(a.at(x, y), ref.at(x, y)));
       unsigned char* p = &rgb[(size_t(y) * a.width + x) * 3];
       for (int k = 0; k < 3; ++k) p[k] = (unsigned char)(c[k] * 255.f);
     }

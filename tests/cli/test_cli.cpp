@@ -303,3 +303,52 @@ TEST(CliEnvmap, AnOutputNamedAsTheWrongKindOfFileIsRefused) {
     EXPECT_EQ(r.code, 0) << ok << ": " << r.output;
   }
 }
+
+// `envgi image`: info counts what compare once had to be run to see (means, range, NaN and
+// infinite values), convert writes another format with exposure, diff draws the relative error
+// in the study's colours and prints compare's figures.
+TEST(CliImage, InfoConvertAndDiff) {
+  TempDir d;
+  envgi::Image img(4, 2);
+  for (int x = 0; x < 4; ++x) img.set(x, 0, envgi::Color(0.25f * float(x)));
+  img.set(0, 1, envgi::Color(0.5f));
+  img.rgb[3 * 5] = NAN;  // pixel (1, 1)'s red
+  img.rgb[3 * 6 + 1] = INFINITY;
+  envgi::saveImage(img, d.file("a.pfm"));
+  CliResult info = runCli("image info " + d.file("a.pfm"));
+  ASSERT_EQ(info.code, 0) << info.output;
+  EXPECT_NE(info.output.find("size:           4 x 2"), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("NaN values:     1\ninfinite:       1\n"), std::string::npos) << info.output;
+  // The six all-finite pixels: 0, 0.25, 0.5, 0.75, 0.5 and two zeros.
+  EXPECT_NE(info.output.find(fmt::format("mean (RGB):     {:.6g}", 2.0 / 6.0)), std::string::npos) << info.output;
+  EXPECT_NE(info.output.find("max (RGB):      0.75 0.75 0.75"), std::string::npos) << info.output;
+
+  envgi::Image grey(2, 2);
+  for (float& v : grey.rgb) v = 0.25f;
+  envgi::saveImage(grey, d.file("grey.exr"));
+  CliResult convert = runCli("image convert " + d.file("grey.exr") + " -o " + d.file("grey.png") + " --exposure 2");
+  ASSERT_EQ(convert.code, 0) << convert.output;
+  const envgi::Image png = envgi::loadImage(d.file("grey.png"));
+  EXPECT_NEAR(png.at(0, 0).x, 1.0f, 0.01f) << "0.25 at +2 stops is 1";
+  EXPECT_NE(runCli("image convert " + d.file("grey.exr") + " -o " + d.file("grey.txt")).code, 0);
+
+  // Against itself the picture is dark blue (the ramp at 0) and the RMSE 0; against a brighter
+  // copy it is red where the error is 1 or more.
+  CliResult same = runCli("image diff " + d.file("grey.exr") + " " + d.file("grey.exr") + " -o " + d.file("same.png"));
+  ASSERT_EQ(same.code, 0) << same.output;
+  EXPECT_NE(same.output.find("RMSE 0,"), std::string::npos) << same.output;
+  const envgi::Image blue = envgi::loadImage(d.file("same.png"), false);
+  EXPECT_NEAR(blue.at(1, 1).z, 0.6f, 0.01f);
+  EXPECT_EQ(blue.at(1, 1).x, 0.f);
+  for (float& v : grey.rgb) v = 2.f;
+  envgi::saveImage(grey, d.file("bright.exr"));
+  ASSERT_EQ(runCli("image diff " + d.file("grey.exr") + " " + d.file("bright.exr") + " -o " + d.file("red.png")).code, 0);
+  const envgi::Image red = envgi::loadImage(d.file("red.png"), false);
+  EXPECT_NEAR(red.at(0, 0).x, 1.f, 0.01f);
+  EXPECT_NEAR(red.at(0, 0).y, 0.f, 0.01f);
+  // Images of two sizes: one error line naming both.
+  CliResult sizes = runCli("image diff " + d.file("grey.exr") + " " + d.file("a.pfm") + " -o " + d.file("x.png"));
+  EXPECT_EQ(sizes.code, 1) << sizes.output;
+  EXPECT_NE(sizes.output.find("envgi: error:"), std::string::npos) << sizes.output;
+  EXPECT_FALSE(fs::exists(d.file("x.png")));
+}

@@ -1,0 +1,23 @@
+// The false-colour ramp envgi draws errors with (the study's error maps, `envgi image diff`):
+// dark blue at 0, then green, yellow and red at 1.
+#pragma once
+
+#include <algorithm>
+
+#include "core/Vec.h"
+
+namespace envgi {
+
+inline Color errorRamp(float e) {
+  return Color(std::clamp(2.f * e - 0.5f, 0.f, 1.f), std::clamp(e < 0.75f ? 1.6f * e : 4.f * (1.f - e), 0.f, 1.f),
+               std::clamp(0.6f - 1.5f * e, 0.f, 1.f));
+}
+
+// A pixel's relative error |L(a) - L(ref)| / (L(ref) + 0.05), clamped to [0, 1]: 0.05 keeps black
+// reference pixels from dominating.
+inline float relativeLuminanceError(const Color& a, const Color& ref) {
+  const float la = luminance(a), lr = luminance(ref);
+  return std::clamp(std::fabs(la - lr) / (lr + 0.05f), 0.f, 1.f);
+}
+
+}  // namespace envgi
