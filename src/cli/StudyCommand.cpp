@@ -396,7 +396,17 @@ void runStudy(const StudyArgs& a) {
   }
   writeFileAtomically(a.out + "/results.csv", csv);
   writeFileAtomically(a.out + "/results.json", nlohmann::json{{"scene", a.scene}, {"runs", all}}.dump(2));
-  writeFileAtomically(a.out + "/report.html", studyReportHtml(a.scene, runs, ref, images, strategies));
+  std::string defines;
+  for (const auto& [k, v] : parseDefines(a.defines)) defines += (defines.empty() ? "" : ", ") + k + "=" + v;
+  std::vector<std::pair<std::string, std::string>> howMade = {
+      {"reference", studySettings(a)["reference"].get<std::string>()},
+      {"integrator", a.integrator},
+      {"image", fmt::format("{} x {}", ref.width, ref.height)},
+      {"-D values", defines.empty() ? "none" : defines},
+      {"seeds", std::to_string(a.seeds) + " (the tables give the median)"}};
+  if (a.noiseThreshold > 0.f)
+    howMade.push_back({"adaptive sampling", fmt::format("noise threshold {:g} from {} spp", a.noiseThreshold, a.minSpp)});
+  writeFileAtomically(a.out + "/report.html", studyReportHtml(a.scene, runs, ref, images, strategies, howMade));
   spdlog::info("study: {} runs ({} already done) in {:.1f} s; wrote {}/report.html, results.csv, results.json",
                runs.size(), skipped,
                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),

@@ -214,7 +214,8 @@ std::string collapsedMapSection(const std::vector<StudyRun>& runs, const std::ve
 }  // namespace
 
 std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun>& runs, const Image& reference,
-                            const std::vector<StudyImage>& images, const std::vector<std::string>& strategies) {
+                            const std::vector<StudyImage>& images, const std::vector<std::string>& strategies,
+                            const std::vector<std::pair<std::string, std::string>>& settings) {
   // Median over seeds for each (strategy, spp) and (strategy, time budget).
   std::map<std::pair<std::string, int>, std::vector<double>> bySpp, secBySpp, takenBySpp;
   std::map<std::pair<std::string, double>, std::vector<double>> byTime, secByTime;
@@ -254,6 +255,11 @@ std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun
                   "td,th{border:1px solid #ccc;padding:4px 8px;text-align:right}figure{display:inline-block;margin:6px}"
                   "figcaption{font-size:12px;text-align:center}img{image-rendering:pixelated;width:192px}</style></head><body>";
   h += "<h1>Strategies compared: " + escape(scene) + "</h1>";
+  if (!settings.empty()) {
+    h += "<table>";
+    for (const auto& [name, value] : settings) h += "<tr><th>" + escape(name) + "</th><td>" + escape(value) + "</td></tr>";
+    h += "</table>";
+  }
   // Times (and so the equal-time runs) are the device's: say which rendered the runs.
   std::set<std::string> devices;
   for (const StudyRun& r : runs) devices.insert(r.device.empty() ? "not recorded" : r.device);

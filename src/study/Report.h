@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "image/Image.h"
@@ -36,7 +37,10 @@ std::string svgLogLogPlot(const std::string& title, const std::string& xLabel, c
 // Bytes as base64 (data URIs for images inside the page).
 std::string base64(const std::string& bytes);
 
+// settings: how the study was made (the reference, -D values, size, seeds...), name and value,
+// shown under the title so that a report read alone says what it measured.
 std::string studyReportHtml(const std::string& scene, const std::vector<StudyRun>& runs, const Image& reference,
-                            const std::vector<StudyImage>& images, const std::vector<std::string>& strategies);
+                            const std::vector<StudyImage>& images, const std::vector<std::string>& strategies,
+                            const std::vector<std::pair<std::string, std::string>>& settings = {});
 
 }  // namespace envgi

@@ -55,6 +55,11 @@ TEST(StudyCli, WritesResultsAndResumes) {
   std::string html = slurp(out + "/report.html");
   EXPECT_NE(html.find("<svg"), std::string::npos);
   EXPECT_NE(html.find("Rendered on: cpu."), std::string::npos);
+  // How the study was made, read from the report alone.
+  EXPECT_NE(html.find("<th>reference</th><td>rendered with mis at 256 spp</td>"), std::string::npos);
+  EXPECT_NE(html.find("<th>image</th><td>24 x 24</td>"), std::string::npos);
+  EXPECT_NE(html.find("<th>-D values</th><td>res=24</td>"), std::string::npos);
+  EXPECT_NE(html.find("<th>seeds</th><td>1 "), std::string::npos);
   EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
   // Re-run: every run is found done.
   CliResult again = runCli(args);
