@@ -138,7 +138,8 @@ void runRender(const RenderArgs& a) {
                  "points-draw do)",
                  scene.integrator.env.strategy);
   // An emitter envgi ignored (the log said which) leaves a black image: say so, as photons does.
-  if (!scene.env && scene.lightCount() == 0 && scene.deltaLights.empty() && !a.aovGiven)
+  // AOVs (given or the scene's own aov integrator) need no light.
+  if (!scene.env && scene.lightCount() == 0 && scene.deltaLights.empty() && scene.aovs.empty())
     throw std::runtime_error("the scene emits no light (no environment map, area light, or directional, point or spot "
                              "light envgi renders): its image would be black");
   bool cuda = chooseCuda(a.device);
