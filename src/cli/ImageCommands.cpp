@@ -75,13 +75,8 @@ void runDiff(const ImageArgs& a) {
   requireOutputExtension(a.output, {".png"}, "diff picture");
   const Image img = loadImage(a.input), ref = loadImage(a.reference);
   const ImageError e = imageError(img, ref);  // throws, naming both sizes, where they differ
-  std::vector<unsigned char> rgb(size_t(img.width) * img.height * 3);
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) {
-      const Color c = errorRamp(relativeLuminanceError(img.at(x, y), ref.at(x, y)));
-      for (int k = 0; k < 3; ++k) rgb[(size_t(y) * img.width + x) * 3 + k] = (unsigned char)(c[k] * 255.f);
-    }
-  writeFileAtomically(a.output, encodePng(img.width, img.height, rgb));  // the ramp's own codes, no tone curve
+  // The ramp's own codes, with no tone curve.
+  writeFileAtomically(a.output, encodePng(img.width, img.height, errorMapRgb(img, ref)));
   fmt::print("RMSE {:.6g}, relMSE {:.6g}, worst region {:.6g}, non-finite {}\n", e.rmse, e.relMse, e.worstRegionRmse,
              nonFiniteValues(img));
   fmt::print("wrote {}: |L - L_ref| / (L_ref + 0.05), 0 (dark blue) to 1 or more (red)\n", a.output);

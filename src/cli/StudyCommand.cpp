@@ -173,6 +173,12 @@ StudyRun fromJson(const nlohmann::json& j) {
   return r;
 }
 
+// How the reference is made: rendered here, or the file given.
+std::string referenceDescription(const StudyArgs& a) {
+  return a.reference.empty() ? fmt::format("rendered with mis at {} spp", a.referenceSpp)
+                             : fs::absolute(a.reference).lexically_normal().string();
+}
+
 // What the runs in the output folder are made with: the scene file (name and a hash of its
 // text), the -D values, the integrator and the reference. A re-run reuses the folder's runs only
 // when these are the same, so old runs never mix with a changed scene or a new reference.
@@ -187,8 +193,7 @@ nlohmann::json studySettings(const StudyArgs& a) {
                       {"scene_fnv1a", fmt::format("{:016x}", h)},
                       {"defines", defines},
                       {"integrator", a.integrator},
-                      {"reference", a.reference.empty() ? fmt::format("rendered with mis at {} spp", a.referenceSpp)
-                                                        : fs::absolute(a.reference).lexically_normal().string()}};
+                      {"reference", referenceDescription(a)}};
   // Recorded only when on, so that a folder made before adaptive sampling reads as it was.
   if (a.noiseThreshold > 0.f) s["adaptive_sampling"] = {{"noise_threshold", a.noiseThreshold}, {"min_spp", a.minSpp}};
   return s;
@@ -399,7 +404,7 @@ void runStudy(const StudyArgs& a) {
   std::string defines;
   for (const auto& [k, v] : parseDefines(a.defines)) defines += (defines.empty() ? "" : ", ") + k + "=" + v;
   std::vector<std::pair<std::string, std::string>> howMade = {
-      {"reference", studySettings(a)["reference"].get<std::string>()},
+      {"reference", referenceDescription(a)},
       {"integrator", a.integrator},
       {"image", fmt::format("{} x {}", ref.width, ref.height)},
       {"-D values", defines.empty() ? "none" : defines},

@@ -2,6 +2,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <cstdio>
 #include <exception>
 #include <new>
@@ -23,9 +24,9 @@ std::string nearestNameHint(CLI::App& app, int argc, char** argv) {
   for (int i = 1; i < argc && !command; ++i) {
     const std::string word = argv[i];
     if (word.empty() || word[0] == '-') continue;
-    for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
-      if (sub->get_name() == word) command = sub;
-    if (!command) return "; unknown command '" + word + "'" + envgi::didYouMean(word, commands);
+    if (std::find(commands.begin(), commands.end(), word) == commands.end())
+      return "; unknown command '" + word + "'" + envgi::didYouMean(word, commands);
+    command = app.get_subcommand(word);
   }
   if (!command) return "";
   std::vector<std::string> options;

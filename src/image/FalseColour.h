@@ -3,8 +3,10 @@
 #pragma once
 
 #include <algorithm>
+#include <vector>
 
 #include "core/Vec.h"
+#include "image/Image.h"
 
 namespace envgi {
 
@@ -18,6 +20,17 @@ inline Color errorRamp(float e) {
 inline float relativeLuminanceError(const Color& a, const Color& ref) {
   const float la = luminance(a), lr = luminance(ref);
   return std::clamp(std::fabs(la - lr) / (lr + 0.05f), 0.f, 1.f);
+}
+
+// The 8-bit RGB picture of a's relative error against ref, pixel by pixel through errorRamp.
+inline std::vector<unsigned char> errorMapRgb(const Image& a, const Image& ref) {
+  std::vector<unsigned char> rgb(size_t(a.width) * a.height * 3);
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) {
+      const Color c = errorRamp(relativeLuminanceError(a.at(x, y), ref.at(x, y)));
+      for (int k = 0; k < 3; ++k) rgb[(size_t(y) * a.width + x) * 3 + k] = (unsigned char)(c[k] * 255.f);
+    }
+  return rgb;
 }
 
 }  // namespace envgi

@@ -65,14 +65,7 @@ std::string pngDataUri(const Image& img) {
 
 // |L(a) - L(ref)| / (L(ref) + 0.05) through errorRamp (0 to 1).
 std::string errorMapDataUri(const Image& a, const Image& ref) {
-  std::vector<unsigned char> rgb(size_t(a.width) * a.height * 3);
-  for (int y = 0; y < a.height; ++y)
-    for (int x = 0; x < a.width; ++x) {
-      const Color c = errorRamp(relativeLuminanceError(a.at(x, y), ref.at(x, y)));
-      unsigned char* p = &rgb[(size_t(y) * a.width + x) * 3];
-      for (int k = 0; k < 3; ++k) p[k] = (unsigned char)(c[k] * 255.f);
-    }
-  return "data:image/png;base64," + base64(encodePng(a.width, a.height, rgb));
+  return "data:image/png;base64," + base64(encodePng(a.width, a.height, errorMapRgb(a, ref)));
 }
 
 // The error maps' colour bar: the ramp from 0 to 1 with its ticks, as an SVG element.
