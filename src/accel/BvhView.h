@@ -238,7 +238,7 @@ struct BvhTracer {
   ENVGI_HD bool intersect(const Ray& r, Hit* h) const { return bvh.intersect(r, h); }
   ENVGI_HD bool occluded(Vec3f o, Vec3f d, float tMax) const { return bvh.occluded(o, d, tMax); }
   ENVGI_HD bool intersectSurface(const Ray& r, Hit* h) const { return bvh.intersectSurface(r, h); }
-  // A round of coherent rays (renderTileByBounce's camera rays), one at a time here.
+  // A round of coherent rays (the tile wavefront's camera rays), one at a time here.
   template <class Rays, class Out>
   void intersectCoherent(int n, Rays rays, Out out) const {
     for (int i = 0; i < n; ++i) {
@@ -247,7 +247,7 @@ struct BvhTracer {
       out(i, found, h);
     }
   }
-  // A round's bounce rays and shadow rays (renderTileByBounce), one at a time here too.
+  // A round's bounce rays and shadow rays (the tile wavefront), one at a time here too.
   template <class Rays, class Out>
   void intersectMany(int n, Rays rays, Out out) const { intersectCoherent(n, rays, out); }
   template <class Rays, class Out>

@@ -77,7 +77,7 @@ struct ProductDraw {
   bool placed = false;
   Color radiance;
   // Its world direction (EnvironmentMapView::fromLocal(uvToDir(uv))), worked out ahead (the
-  // CPU's renderTileByBounce, for the BSDF's value there in lanes).
+  // CPU's tile wavefront, for the BSDF's value there in lanes).
   bool directed = false;
   Vec3f dir;
   ENVGI_HD bool isFor(Vec2f u2, Vec3f n2) const {

@@ -345,7 +345,7 @@ struct EnvironmentMapView {
   // Draws a direction; `normal` (world space) is used by the cosine and product strategies
   // only. A zero normal (a BSDF that also transmits) means the whole sphere: the cosine strategy
   // then samples uniformly and the product strategy by Algorithm 1's density. drawn: a product
-  // draw made ahead (CPU: renderTileByBounce's walk), taken where it is for this u and normal.
+  // draw made ahead (CPU: the tile wavefront's walk), taken where it is for this u and normal.
   ENVGI_HD EnvSample sample(EnvStrategy s, Vec2f u, Vec3f normal = Vec3f(0.f, 1.f, 0.f),
                             const ProductDraw* drawn = nullptr) const {
     EnvSample out;

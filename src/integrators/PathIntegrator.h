@@ -50,7 +50,7 @@ ENVGI_HD inline BounceLayout bounceLayout(const PathParams& pp) {
   return pp.lightSample ? BounceLayout{1u, 6u} : BounceLayout{1u, 1u};
 }
 
-// What an executor works out for a hit before shading it (CPU: renderTileByBounce, which walks
+// What an executor works out for a hit before shading it (CPU: the tile wavefront, which walks
 // a round's map draws level by level first): the interaction, the light's and the BSDF's 2D
 // draws where it drew them in lanes (at bounceLayout's offsets), and work done with them.
 // pathShade then takes them instead of redoing them.
@@ -202,7 +202,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
 }
 
 // What pathShade will read from the map for a path whose ray escaped and meets the map at uv,
-// asked for ahead (CPU only: renderTileByBounce prefetches a round's escapes before shading it).
+// asked for ahead (CPU only: the tile wavefront prefetches a round's escapes before shading it).
 inline void pathPrefetchEscape(const SceneView& sc, const PathState& st, const PathParams& pp, Vec2f uv) {
   if (sc.hasEnvironment && !st.prevDelta && envSeenByBsdfSampling(pp.envStrategy, false))
     sc.env.prefetchEvalWithPdf(pp.envStrategy, uv, st.prevAxis);

@@ -1,5 +1,5 @@
 // Runs render passes on the CPU: oneTBB over image tiles, each tile a bounce at a time
-// (renderTileByBounce) for the path tracer and for direct with at most one light and one BSDF
+// (renderTileWavefront) for the path tracer and for direct with at most one light and one BSDF
 // sample (a one-bounce path), each pixel through renderPixel for the others; both
 // run the integrator bodies the CUDA kernels run. Deterministic whatever the thread count (no
 // shared sums), and the same sums either way up to Embree's packets' rounding of camera hits.
@@ -18,6 +18,7 @@
 
 #include "render/PassExecutor.h"
 #include "render/PixelKernel.h"
+#include "wavefront/TileWavefront.h"
 #include "render/WorkerThreads.h"
 
 namespace envgi {
@@ -44,7 +45,7 @@ class CpuExecutor final : public PassExecutor {
 
   // The device alone: the study's results and report group runs by it, whichever body ran.
   std::string deviceName() const override { return name_; }
-  // Whether passes run a tile a bounce at a time (renderTileByBounce) rather than per pixel.
+  // Whether passes run a tile as a wavefront (renderTileWavefront) rather than per pixel.
   bool runsByBounce() const { return byBounce_; }
 
   void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
@@ -76,7 +77,7 @@ class CpuExecutor final : public PassExecutor {
             for (int x = x0; x < x1; ++x) pixels += fv.takesSamples(size_t(y) * size_t(W) + size_t(x));
           if constexpr (RunsByBounce<Integrator>::value) {
             if (byBounce_) {
-              renderTileByBounce(cam_, seq_, integrate_, x0, y0, x1, y1, s0, s1, fv, &batch_.local(), &pc);
+              renderTileWavefront(cam_, seq_, integrate_, x0, y0, x1, y1, s0, s1, fv, &batch_.local(), &pc);
               progress.add(pixels * size_t(s1 - s0));
               continue;
             }
@@ -139,10 +140,10 @@ class CpuExecutor final : public PassExecutor {
   std::vector<unsigned char> active_;  // empty: every pixel takes samples
   const std::atomic<bool>* cancel_ = nullptr;  // watchCancel's
   std::vector<unsigned char> took_;  // the last pass's pixels where Ctrl-C cut it; else empty
-  // renderTileByBounce's room, one per thread. In memory from the standard allocator, not TBB's
+  // renderTileWavefront's room, one per thread. In memory from the standard allocator, not TBB's
   // scalable one (mmap'd, unseen by LeakSanitizer, which then took each batch's arrays for leaks
   // while the executor lived: a false report in the viewer's fuzzer).
-  tbb::enumerable_thread_specific<TileBatch, std::allocator<TileBatch>> batch_;
+  tbb::enumerable_thread_specific<TileQueues, std::allocator<TileQueues>> batch_;
 };
 
 }  // namespace envgi

@@ -6,9 +6,9 @@
 
 #include <cstring>
 
-#include "render/RoundLanes.h"
+#include "wavefront/RoundLanes.h"
 #include "materials/BsdfFactory.h"
-#include "render/PixelKernel.h"
+#include "wavefront/TileWavefront.h"
 #include "sampling/Pcg32.h"
 
 using namespace envgi;

@@ -1,4 +1,4 @@
-#include "render/RoundLanes.h"
+#include "wavefront/RoundLanes.h"
 
 namespace envgi {
 

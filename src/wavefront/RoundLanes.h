@@ -1,4 +1,4 @@
-// The lanes of a tile's round (renderTileByBounce): work done a step at a time across the
+// The lanes of a tile's round (wavefront/TileWavefront.h): work done a step at a time across the
 // round's paths, each step a loop over plain arrays that the compiler vectorises. The camera
 // round's samples (the pixels' hashes, their Sobol draws, the filter's offsets, the rays), and
 // in every round, where the rays that escaped meet the map. One sample at a time, the camera's
