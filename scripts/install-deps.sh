@@ -14,6 +14,8 @@ PKGS=(
   xz-utils
   # The viewer's browser test drives a real headless Chromium.
   chromium
+  # import envgi: the module (pybind11) for Debian's Python, and what its tests use.
+  python3-dev pybind11-dev python3-numpy python3-pytest
 )
 
 missing=()

@@ -7,18 +7,27 @@
 
 namespace envgi {
 
-Progress::Progress(size_t total, bool enabled, double timeLimit)
+Progress::Progress(size_t total, bool enabled, double timeLimit, std::atomic<float>* fraction)
     : total_(total > 0 ? total : 1),
       enabled_(enabled),
       tty_(::isatty(2)),
       timeLimit_(timeLimit),
-      start_(std::chrono::steady_clock::now()) {}
+      start_(std::chrono::steady_clock::now()),
+      fraction_(fraction) {
+  if (fraction_) fraction_->store(0.f, std::memory_order_relaxed);
+}
 
 void Progress::add(size_t n) {
-  if (!enabled_) return;
+  if (!enabled_ && !fraction_) return;
   size_t done = done_.fetch_add(n) + n;
   std::lock_guard<std::mutex> lock(m_);
-  draw(done);
+  store(done);
+  if (enabled_) draw(done);
+}
+
+// Under m_.
+void Progress::store(size_t done) {
+  if (fraction_) fraction_->store(float(std::min(1.0, double(done) / double(total_))), std::memory_order_relaxed);
 }
 
 // Under m_.
@@ -44,6 +53,7 @@ void Progress::shrinkTotal(size_t n) {
   std::lock_guard<std::mutex> lock(m_);
   size_t done = done_.load();
   total_ = std::max<size_t>({total_ > n ? total_ - n : 0, done, 1});
+  store(done);
   if (enabled_ && n > 0) draw(done);  // the bar jumps forward; at the end, its last line
 }
 

@@ -319,7 +319,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   // Where the pass that starts at s0 ends, one pass at a time: a list of them all (33 million
   // for --spp 2147483647 and a time limit) and s0 + n in int had overflowed into a hang.
   auto passEnd = [&](int s0) { return int(std::min<int64_t>(spp, int64_t(s0) + std::clamp(s0, 1, maxPass))); };
-  Progress progress(size_t(W) * H * spp, opts.progress, opts.timeLimitSeconds);
+  Progress progress(size_t(W) * H * spp, opts.progress, opts.timeLimitSeconds, opts.progressFraction);
   PassCounters counters;
   FilmSums film;
   auto t0 = Clock::now();

@@ -28,6 +28,9 @@ struct RenderOptions {
   int threads = 0;          // 0: all cores
   int tileSize = 16;
   bool progress = true;
+  // Where set, the share of the render done (0 to 1), kept current whether or not the bar is
+  // drawn: for a caller's own progress display.
+  std::atomic<float>* progressFraction = nullptr;
   double checkpointSeconds = 60.0;  // write the image so far at most this often (0: never)
   // Called with the mean image of the passes done so far (checkpoints).
   std::function<void(const Image&, int sppDone)> checkpoint;

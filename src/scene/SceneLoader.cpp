@@ -49,11 +49,17 @@ class Loader {
 
   void loadFile(const std::string& path, int depth) {
     if (depth > 16) throw std::runtime_error(path + ": includes nested too deeply (a cycle?)");
-    auto src = std::make_unique<SourceFile>();
-    src->path = path;
     std::ifstream f(path, std::ios::binary);
     if (!f) throw std::runtime_error("cannot open scene file '" + path + "'");
-    src->text.assign((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    loadText(path, std::string((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>()), depth);
+  }
+
+  // XML text read as the file `path` (its name in messages, its folder the base of relative
+  // file names).
+  void loadText(const std::string& path, std::string text, int depth) {
+    auto src = std::make_unique<SourceFile>();
+    src->path = path;
+    src->text = std::move(text);
     auto doc = std::make_unique<pugi::xml_document>();
     pugi::xml_parse_result r = doc->load_buffer(src->text.data(), src->text.size());
     if (!r) throw std::runtime_error(fmt::format("{}:{}: XML error: {}", path, src->lineOf(r.offset), r.description()));
@@ -1461,6 +1467,13 @@ void loadScene(const std::string& path, const std::map<std::string, std::string>
   loader.loadFile(path, 0);
   loader.finish();
   scene.sourcePath = path;
+  scene.finalize();
+}
+
+void loadSceneString(const std::string& xml, const std::map<std::string, std::string>& defines, Scene& scene) {
+  Loader loader(scene, defines);
+  loader.loadText(kSceneStringName, xml, 0);
+  loader.finish();
   scene.finalize();
 }
 
