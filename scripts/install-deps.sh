@@ -16,6 +16,8 @@ PKGS=(
   chromium
   # import envgi: the module (pybind11) for Debian's Python, and what its tests use.
   python3-dev pybind11-dev python3-numpy python3-pytest
+  # The example notebook (examples/strategies.ipynb) plots with matplotlib.
+  python3-matplotlib
 )
 
 missing=()
