@@ -59,7 +59,7 @@ class EmbreeAccel {
 
   // intersect() for n coherent rays (rays(i) the i-th, out(i, found, hit) its answer) in
   // Embree's 16-wide packets, which share traversal steps: a tile's camera rays, in 4 x 4
-  // blocks, in 0.83x the time of one at a time (docs/performance.md). The hits are
+  // blocks, in 0.83x the time of one at a time. The hits are
   // intersect()'s: the same primitive, u and v to the bit, t within an ulp or two (the packet
   // kernels compute it their own way).
   template <class Rays, class Out>
@@ -103,7 +103,7 @@ class EmbreeAccel {
 
   // intersect() for n rays that need not be coherent (a round's bounce rays), through Embree's
   // stream call (rtcIntersect1M) in chunks of kStreamChunk: it traces a stream faster than one
-  // call a ray (docs/performance.md). The hits are intersect()'s, t to an ulp or two.
+  // call a ray. The hits are intersect()'s, t to an ulp or two.
   template <class Rays, class Out>
   void intersectMany(int n, Rays rays, Out out) const {
     RTCRayHit rh[kStreamChunk];
@@ -156,7 +156,7 @@ class EmbreeAccel {
 
   // Embree's ray for envgi's, written in place field by field (the benchmarks' plain loops use
   // it too: building one apart and copying it whole into a stream made Embree's loop over that
-  // stream 15-20% slower, docs/performance.md).
+  // stream 15-20% slower).
   static void fillRay(const Ray& ray, RTCRay& r) {
     r.org_x = ray.o.x;
     r.org_y = ray.o.y;
@@ -191,7 +191,7 @@ class EmbreeAccel {
 
  private:
   // Rays per stream call: the bench's shadow rays took 0.80x the one-ray time in chunks of 64
-  // and 0.68x in chunks of 256 (docs/performance.md); a tile of 16 x 16 has 256 paths.
+  // and 0.68x in chunks of 256; a tile of 16 x 16 has 256 paths.
   static constexpr int kStreamChunk = 256;
 
   // A context for a stream whose k-th ray is given[k], with RTCRay::id k (the mask filter reads

@@ -1,5 +1,5 @@
 // atan2 as a polynomial: the environment map turns every escaping ray into (u, v) with two
-// atan2 calls, and libm's atan2f was 4.5% of a path-traced frame (docs/performance.md).
+// atan2 calls, and libm's atan2f was 4.5% of a path-traced frame.
 #pragma once
 
 #include <cmath>

@@ -194,7 +194,7 @@ struct EnvironmentMapView {
   // x, each by inverting a piecewise-linear cdf, so that stratified (u1, u2) stay stratified.
   // With the pixel chosen by the lookup's average over it, the density is then proportional to
   // the lookup itself, as Mitsuba's piecewise-bilinear warp is; a pixel-constant density is
-  // not, next to a small sun (docs/performance.md, "A low sun").
+  // not, next to a small sun.
   // *rel: its density at the point, as densityInPixel gives it, from the same lattice.
   ENVGI_HD Vec2f warpInPixel(const PixelPoint& p, float* rel) const {
     return warpInPixelIn(texels, width, height, p, rel);

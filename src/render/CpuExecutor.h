@@ -35,8 +35,7 @@ class CpuExecutor final : public PassExecutor {
     if (keepVariance) film_.sumSqLum.assign(film_.sum.size(), 0.0);
     if (cam.filter.hasNegativeLobes()) film_.weightSum.assign(film_.sum.size(), 0.f);
     if constexpr (RunsByBounce<Integrator>::value) {
-      // A bounce at a time unless ENVGI_CPU_BY_BOUNCE=0 asks for renderPixel (for A/B timings:
-      // docs/performance.md); the film is the same either way but for the last bits of the
+      // A bounce at a time unless ENVGI_CPU_BY_BOUNCE=0 asks for renderPixel (for A/B timings); the film is the same either way but for the last bits of the
       // camera rays' hit distances, which Embree's packets compute in their own way.
       const char* e = std::getenv("ENVGI_CPU_BY_BOUNCE");
       byBounce_ = integrate_.shadesAfterTrace() && !(e && std::strcmp(e, "0") == 0);

@@ -2,7 +2,7 @@
 // round's paths, each step a loop over plain arrays that the compiler vectorises. The camera
 // round's samples (the pixels' hashes, their Sobol draws, the filter's offsets, the rays), and
 // in every round, where the rays that escaped meet the map. One sample at a time, the camera's
-// share was a third of the time outside Embree on the buddha bench (docs/performance.md).
+// share was a third of the time outside Embree on the buddha bench.
 // Each step calls the function the one-sample path calls (sobolDraw2D, Camera::pinholeRay,
 // EnvironmentMapView::dirToUV), so rays and draws are the same to the bit: a lane does each
 // float operation as the scalar instruction does (no contraction into FMA: the AVX2 clones are
