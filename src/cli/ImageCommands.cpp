@@ -1,7 +1,8 @@
 // `envgi image info|convert|diff`: what pbrt's imgtool does every day, on envgi's formats. info
 // gives an image's size, channels, range, means and bad values; convert writes it in another
 // format (8-bit outputs tone-mapped, with exposure); diff draws a false-colour map of one
-// image's relative error against another and prints compare's figures for it.
+// image's relative error (or its FLIP error) against another and prints compare's figures and
+// the mean FLIP for it.
 #include <fmt/format.h>
 
 #include <cmath>
@@ -13,6 +14,7 @@
 #include "image/FalseColour.h"
 #include "image/Image.h"
 #include "study/ErrorMetrics.h"
+#include "study/FlipError.h"
 
 namespace envgi::cli {
 
@@ -22,6 +24,7 @@ struct ImageArgs {
   std::string input, output, reference;
   float exposure = 0.f;
   bool aces = false;
+  std::string metric = "relative";  // diff's picture: relative or flip
 };
 
 void runInfo(const ImageArgs& a) {
@@ -75,11 +78,17 @@ void runDiff(const ImageArgs& a) {
   requireOutputExtension(a.output, {".png"}, "diff picture");
   const Image img = loadImage(a.input), ref = loadImage(a.reference);
   const ImageError e = imageError(img, ref);  // throws, naming both sizes, where they differ
+  // HDR-FLIP: envgi's images are linear radiance of any range.
+  const std::vector<float> flip = flipHdr(ref, img);
   // The ramp's own codes, with no tone curve.
-  writeFileAtomically(a.output, encodePng(img.width, img.height, errorMapRgb(img, ref)));
-  fmt::print("RMSE {:.6g}, relMSE {:.6g}, worst region {:.6g}, non-finite {}\n", e.rmse, e.relMse, e.worstRegionRmse,
-             nonFiniteValues(img));
-  fmt::print("wrote {}: |L - L_ref| / (L_ref + 0.05), 0 (dark blue) to 1 or more (red)\n", a.output);
+  const std::vector<unsigned char> picture = a.metric == "flip" ? rampRgb(flip) : errorMapRgb(img, ref);
+  writeFileAtomically(a.output, encodePng(img.width, img.height, picture));
+  fmt::print("RMSE {:.6g}, relMSE {:.6g}, worst region {:.6g}, HDR-FLIP mean {:.6g}, non-finite {}\n", e.rmse, e.relMse,
+             e.worstRegionRmse, flipMean(flip), nonFiniteValues(img));
+  if (a.metric == "flip")
+    fmt::print("wrote {}: HDR-FLIP (NVIDIA's, at 67 pixels a degree), 0 (dark blue) to 1 (red)\n", a.output);
+  else
+    fmt::print("wrote {}: |L - L_ref| / (L_ref + 0.05), 0 (dark blue) to 1 or more (red)\n", a.output);
 }
 
 }  // namespace
@@ -101,6 +110,8 @@ void addImageCommands(CLI::App& app) {
   diff->add_option("reference", a->reference, "Reference image")->required()->check(CLI::ExistingFile);
   diff->add_option("image", a->input, "Image")->required()->check(CLI::ExistingFile);
   diff->add_option("-o,--output", a->output, "The picture (.png)")->required();
+  diff->add_option("--metric", a->metric, "The picture's error: relative (default) or flip (HDR-FLIP)")
+      ->check(CLI::IsMember({"relative", "flip"}));
   diff->callback([a] { runDiff(*a); });
 }
 

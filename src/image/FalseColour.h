@@ -22,15 +22,22 @@ inline float relativeLuminanceError(const Color& a, const Color& ref) {
   return std::clamp(std::fabs(la - lr) / (lr + 0.05f), 0.f, 1.f);
 }
 
-// The 8-bit RGB picture of a's relative error against ref, pixel by pixel through errorRamp.
-inline std::vector<unsigned char> errorMapRgb(const Image& a, const Image& ref) {
-  std::vector<unsigned char> rgb(size_t(a.width) * a.height * 3);
-  for (int y = 0; y < a.height; ++y)
-    for (int x = 0; x < a.width; ++x) {
-      const Color c = errorRamp(relativeLuminanceError(a.at(x, y), ref.at(x, y)));
-      for (int k = 0; k < 3; ++k) rgb[(size_t(y) * a.width + x) * 3 + k] = (unsigned char)(c[k] * 255.f);
-    }
+// Errors in [0, 1], one a pixel, as 8-bit RGB through errorRamp.
+inline std::vector<unsigned char> rampRgb(const std::vector<float>& errors) {
+  std::vector<unsigned char> rgb(errors.size() * 3);
+  for (size_t i = 0; i < errors.size(); ++i) {
+    const Color c = errorRamp(errors[i]);
+    for (int k = 0; k < 3; ++k) rgb[3 * i + size_t(k)] = (unsigned char)(c[k] * 255.f);
+  }
   return rgb;
+}
+
+// The 8-bit RGB picture of a's relative error against ref, pixel by pixel.
+inline std::vector<unsigned char> errorMapRgb(const Image& a, const Image& ref) {
+  std::vector<float> e(size_t(a.width) * size_t(a.height));
+  for (int y = 0; y < a.height; ++y)
+    for (int x = 0; x < a.width; ++x) e[size_t(y) * size_t(a.width) + size_t(x)] = relativeLuminanceError(a.at(x, y), ref.at(x, y));
+  return rampRgb(e);
 }
 
 }  // namespace envgi

@@ -346,6 +346,21 @@ TEST(CliImage, InfoConvertAndDiff) {
   const envgi::Image red = envgi::loadImage(d.file("red.png"), false);
   EXPECT_NEAR(red.at(0, 0).x, 1.f, 0.01f);
   EXPECT_NEAR(red.at(0, 0).y, 0.f, 0.01f);
+  // FLIP (study/FlipError.h): 0 against itself; a flat image eight times brighter gets the
+  // reference implementation's 0.2045 (flip-evaluator 1.7: both tone-mapped at one exposure),
+  // and --metric flip draws it.
+  EXPECT_NE(same.output.find("HDR-FLIP mean 0,"), std::string::npos) << same.output;
+  CliResult flip = runCli("image diff " + d.file("grey.exr") + " " + d.file("bright.exr") + " -o " + d.file("flip.png") +
+                          " --metric flip");
+  ASSERT_EQ(flip.code, 0) << flip.output;
+  const size_t at = flip.output.find("HDR-FLIP mean ");
+  ASSERT_NE(at, std::string::npos) << flip.output;
+  EXPECT_NEAR(std::stod(flip.output.substr(at + 14)), 0.2045, 1e-3) << flip.output;
+  const envgi::Color drawn = envgi::loadImage(d.file("flip.png"), false).at(0, 0), zero = blue.at(1, 1);
+  EXPECT_GT(std::fabs(drawn.x - zero.x) + std::fabs(drawn.y - zero.y) + std::fabs(drawn.z - zero.z), 0.1f)
+      << "past the ramp's blue";
+  EXPECT_NE(runCli("image diff " + d.file("grey.exr") + " " + d.file("bright.exr") + " -o " + d.file("x.png") +
+                   " --metric ssim").code, 0);
   // Images of two sizes: one error line naming both.
   CliResult sizes = runCli("image diff " + d.file("grey.exr") + " " + d.file("a.pfm") + " -o " + d.file("x.png"));
   EXPECT_EQ(sizes.code, 1) << sizes.output;
