@@ -18,8 +18,8 @@ from pathlib import Path
 from . import _envgi
 from ._envgi import EnvironmentMap, Scene, read_image, set_log_level, write_image
 
-__all__ = ["EnvironmentMap", "Scene", "load_file", "load_string", "read_image", "render", "set_log_level", "study",
-           "write_image"]
+__all__ = ["EnvironmentMap", "Scene", "load_file", "load_string", "merge_shares", "read_image", "render",
+           "set_log_level", "study", "write_image"]
 
 
 def load_file(path, **params):
@@ -58,7 +58,7 @@ class _Bar:
 
 
 def render(scene, spp=None, integrator=None, strategy=None, seed=None, device="auto", time_limit=None, threads=0,
-           progress=True):
+           progress=True, sample_range=None):
     """Renders ``scene`` and returns its image as a float32 array (height, width, 3) that
     Python owns (NumPy's buffer protocol, ``__array__`` and ``__dlpack__``).
 
@@ -67,13 +67,41 @@ def render(scene, spp=None, integrator=None, strategy=None, seed=None, device="a
     integrator runs there), "cpu" or "cuda". time_limit: seconds, after which the render stops
     with the passes done. threads: CPU threads (0: every core). progress: a tqdm bar where tqdm
     is installed.
+
+    sample_range=(s0, s1) renders samples [s0, s1) of the spp-sample render only (path and
+    direct), and returns that share's film as a dict: "sum" (H, W, 3), "weight" (the filter's
+    weights summed, or None where each sample weighs one), "samples" (s1 - s0) and "image" (the
+    share's own mean). Shares that cover [0, spp) add up with merge_shares to the one render's
+    image, to float rounding.
     """
     bar = _Bar(progress)
     try:
         return _envgi.render(scene, spp, integrator, strategy, seed, device, float(time_limit or 0.0), int(threads),
-                             bar.callback())
+                             bar.callback(), None if sample_range is None else tuple(int(s) for s in sample_range))
     finally:
         bar.close()
+
+
+def merge_shares(shares):
+    """The image of shares of one render (render(..., sample_range=...)): their sums added, then
+    divided by the samples (or the filter's weights) as the renderer's own film does."""
+    import numpy as np
+
+    shares = list(shares)
+    if not shares:
+        raise ValueError("merge_shares: no shares")
+    total = np.zeros_like(shares[0]["sum"])
+    for share in shares:
+        total += share["sum"]
+    count = np.float32(max(sum(share["samples"] for share in shares), 1))
+    if shares[0]["weight"] is None:
+        return total / count
+    weight = np.zeros_like(shares[0]["weight"])
+    for share in shares:
+        weight += share["weight"]
+    # A weighted mean where the weights reach a quarter of the count, the plain mean elsewhere.
+    divisor = np.where(weight > np.float32(0.25) * count, weight, count).astype(np.float32)
+    return total / divisor[..., None]
 
 
 def _cli():

@@ -1,5 +1,5 @@
 from os import PathLike
-from typing import Any, Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -42,7 +42,9 @@ def load_file(path: Union[str, "PathLike[str]"], **params: Any) -> Scene: ...
 def load_string(xml: str, **params: Any) -> Scene: ...
 def render(scene: Scene, spp: Optional[int] = ..., integrator: Optional[str] = ..., strategy: Optional[str] = ...,
            seed: Optional[int] = ..., device: Literal["auto", "cpu", "cuda"] = ...,
-           time_limit: Optional[float] = ..., threads: int = ..., progress: bool = ...) -> FloatArray: ...
+           time_limit: Optional[float] = ..., threads: int = ..., progress: bool = ...,
+           sample_range: Optional[Tuple[int, int]] = ...) -> Any: ...
+def merge_shares(shares: Sequence[Dict[str, Any]]) -> FloatArray: ...
 def study(scene: Union[str, "PathLike[str]"], output: Union[str, "PathLike[str]"],
           strategies: Optional[Sequence[str]] = ..., spp: Optional[Sequence[int]] = ...,
           time: Optional[Sequence[float]] = ..., seeds: Optional[int] = ..., reference: Optional[str] = ...,

@@ -165,9 +165,16 @@ Image runInterruptibly(const std::function<Image()>& work, std::atomic<bool>* ca
   }
 }
 
-py::array_t<float> render(LoadedScene& ls, std::optional<int> spp, std::optional<std::string> integrator,
-                          std::optional<std::string> strategy, std::optional<uint32_t> seed, const std::string& device,
-                          double timeLimit, int threads, const py::object& onProgress) {
+template <class T>
+py::array_t<T> arrayOf(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
+  auto* data = new std::vector<T>(std::move(v));
+  py::capsule owner(data, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<T>(shape, data->data(), owner);
+}
+
+py::object render(LoadedScene& ls, std::optional<int> spp, std::optional<std::string> integrator,
+                  std::optional<std::string> strategy, std::optional<uint32_t> seed, const std::string& device,
+                  double timeLimit, int threads, const py::object& onProgress, std::optional<std::pair<int, int>> range) {
   if (spp && *spp <= 0) throw BadInput("spp must be positive, not " + std::to_string(*spp));
   if (timeLimit < 0.0) throw BadInput("time_limit must be positive (or 0: none)");
   Scene& scene = *ls.scene;
@@ -186,6 +193,16 @@ py::array_t<float> render(LoadedScene& ls, std::optional<int> spp, std::optional
   ro.checkpointSeconds = 0.0;
   ro.cancel = &cancel;
   ro.timeLimitSeconds = timeLimit;
+  FilmSums film;
+  if (range) {
+    const IntegratorType t = scene.integrator.type;
+    if (t != IntegratorType::Path && t != IntegratorType::Direct)
+      throw BadInput("sample_range: the samples of path and direct split into ranges; " +
+                     std::string(integratorName(t)) + " renders as a whole");
+    if (timeLimit > 0.0) throw BadInput("sample_range and time_limit: a share must take all of its samples");
+    ro.firstSample = range->first, ro.sampleEnd = range->second;
+    ro.filmOut = &film;
+  }
   requireFilmFits(scene.camera, ro, physicalMemoryBytes());
   auto work = [&]() -> Image {
     RenderStats st;
@@ -200,7 +217,18 @@ py::array_t<float> render(LoadedScene& ls, std::optional<int> spp, std::optional
     PreparedRender pr = gpu::prepareCudaRender(scene, *ls.bvh, ls.accel.get(), ro, 0, &bytes);
     return renderPasses(*pr.executor, scene.camera.width, scene.camera.height, pr.spp, ro, &st);
   };
-  return toArray(runInterruptibly(work, &cancel, &fraction, onProgress));
+  py::array_t<float> img = toArray(runInterruptibly(work, &cancel, &fraction, onProgress));
+  if (!range) return std::move(img);
+  const size_t n = film.sum.size();
+  const py::ssize_t H = scene.camera.height, W = scene.camera.width;
+  std::vector<float> sum(3 * n);
+  for (size_t i = 0; i < n; ++i) sum[3 * i] = film.sum[i].x, sum[3 * i + 1] = film.sum[i].y, sum[3 * i + 2] = film.sum[i].z;
+  py::dict out;
+  out["sum"] = arrayOf(std::move(sum), {H, W, 3});
+  out["weight"] = film.weightSum.empty() ? py::object(py::none()) : py::object(arrayOf(std::move(film.weightSum), {H, W}));
+  out["samples"] = range->second - range->first;
+  out["image"] = img;
+  return std::move(out);
 }
 
 std::unique_ptr<LoadedScene> loadFile(const std::string& path, const py::kwargs& params) {
@@ -234,12 +262,6 @@ Vec3f normalOf(const std::array<float, 3>& n) {
 
 EnvStrategy mapStrategy(const std::string& name) { return findStrategy(name, true).env; }
 
-template <class T>
-py::array_t<T> arrayOf(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
-  auto* data = new std::vector<T>(std::move(v));
-  py::capsule owner(data, [](void* p) { delete static_cast<std::vector<T>*>(p); });
-  return py::array_t<T>(shape, data->data(), owner);
-}
 
 }  // namespace
 
@@ -284,7 +306,8 @@ PYBIND11_MODULE(_envgi, m) {
   m.def("load_file", &loadFile, py::arg("path"));
   m.def("load_string", &loadString, py::arg("xml"));
   m.def("render", &envgi::python::render, py::arg("scene"), py::arg("spp"), py::arg("integrator"), py::arg("strategy"),
-        py::arg("seed"), py::arg("device"), py::arg("time_limit"), py::arg("threads"), py::arg("on_progress"));
+        py::arg("seed"), py::arg("device"), py::arg("time_limit"), py::arg("threads"), py::arg("on_progress"),
+        py::arg("sample_range"));
 
   py::class_<EnvironmentMap>(m, "EnvironmentMap")
       .def(py::init([](const std::string& path, const std::string& layout) {

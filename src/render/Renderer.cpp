@@ -318,15 +318,22 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   while (maxPass > 1 && double(maxPass) * double(W) * double(H) > double(ex.maxPassPixelSamples())) maxPass /= 2;
   // Where the pass that starts at s0 ends, one pass at a time: a list of them all (33 million
   // for --spp 2147483647 and a time limit) and s0 + n in int had overflowed into a hang.
-  auto passEnd = [&](int s0) { return int(std::min<int64_t>(spp, int64_t(s0) + std::clamp(s0, 1, maxPass))); };
-  Progress progress(size_t(W) * H * spp, opts.progress, opts.timeLimitSeconds, opts.progressFraction);
+  const int first = opts.firstSample, end = opts.sampleEnd < 0 ? spp : opts.sampleEnd;
+  if (first < 0 || first >= end || end > spp)
+    throw std::runtime_error("the samples " + std::to_string(first) + ":" + std::to_string(end) +
+                             " are not a range within the render's " + std::to_string(spp));
+  if (first > 0 && opts.noiseThreshold > 0.f)
+    throw std::runtime_error("adaptive sampling decides from each pixel's samples so far: it cannot render a range "
+                             "that does not start at 0");
+  auto passEnd = [&](int s0) { return int(std::min<int64_t>(end, int64_t(s0) + std::clamp(s0, 1, maxPass))); };
+  Progress progress(size_t(W) * H * size_t(end - first), opts.progress, opts.timeLimitSeconds, opts.progressFraction);
   PassCounters counters;
   FilmSums film;
   auto t0 = Clock::now();
   auto lastCheckpoint = t0;
   double checkpointGap = opts.checkpointSeconds;
   bool gapSaid = false;
-  int sppDone = 0, sppAhead = 0;
+  int sppDone = first, sppAhead = 0;
   size_t pixelsAhead = 0;
   bool cancelled = false, timeLimited = false;
   const size_t px = size_t(W) * size_t(H);
@@ -350,7 +357,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
            opts.timeLimitSeconds;
   };
   bool nextPastTimeLimit = false;
-  for (int s0 = 0, s1 = 0; s0 < spp; s0 = s1) {
+  for (int s0 = first, s1 = first; s0 < end; s0 = s1) {
     s1 = passEnd(s0);
     if (opts.cancel && opts.cancel->load()) {
       cancelled = true;
@@ -363,7 +370,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     // Ctrl-C stops a pass at its next tile, but for the first, which every pixel takes whole
     // (an image with black tiles would not be finished work). The finished tiles' samples are
     // kept: each pixel's mean is over its own count.
-    ex.watchCancel(s0 > 0 ? opts.cancel : nullptr);
+    ex.watchCancel(s0 > first ? opts.cancel : nullptr);
     ex.runPass(s0, s1, progress, &counters);
     if (const std::vector<unsigned char>* took = ex.cutPass()) {
       pixelsAhead = pixels.passDone(s0, s1, *took);
@@ -373,16 +380,16 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
     }
     pixels.passDone(s0, s1);
     sppDone = s1;
-    if (adaptive && sppDone >= opts.adaptiveMinSpp && sppDone < spp) {
+    if (adaptive && sppDone >= opts.adaptiveMinSpp && sppDone < end) {
       size_t before = pixels.activeCount();
       size_t left = pixels.update(ex, &film);
-      progress.shrinkTotal((before - left) * size_t(spp - sppDone));
+      progress.shrinkTotal((before - left) * size_t(end - sppDone));
       spdlog::debug("adaptive sampling: {} of {} pixels still sampling after {} spp", left, px, sppDone);
       if (left == 0) break;  // every pixel has converged: the render is done
     }
-    nextPastTimeLimit = sppDone < spp && pastTimeLimit(sppDone);
+    nextPastTimeLimit = sppDone < end && pastTimeLimit(sppDone);
     double sinceCheckpoint = std::chrono::duration<double>(Clock::now() - lastCheckpoint).count();
-    if (opts.checkpoint && opts.checkpointSeconds > 0.0 && sinceCheckpoint >= checkpointGap && sppDone < spp &&
+    if (opts.checkpoint && opts.checkpointSeconds > 0.0 && sinceCheckpoint >= checkpointGap && sppDone < end &&
         !nextPastTimeLimit) {
       const auto start = Clock::now();
       opts.checkpoint(meanImage(), sppDone);
@@ -402,6 +409,7 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   ex.watchCancel(nullptr);
   progress.finish();
   Image img = meanImage();
+  if (opts.filmOut) *opts.filmOut = film;
   if (stats) {
     stats->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     stats->sppDone = sppDone;

@@ -25,6 +25,11 @@ enum class CpuTracer { Embree, Bvh };
 
 struct RenderOptions {
   int spp = -1;             // -1: the scene's sample_count
+  // Samples [firstSample, sampleEnd) of the spp-sample sequence only (sampleEnd -1: to spp): one
+  // share of a render split over tasks, whose film sums (filmOut) add up with the other
+  // shares' to the whole render's, up to float rounding.
+  int firstSample = 0, sampleEnd = -1;
+  FilmSums* filmOut = nullptr;  // when set, receives the film's sums at the end
   int threads = 0;          // 0: all cores
   int tileSize = 16;
   bool progress = true;
