@@ -138,6 +138,32 @@ TEST(RenderPasses, TheLargestSampleCountStartsAtOnce) {
   EXPECT_EQ(ex.passes, (Passes{{0, 1}, {1, 2}, {2, 4}, {4, 8}, {8, 16}, {16, 32}, {32, 64}, {64, 128}, {128, 192}}));
 }
 
+// A share of a render (RenderOptions::firstSample, sampleEnd) takes exactly its samples, in
+// passes that start where it starts; a range outside the render, or a share of an adaptive
+// render, is refused before any pass.
+TEST(RenderPasses, AShareTakesOnlyItsSamples) {
+  RecordingExecutor ex(4, 4, 1e9);
+  RenderOptions o;
+  o.progress = false;
+  o.firstSample = 5, o.sampleEnd = 23;
+  FilmSums film;
+  o.filmOut = &film;
+  RenderStats st;
+  renderPasses(ex, 4, 4, 64, o, &st);
+  EXPECT_EQ(ex.passes, (Passes{{5, 10}, {10, 20}, {20, 23}}));
+  EXPECT_EQ(st.sppDone, 23);
+  EXPECT_EQ(film.sum.size(), 16u);
+  for (auto [first, end] : {std::pair{-1, 4}, std::pair{4, 4}, std::pair{0, 65}}) {
+    RecordingExecutor bad(4, 4, 1e9);
+    o.firstSample = first, o.sampleEnd = end;
+    EXPECT_THROW(renderPasses(bad, 4, 4, 64, o, &st), std::runtime_error) << first << ":" << end;
+    EXPECT_TRUE(bad.passes.empty());
+  }
+  o.firstSample = 8, o.sampleEnd = -1, o.noiseThreshold = 0.05f;
+  RecordingExecutor adaptive(4, 4, 1e9);
+  EXPECT_THROW(renderPasses(adaptive, 4, 4, 64, o, &st), std::runtime_error);
+}
+
 // The default budget leaves the bundled scenes' passes as they were (320 x 320: up to 64
 // samples) and cuts a 4096 x 4096 image's to one sample.
 TEST(RenderPasses, TheDefaultBudgetCutsOnlyLargeImages) {
