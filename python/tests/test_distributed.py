@@ -25,6 +25,9 @@ WORKER_PORTS = (PORT + 600, PORT + 700)  # each worker node's raylet, so that a 
 
 @pytest.fixture(scope="module")
 def cluster(tmp_path_factory):
+    # A cluster on loopback, torn down at the end: no token (Ray's default asks the nodes to share
+    # one, which a token left in ~/.ray by an earlier local Ray would not match).
+    os.environ["RAY_AUTH_MODE"] = "disabled"
     ray_bin = Path(__import__("sys").executable).with_name("ray")
     temp = tmp_path_factory.mktemp("ray")
     common = ["--num-cpus=1", "--disable-usage-stats"]

@@ -197,3 +197,27 @@ def test_study_runs_the_clis_study_and_returns_its_records(tmp_path):
     assert envgi.study(BUDDHA, tmp_path / "s", **kwargs) == records
     with pytest.raises(ValueError, match="strateg"):
         envgi.study(BUDDHA, tmp_path / "t", strategies=["importnce"], res=16)
+
+
+def test_camera_and_environment_change_without_a_new_bvh():
+    scene = envgi.load_file(BUDDHA, res=32)
+    first = envgi.render(scene, spp=4, progress=False)
+    scene.set_camera((0.0, 1.5, 4.0), (0.0, 0.0, 0.0))
+    moved = envgi.render(scene, spp=4, progress=False)
+    assert not np.allclose(moved, first)
+    # The scene file's own lookat again: the first image to the bit, on the BVH built for it.
+    scene.set_camera((0.0, 0.1, 4.4), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0))
+    assert scene.accel_built
+    assert np.array_equal(envgi.render(scene, spp=4, progress=False), first)
+    # The map twice as bright lights the scene twice as brightly (it is the only light); turned
+    # a full circle it is where it was; turned a quarter it lights the Buddha otherwise.
+    scene.set_environment(scale=2.0)
+    np.testing.assert_allclose(envgi.render(scene, spp=4, progress=False), 2 * first, rtol=1e-5, atol=1e-6)
+    scene.set_environment(rotation=360.0)
+    np.testing.assert_allclose(envgi.render(scene, spp=4, progress=False), first, rtol=1e-3, atol=1e-3)
+    scene.set_environment(rotation=90.0)
+    assert not np.allclose(envgi.render(scene, spp=4, progress=False), first, rtol=0.05)
+    with pytest.raises(ValueError, match="same point"):
+        scene.set_camera((0.0, 0.0, 1.0), (0.0, 0.0, 1.0))
+    with pytest.raises(ValueError, match="scale"):
+        scene.set_environment(scale=-1.0)

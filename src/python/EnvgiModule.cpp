@@ -19,6 +19,7 @@
 #include "accel/Bvh.h"
 #include "accel/EmbreeAccel.h"
 #include "core/PhysicalMemory.h"
+#include "core/Transform.h"
 #include "envmap/EnvironmentMap.h"
 #include "gpu/CudaExecutor.h"
 #include "image/Image.h"
@@ -64,6 +65,35 @@ struct LoadedScene {
   std::unique_ptr<EmbreeAccel> accel;
   std::unique_ptr<Bvh> bvh;
   std::string name;
+  Transform envToWorld;  // the map's placement as loaded, which set_environment turns and scales
+  float envScale = 1.f;
+
+  void loaded() {
+    if (!scene->env) return;
+    envToWorld = scene->env->options().toWorld;
+    envScale = scene->env->options().scale;
+  }
+  // A new camera (perspective: its lookat), with the BVH kept: only the camera's rays change.
+  void setCamera(const std::array<float, 3>& o, const std::array<float, 3>& t, const std::array<float, 3>& u) {
+    if (scene->camera.orthographic)
+      throw BadInput("set_camera: an orthographic sensor keeps the scene's own to_world (its scale is its view)");
+    const Vec3f origin(o[0], o[1], o[2]), target(t[0], t[1], t[2]), up(u[0], u[1], u[2]);
+    const Transform m = lookAt(origin, target, up);
+    for (const auto& row : m.mat.m)
+      for (float v : row)
+        if (!std::isfinite(v)) throw BadInput("set_camera: origin, target and up must be finite and span a frame");
+    scene->camera.toWorld = m;
+    scene->finalize();
+  }
+  // The map turned about the vertical and scaled, from its placement as loaded (the viewer's
+  // controls); its sampling tables, in its own frame, stay as they are.
+  void setEnvironment(float rotation, float scale) {
+    if (!scene->env) throw BadInput("set_environment: the scene has no environment map");
+    if (!(scale >= 0.f) || !std::isfinite(scale) || !std::isfinite(rotation))
+      throw BadInput("set_environment: the scale must be finite and not negative, the rotation finite");
+    scene->env->setPlacement(envScale * scale, rotate(Vec3f(0.f, 1.f, 0.f), rotation) * envToWorld);
+    scene->finalize();
+  }
 };
 
 // The scene's integrator and sampler as a render's keywords set them, put back when the
@@ -236,6 +266,7 @@ std::unique_ptr<LoadedScene> loadFile(const std::string& path, const py::kwargs&
   auto ls = std::make_unique<LoadedScene>();
   ls->name = path;
   loadScene(path, definesOf(params), *ls->scene);
+  ls->loaded();
   return ls;
 }
 
@@ -243,6 +274,7 @@ std::unique_ptr<LoadedScene> loadString(const std::string& xml, const py::kwargs
   auto ls = std::make_unique<LoadedScene>();
   ls->name = kSceneStringName;
   loadSceneString(xml, definesOf(params), *ls->scene);
+  ls->loaded();
   return ls;
 }
 
@@ -298,6 +330,11 @@ PYBIND11_MODULE(_envgi, m) {
       .def_property_readonly("strategy", [](const LoadedScene& s) { return s.scene->integrator.env.strategy; })
       .def_property_readonly("has_environment", [](const LoadedScene& s) { return bool(s.scene->env); })
       .def_property_readonly("accel_built", [](const LoadedScene& s) { return bool(s.accel) || bool(s.bvh); })
+      .def("set_camera", &LoadedScene::setCamera, py::arg("origin"), py::arg("target"),
+           py::arg("up") = std::array<float, 3>{0.f, 1.f, 0.f},
+           "Points the camera from origin at target (Mitsuba's lookat); later renders reuse the BVH.")
+      .def("set_environment", &LoadedScene::setEnvironment, py::arg("rotation") = 0.f, py::arg("scale") = 1.f,
+           "Turns the map by rotation degrees about the vertical and scales it, from its placement as loaded.")
       .def("__repr__", [](const LoadedScene& s) {
         return "<envgi.Scene '" + s.name + "' " + std::to_string(s.scene->camera.width) + "x" +
                std::to_string(s.scene->camera.height) + ">";
