@@ -221,3 +221,18 @@ def test_camera_and_environment_change_without_a_new_bvh():
         scene.set_camera((0.0, 0.0, 1.0), (0.0, 0.0, 1.0))
     with pytest.raises(ValueError, match="scale"):
         scene.set_environment(scale=-1.0)
+
+
+def test_shares_of_a_render_add_up_to_it():
+    scene = envgi.load_file(BUDDHA, res=24)
+    whole = envgi.render(scene, spp=8, progress=False)
+    a = envgi.render(scene, spp=8, sample_range=(0, 3), progress=False)
+    b = envgi.render(scene, spp=8, sample_range=(3, 8), progress=False)
+    assert (a["samples"], b["samples"]) == (3, 5) and a["weight"] is None
+    np.testing.assert_allclose(envgi.merge_shares([a, b]), whole, rtol=1e-5, atol=1e-6)
+    # Each share's own image is the mean of its samples.
+    np.testing.assert_allclose((3 * a["image"] + 5 * b["image"]) / 8, whole, rtol=1e-5, atol=1e-6)
+    with pytest.raises(ValueError, match="renders as a whole"):
+        envgi.render(scene, spp=8, sample_range=(0, 4), integrator="sppm", progress=False)
+    with pytest.raises(ValueError, match="not a range"):
+        envgi.render(scene, spp=8, sample_range=(4, 12), progress=False)

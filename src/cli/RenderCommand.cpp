@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <stdexcept>
+#include <tuple>
 
 #include <unistd.h>
 
@@ -65,7 +66,25 @@ struct RenderArgs {
   std::string device = "auto", sampler, pointMethod, filter;
   int points = 0;
   int gpu = 0;
+  std::string samples;  // S0:S1, a share of the render
 };
+
+// --samples S0:S1: samples [S0, S1) of the render's sequence (0 <= S0 < S1; renderPasses checks
+// them against the spp).
+std::pair<int, int> sampleRangeOf(const std::string& text) {
+  const size_t colon = text.find(':');
+  int s0 = -1, s1 = -1;
+  size_t used0 = 0, used1 = 0;
+  try {
+    s0 = std::stoi(text.substr(0, colon), &used0);
+    s1 = std::stoi(text.substr(colon + 1), &used1);
+  } catch (const std::exception&) {
+    s0 = -1;
+  }
+  if (colon == std::string::npos || used0 != colon || used1 != text.size() - colon - 1 || s0 < 0 || s1 <= s0)
+    throw std::runtime_error("--samples " + text + ": give S0:S1, whole numbers with 0 <= S0 < S1");
+  return {s0, s1};
+}
 
 double secondsSince(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
@@ -201,6 +220,17 @@ void runRender(const RenderArgs& a) {
   ro.cancel = &g_cancel;
   ro.timeLimitSeconds = a.timeLimit;
   ro.noiseThreshold = a.noiseThreshold;
+  if (!a.samples.empty()) {
+    // A share of the render: the image is the mean of its samples, which shares of equal
+    // weight average into the whole (envgi.distributed adds their sums instead).
+    std::tie(ro.firstSample, ro.sampleEnd) = sampleRangeOf(a.samples);
+    const IntegratorType t = scene.integrator.type;
+    if (t != IntegratorType::Path && t != IntegratorType::Direct)
+      throw std::runtime_error("--samples: the samples of path and direct split into ranges; " +
+                               std::string(integratorName(t)) + " renders as a whole");
+    if (a.timeLimit > 0.0 || a.noiseThreshold > 0.f)
+      throw std::runtime_error("--samples: a share takes all of its samples (no --time-limit or --noise-threshold)");
+  }
   ro.adaptiveMinSpp = a.minSpp;
   std::vector<int> samples;
   if (!a.sampleMap.empty()) ro.samplesOut = &samples;
@@ -358,6 +388,9 @@ void addRenderCommand(CLI::App& app) {
   c->add_option("--time-limit", a->timeLimit,
                 "Seconds of sampling at most: stop at the last pass that fits, with the samples done (0: none)")
       ->check(atLeast(0));
+  c->add_option("--samples", a->samples,
+                "S0:S1: only samples [S0, S1) of the render's --spp, for splitting one render over machines (path, "
+                "direct)");
   c->add_option("--noise-threshold", a->noiseThreshold,
                 "Adaptive sampling: a pixel stops once its noise (standard error of its mean luminance over the "
                 "root of that mean) and its neighbours' is below this, as Cycles' noise threshold (0: off)")

@@ -24,14 +24,14 @@ bool ActivePixels::attach(PassExecutor& ex) {
 
 void ActivePixels::passDone(int s0, int s1) {
   for (size_t i = 0; i < samples_.size(); ++i)
-    if (active_[i]) samples_[i] = s1;
+    if (active_[i]) samples_[i] += s1 - s0;
   pixelSamples_ += uint64_t(activeCount_) * uint64_t(s1 - s0);
 }
 
 size_t ActivePixels::passDone(int s0, int s1, const std::vector<unsigned char>& took) {
   size_t n = 0;
   for (size_t i = 0; i < samples_.size() && i < took.size(); ++i)
-    if (active_[i] && took[i]) samples_[i] = s1, ++n;
+    if (active_[i] && took[i]) samples_[i] += s1 - s0, ++n;
   pixelSamples_ += uint64_t(n) * uint64_t(s1 - s0);
   return n;
 }

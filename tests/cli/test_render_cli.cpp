@@ -639,6 +639,41 @@ TEST(CliRender, ThinLensBlursAStepByItsCircleOfConfusion) {
   }
 }
 
+// --samples S0:S1 renders a share of the render: two halves average to the whole render to
+// float rounding (the tiny scene's filter has no negative lobes), and a range that is not one,
+// lies past --spp, or asks it of an integrator that renders whole is one error line, no file.
+TEST(RenderCli, SampleRangesSplitARender) {
+  TempDir d;
+  std::string scene = tinyScene(d, 16, 8);
+  auto render = [&](const std::string& name, const std::string& extra) {
+    return runCli("render " + scene + " -o " + d.file(name) + " --spp 8 --no-progress " + extra);
+  };
+  ASSERT_EQ(render("whole.exr", "").code, 0);
+  ASSERT_EQ(render("a.exr", "--samples 0:3").code, 0);
+  ASSERT_EQ(render("b.exr", "--samples 3:8").code, 0);
+  const envgi::Image whole = envgi::loadImage(d.file("whole.exr")), a = envgi::loadImage(d.file("a.exr")),
+                     b = envgi::loadImage(d.file("b.exr"));
+  double diff = 0.0, mean = 0.0, apart = 0.0;
+  for (size_t i = 0; i < whole.rgb.size(); ++i) {
+    diff = std::max(diff, std::fabs(double(whole.rgb[i]) - (3.0 * a.rgb[i] + 5.0 * b.rgb[i]) / 8.0));
+    mean += whole.rgb[i];
+    apart += std::fabs(double(a.rgb[i]) - b.rgb[i]);
+  }
+  EXPECT_LT(diff, 1e-5 * (1.0 + mean / double(whole.rgb.size())));
+  EXPECT_GT(apart, 0.0) << "the two shares took different samples";
+  for (auto [extra, message] : {std::pair<std::string, std::string>{"--samples 5", "give S0:S1"},
+                                {"--samples 6:2", "give S0:S1"},
+                                {"--samples 0:x", "give S0:S1"},
+                                {"--samples 4:16", "not a range within the render's 8"},
+                                {"--samples 0:4 --time-limit 5", "takes all of its samples"},
+                                {"--samples 0:4 --integrator sppm", "renders as a whole"}}) {
+    CliResult r = render("bad.exr", extra);
+    EXPECT_EQ(r.code, 1) << extra << "\n" << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << extra << "\n" << r.output;
+    EXPECT_FALSE(fs::exists(d.file("bad.exr"))) << extra;
+  }
+}
+
 // --device: auto falls back to the CPU without a GPU, and says so; cuda without one is one
 // error line and no output file; a bad device name is an error.
 TEST(RenderCli, DeviceChoice) {
