@@ -156,11 +156,7 @@ void runRender(const RenderArgs& a) {
     spdlog::warn("--points and --point-method shape the collapsed map, which strategy '{}' does not use (points or "
                  "points-draw do)",
                  scene.integrator.env.strategy);
-  // An emitter envgi ignored (the log said which) leaves a black image: say so, as photons does.
-  // AOVs (given or the scene's own aov integrator) need no light.
-  if (!scene.env && scene.lightCount() == 0 && scene.deltaLights.empty() && scene.aovs.empty())
-    throw std::runtime_error("the scene emits no light (no environment map, area light, or directional, point or spot "
-                             "light envgi renders): its image would be black");
+  requireLight(scene);  // as photons says it
   bool cuda = chooseCuda(a.device);
   if (cuda && a.device == "auto") {
     if (const std::string why = gpu::whyNotOnCuda(scene); !why.empty()) {
@@ -223,13 +219,8 @@ void runRender(const RenderArgs& a) {
   if (!a.samples.empty()) {
     // A share of the render: the image is the mean of its samples, which shares of equal
     // weight average into the whole (envgi.distributed adds their sums instead).
+    // (The preparation refuses other integrators, a time limit and adaptive sampling.)
     std::tie(ro.firstSample, ro.sampleEnd) = sampleRangeOf(a.samples);
-    const IntegratorType t = scene.integrator.type;
-    if (t != IntegratorType::Path && t != IntegratorType::Direct)
-      throw std::runtime_error("--samples: the samples of path and direct split into ranges; " +
-                               std::string(integratorName(t)) + " renders as a whole");
-    if (a.timeLimit > 0.0 || a.noiseThreshold > 0.f)
-      throw std::runtime_error("--samples: a share takes all of its samples (no --time-limit or --noise-threshold)");
   }
   ro.adaptiveMinSpp = a.minSpp;
   std::vector<int> samples;

@@ -16,6 +16,7 @@ std::string whyNotOnCuda(const Scene& scene) {
 
 PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const EmbreeAccel* accel, RenderOptions opts,
                                  int gpu, size_t* deviceBytes) {
+  requireShareable(scene, opts);
   requireFilmFits(scene.view().camera, opts, physicalMemoryBytes());  // its host copy, before the device's
   size_t bytes = 0;
   PreparedRender pr;

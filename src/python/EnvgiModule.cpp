@@ -209,9 +209,7 @@ py::object render(LoadedScene& ls, std::optional<int> spp, std::optional<std::st
   if (timeLimit < 0.0) throw BadInput("time_limit must be positive (or 0: none)");
   Scene& scene = *ls.scene;
   Overrides set(scene, integrator, strategy, seed);
-  if (!scene.env && scene.lightCount() == 0 && scene.deltaLights.empty() && scene.aovs.empty())
-    throw BadInput(ls.name + ": the scene emits no light (no environment map, area light, or directional, point or "
-                             "spot light envgi renders): its image would be black");
+  requireLight(scene);
   const bool cuda = useCuda(scene, device);
   std::atomic<bool> cancel{false};
   std::atomic<float> fraction{0.f};
@@ -224,12 +222,7 @@ py::object render(LoadedScene& ls, std::optional<int> spp, std::optional<std::st
   ro.cancel = &cancel;
   ro.timeLimitSeconds = timeLimit;
   FilmSums film;
-  if (range) {
-    const IntegratorType t = scene.integrator.type;
-    if (t != IntegratorType::Path && t != IntegratorType::Direct)
-      throw BadInput("sample_range: the samples of path and direct split into ranges; " +
-                     std::string(integratorName(t)) + " renders as a whole");
-    if (timeLimit > 0.0) throw BadInput("sample_range and time_limit: a share must take all of its samples");
+  if (range) {  // the preparation refuses other integrators and a time limit (requireShareable)
     ro.firstSample = range->first, ro.sampleEnd = range->second;
     ro.filmOut = &film;
   }

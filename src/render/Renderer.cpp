@@ -142,6 +142,7 @@ std::shared_ptr<PhotonBatchTracer> cpuPhotonTracer(const Scene& scene, const Bvh
 // the CPU: with Embree, or with the GPU's BVH to check the GPU's bodies without a GPU.
 template <class Tracer>
 PreparedRender prepareOnTracer(const Scene& scene, const Tracer& tracer, const RenderOptions& opts, const char* name) {
+  requireShareable(scene, opts);
   requireFilmFits(scene.view().camera, opts, physicalMemoryBytes());
   switch (scene.integrator.type) {
     case IntegratorType::Sppm:
@@ -181,6 +182,7 @@ PreparedRender prepareOnTracer(const Scene& scene, const Tracer& tracer, const R
 }
 
 PreparedRender preparePhoton(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {
+  requireShareable(scene, opts);
   requireFilmFits(scene.view().camera, opts, physicalMemoryBytes());  // before the photon pass
   const PhotonSettings& ps = scene.integrator.photon;
   int spp = samplesOf(scene, opts);
@@ -436,6 +438,23 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   if (opts.samplesOut) *opts.samplesOut = pixels.samples();
   if (counters.dropped > 0) spdlog::warn("{} samples were NaN, infinite or negative and were dropped", counters.dropped);
   return img;
+}
+
+void requireLight(const Scene& scene) {
+  if (!scene.env && scene.lightCount() == 0 && scene.deltaLights.empty() && scene.aovs.empty())
+    throw std::runtime_error("the scene emits no light (no environment map, area light, or directional, point or spot "
+                             "light envgi renders): its image would be black");
+}
+
+void requireShareable(const Scene& scene, const RenderOptions& opts) {
+  if (opts.firstSample == 0 && opts.sampleEnd < 0) return;
+  const std::string share = "samples " + std::to_string(opts.firstSample) + ":" + std::to_string(opts.sampleEnd);
+  const IntegratorType t = scene.integrator.type;
+  if (t != IntegratorType::Path && t != IntegratorType::Direct)
+    throw std::runtime_error(share + ": only path's and direct's samples split into shares; " +
+                             std::string(integratorName(t)) + " renders as a whole");
+  if (opts.timeLimitSeconds > 0.0 || opts.noiseThreshold > 0.f)
+    throw std::runtime_error(share + ": a share takes all of its samples (no time limit or noise threshold)");
 }
 
 PreparedRender prepareRender(const Scene& scene, const EmbreeAccel& accel, const RenderOptions& opts) {

@@ -124,6 +124,15 @@ size_t filmBytesPerPixel(const Camera& cam, const RenderOptions& opts);
 // any of it is allocated: a 32768^2 film (44 GB) otherwise thrashed a 25 GB machine for minutes.
 void requireFilmFits(const Camera& cam, const RenderOptions& opts, double memoryBytes);
 
+// Throws where the scene emits no light envgi renders (an emitter it ignored, the log said
+// which, would leave a black image); AOVs need none.
+void requireLight(const Scene& scene);
+
+// Throws where opts asks for a share of the render (firstSample, sampleEnd) that cannot be one:
+// only path's and direct's samples split into shares, and a share takes all of its samples (no
+// time limit, no adaptive sampling). Every executor's preparation calls it.
+void requireShareable(const Scene& scene, const RenderOptions& opts);
+
 // The loop itself, over an executor that already holds the scene (e.g. a GPU's).
 Image renderPasses(PassExecutor& executor, int width, int height, int spp, const RenderOptions& opts,
                    RenderStats* stats);
