@@ -16,9 +16,9 @@ import subprocess
 from pathlib import Path
 
 from . import _envgi
-from ._envgi import EnvironmentMap, Scene, read_image, set_log_level, write_image
+from ._envgi import EnvironmentMap, Scene, image_error, read_image, set_log_level, write_image
 
-__all__ = ["EnvironmentMap", "Scene", "load_file", "load_string", "merge_shares", "read_image", "render",
+__all__ = ["EnvironmentMap", "Scene", "image_error", "load_file", "load_string", "merge_shares", "read_image", "render",
            "set_log_level", "study", "write_image"]
 
 
@@ -58,7 +58,7 @@ class _Bar:
 
 
 def render(scene, spp=None, integrator=None, strategy=None, seed=None, device="auto", time_limit=None, threads=0,
-           progress=True, sample_range=None):
+           progress=True, sample_range=None, noise_threshold=0.0, min_spp=16, stats=False):
     """Renders ``scene`` and returns its image as a float32 array (height, width, 3) that
     Python owns (NumPy's buffer protocol, ``__array__`` and ``__dlpack__``).
 
@@ -66,7 +66,10 @@ def render(scene, spp=None, integrator=None, strategy=None, seed=None, device="a
     starts from the scene's own. device is "auto" (a GPU where there is one and the
     integrator runs there), "cpu" or "cuda". time_limit: seconds, after which the render stops
     with the passes done. threads: CPU threads (0: every core). progress: a tqdm bar where tqdm
-    is installed.
+    is installed. noise_threshold > 0 samples adaptively, as ``envgi render --noise-threshold``:
+    every pixel takes min_spp samples, then stops once its noise is below the threshold.
+    stats=True returns (result, stats), stats a dict of the render's own "seconds" (without
+    loading or building), "spp", "mean_spp" (samples a pixel, on average) and "device".
 
     sample_range=(s0, s1) renders samples [s0, s1) of the spp-sample render only (path and
     direct), and returns that share's film as a dict: "sum" (H, W, 3), "weight" (the filter's
@@ -77,7 +80,8 @@ def render(scene, spp=None, integrator=None, strategy=None, seed=None, device="a
     bar = _Bar(progress)
     try:
         return _envgi.render(scene, spp, integrator, strategy, seed, device, float(time_limit or 0.0), int(threads),
-                             bar.callback(), None if sample_range is None else tuple(int(s) for s in sample_range))
+                             bar.callback(), None if sample_range is None else tuple(int(s) for s in sample_range),
+                             float(noise_threshold), int(min_spp), bool(stats))
     finally:
         bar.close()
 
@@ -118,12 +122,9 @@ def _cli():
     raise FileNotFoundError("the envgi command was not found: set ENVGI_CLI, or put envgi on PATH")
 
 
-def study(scene, output, strategies=None, spp=None, time=None, seeds=None, reference=None, reference_spp=None,
-          integrator=None, device="auto", as_frame=False, **params):
-    """Runs ``envgi study`` (docs/study.md) with the CLI's arguments: lists for strategies, spp
-    and time; keyword arguments for the scene's parameters. It writes output/results.csv,
-    results.json and report.html, resumes from the runs already in output, and returns the
-    results as a list of records, or as a pandas DataFrame with as_frame=True."""
+def _study_args(scene, output, strategies, spp, time, seeds, reference, reference_spp, integrator, device, params,
+                noise_threshold=None, min_spp=None, threads=None):
+    """The ``envgi study`` command line of study()'s arguments."""
     args = [_cli(), "study", str(scene), "-o", str(output), "-q", "--device", device]
 
     def listed(option, values):
@@ -134,17 +135,46 @@ def study(scene, output, strategies=None, spp=None, time=None, seeds=None, refer
     listed("--spp", spp)
     listed("--time", time)
     for option, value in (("--seeds", seeds), ("--reference", reference), ("--reference-spp", reference_spp),
-                          ("--integrator", integrator)):
+                          ("--integrator", integrator), ("--noise-threshold", noise_threshold),
+                          ("--min-spp", min_spp), ("--threads", threads)):
         if value is not None:
             args.extend([option, str(value)])
     for name, value in params.items():
         args.extend(["-D", f"{name}={str(value).lower() if isinstance(value, bool) else value}"])
+    return args
+
+
+def _run_study_cli(args):
     done = subprocess.run(args, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     if done.returncode != 0:
         message = done.stderr.strip().splitlines()[-1] if done.stderr.strip() else f"exit {done.returncode}"
         raise ValueError(message.removeprefix("envgi: error: "))
+
+
+def _study_records(output, as_frame):
     records = json.loads((Path(output) / "results.json").read_text())["runs"]
     if as_frame:
         import pandas
         return pandas.DataFrame.from_records(records)
     return records
+
+
+def study(scene, output, strategies=None, spp=None, time=None, seeds=None, reference=None, reference_spp=None,
+          integrator=None, device="auto", as_frame=False, cluster=None, **params):
+    """Runs ``envgi study`` (docs/study.md) with the CLI's arguments: lists for strategies, spp
+    and time; keyword arguments for the scene's parameters. It writes output/results.csv,
+    results.json and report.html, resumes from the runs already in output, and returns the
+    results as a list of records, or as a pandas DataFrame with as_frame=True.
+
+    cluster: a Ray address ("auto", "HOST:PORT", or "local" to start Ray here) runs each run,
+    and the reference's shares, as Ray tasks (envgi.distributed.study): the same files result."""
+    if cluster is not None:
+        from . import distributed
+
+        return distributed.study(scene, output, address=None if cluster == "local" else cluster,
+                                 strategies=strategies, spp=spp, time=time, seeds=seeds, reference=reference,
+                                 reference_spp=reference_spp, integrator=integrator, device=device,
+                                 as_frame=as_frame, **params)
+    _run_study_cli(_study_args(scene, output, strategies, spp, time, seeds, reference, reference_spp, integrator,
+                               device, params))
+    return _study_records(output, as_frame)

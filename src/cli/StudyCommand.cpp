@@ -4,14 +4,19 @@
 // finished run is a JSON file under DIR/runs, written atomically and skipped when re-run.
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <memory>
+#include <set>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <stdexcept>
@@ -41,6 +46,8 @@ struct StudyArgs {
   float noiseThreshold = 0.f;  // adaptive sampling in every run but the reference; 0: off
   int minSpp = 16;
   std::string device = "auto";
+  std::string plan;  // where to write the runs still to do, instead of rendering them
+  std::string ray;   // a Ray cluster's address: the runs go to envgi.distributed.study
 };
 
 std::vector<std::string> splitList(const std::string& s) {
@@ -77,38 +84,25 @@ constexpr long long kMaxStudySpp = 2147483647;
 
 // A strategy name of the study: a render strategy, points-N (the collapsed map with N lights,
 // every one at each point) or points-draw-N (one of them drawn a light sample), each with its
-// own sample counts (setStrategy) whatever the scene file asked for.
+// own sample counts (setStrategy) whatever the scene file asked for. A collapsed map's rows must
+// say their size.
 void applyStrategy(const std::string& name, Scene& scene) {
-  for (const char* base : {"points-draw", "points"}) {
-    const std::string prefix = std::string(base) + "-";
-    if (name.rfind(prefix, 0) != 0 || (std::string(base) == "points" && name.rfind("points-draw", 0) == 0)) continue;
-    long long n = 0;
-    try {
-      size_t used = 0;
-      n = std::stoll(name.substr(prefix.size()), &used);
-      if (used != name.size() - prefix.size()) n = 0;
-    } catch (...) {
-    }
-    if (n < 1 || n > kMaxCollapsedPoints)
-      throw std::runtime_error(
-          fmt::format("strategy '{}': {}-N needs a whole N from 1 to {}", name, base, kMaxCollapsedPoints));
-    scene.integrator.setStrategy(base);
-    scene.integrator.env.pointCount = int(n);
-    return;
-  }
   const StrategyName* known = nullptr;
   for (const StrategyName& n : kStrategyNames)
     if (name == n.name) known = &n;
-  if (!known) {
-    // The study's own names: the collapsed map's strategies take their size in the name.
+  if (known && isCollapsedMap(known->env)) throw std::runtime_error("strategy '" + name + "': name its size, " + name + "-N");
+  if (!known && name.rfind("points-", 0) != 0) {
     std::string list;
     for (const StrategyName& n : kStrategyNames)
       list += (list.empty() ? "" : ", ") + std::string(n.name) + (isCollapsedMap(n.env) ? "-N" : "");
     throw std::runtime_error("unknown strategy '" + name + "' (" + list + ")");
   }
-  if (isCollapsedMap(known->env)) throw std::runtime_error("strategy '" + name + "': name its size, " + name + "-N");
   scene.integrator.setStrategy(name);
 }
+
+// The sampler's seeds: the reference's, and each run's from its seed index.
+constexpr uint32_t kReferenceSeed = 1000003u;
+uint32_t runSeed(int seed) { return uint32_t(17 + 7919 * seed); }
 
 struct Rendered {
   Image image;
@@ -322,9 +316,16 @@ void runStudy(const StudyArgs& a) {
     ref = loadImage(refPath);
     checkReference(ref, refPath, scene);
     spdlog::info("study: reference {}", refPath);
+  } else if (a.reference.empty() && !a.plan.empty()) {
+    // Settings checked and folder made: what is left is the reference, then the runs against it.
+    nlohmann::json todo = {{"reference", {{"path", refPath}, {"strategy", "mis"}, {"spp", a.referenceSpp},
+                                          {"seed", kReferenceSeed}, {"integrator", a.integrator}}},
+                           {"runs", nlohmann::json::array()}};
+    writeFileAtomically(a.plan, todo.dump(2));
+    return;
   } else if (a.reference.empty()) {
     spdlog::info("study: rendering the reference, mis at {} spp", a.referenceSpp);
-    Rendered r = renderOnce(a, scene, accel, prepare, "mis", a.referenceSpp, 1000003u, true);
+    Rendered r = renderOnce(a, scene, accel, prepare, "mis", a.referenceSpp, kReferenceSeed, true);
     ref = r.image;
     saveImage(ref, refPath);
     spdlog::info("study: reference done in {:.1f} s", r.seconds);
@@ -344,6 +345,8 @@ void runStudy(const StudyArgs& a) {
   int middleSpp = sppList[sppList.size() / 2];
   std::map<std::string, double> secondsPerSpp;  // from the equal-samples runs, for the time budgets
   int done = 0, skipped = 0;
+  nlohmann::json todo = nlohmann::json::array();
+  std::set<std::string> sppRunsToDo;  // strategies whose equal-samples runs are not all done
   for (StudyRun r : plan) {
     ++done;
     std::string key = runKey(r), json = a.out + "/runs/" + key + ".json", exr = a.out + "/runs/" + key + ".exr";
@@ -369,10 +372,25 @@ void runStudy(const StudyArgs& a) {
         // Clamped before the cast: a budget of 1e12 s made a count past int's range (undefined).
         r.spp = sps > 0 ? int(std::clamp(r.timeBudget / sps, 1.0, double(kMaxStudySpp))) : 1;
       }
+      if (!a.plan.empty()) {
+        // A budget's sample count comes from the equal-samples runs' seconds: null until they are done.
+        const bool waits = r.timeBudget > 0 && sppRunsToDo.count(r.strategy);
+        if (r.timeBudget == 0) sppRunsToDo.insert(r.strategy);
+        todo.push_back({{"key", key},
+                        {"strategy", r.strategy},
+                        {"spp", waits ? nlohmann::json() : nlohmann::json(r.spp)},
+                        {"time_budget", r.timeBudget},
+                        {"seed", r.seed},
+                        {"render_seed", runSeed(r.seed)},
+                        {"image", wantImage},
+                        {"json", json},
+                        {"exr", exr}});
+        continue;
+      }
       spdlog::info("study: [{}/{}] {} {} seed {}", done, plan.size(), r.strategy,
                    r.timeBudget > 0 ? fmt::format("{} s ({} spp)", r.timeBudget, r.spp) : fmt::format("{} spp", r.spp),
                    r.seed);
-      Rendered img = renderOnce(a, scene, accel, prepare, r.strategy, r.spp, uint32_t(17 + 7919 * r.seed));
+      Rendered img = renderOnce(a, scene, accel, prepare, r.strategy, r.spp, runSeed(r.seed));
       ImageError e = imageError(img.image, ref);
       r.seconds = img.seconds;
       r.device = img.device;
@@ -391,6 +409,19 @@ void runStudy(const StudyArgs& a) {
       if (r.spp == sppList.back() || !secondsPerSpp.count(r.strategy)) secondsPerSpp[r.strategy] = sps;
     }
     runs.push_back(r);
+  }
+  if (!a.plan.empty()) {
+    nlohmann::json adaptive = a.noiseThreshold > 0.f ? nlohmann::json{{"noise_threshold", a.noiseThreshold}, {"min_spp", a.minSpp}}
+                                                     : nlohmann::json();
+    writeFileAtomically(a.plan, nlohmann::json{{"reference", nullptr},
+                                               {"reference_path", refPath},
+                                               {"integrator", a.integrator},
+                                               {"adaptive_sampling", adaptive},
+                                               {"done", skipped},
+                                               {"total", plan.size()},
+                                               {"runs", todo}}
+                                    .dump(2));
+    return;
   }
   std::string csv = "strategy,spp,time_budget,seed,seconds,rmse,relmse,worst_region_rmse,device,mean_spp\n";
   nlohmann::json all = nlohmann::json::array();
@@ -416,6 +447,47 @@ void runStudy(const StudyArgs& a) {
                runs.size(), skipped,
                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(),
                fs::absolute(a.out).string());
+}
+
+// study --ray: the same study as Ray tasks, run by envgi.distributed in the Python this build
+// made its module for (or $ENVGI_PYTHON), which calls this envgi back to plan and gather.
+[[noreturn]] void runStudyOnRay(const StudyArgs& a) {
+  if (!a.plan.empty()) throw std::runtime_error("--plan and --ray are each a way to run the study: choose one");
+#ifdef ENVGI_PYTHON_EXECUTABLE
+  const char* given = std::getenv("ENVGI_PYTHON");
+  const std::string python = given && *given ? given : ENVGI_PYTHON_EXECUTABLE;
+  nlohmann::json params = nlohmann::json::object();
+  for (const auto& [k, v] : parseDefines(a.defines)) params[k] = v;
+  auto listOf = [](const std::string& s) { return nlohmann::json(splitList(s)); };
+  nlohmann::json spec = {{"scene", a.scene},
+                         {"output", a.out},
+                         {"address", a.ray == "local" ? nlohmann::json() : nlohmann::json(a.ray)},
+                         {"strategies", listOf(a.strategies)},
+                         {"spp", listOf(a.spp)},
+                         {"time", a.times.empty() ? nlohmann::json() : listOf(a.times)},
+                         {"seeds", a.seeds},
+                         {"reference", a.reference.empty() ? nlohmann::json() : nlohmann::json(a.reference)},
+                         {"reference_spp", a.referenceSpp},
+                         {"integrator", a.integrator},
+                         {"device", a.device},
+                         {"noise_threshold", a.noiseThreshold},
+                         {"min_spp", a.minSpp},
+                         {"threads", a.threads > 0 ? a.threads : 1},  // a task renders with the CPUs it asks Ray for
+                         {"progress", spdlog::should_log(spdlog::level::info)},
+                         {"params", params}};
+  std::string pythonPath = ENVGI_PYTHON_PATH;
+  if (const char* p = std::getenv("PYTHONPATH"); p && *p) pythonPath += std::string(":") + p;
+  setenv("PYTHONPATH", pythonPath.c_str(), 1);
+  setenv("ENVGI_CLI", fs::read_symlink("/proc/self/exe").c_str(), 1);
+  const std::string json = spec.dump();
+  std::vector<const char*> argv = {python.c_str(), "-m", "envgi.distributed", "--study", json.c_str(), nullptr};
+  std::fflush(nullptr);
+  execv(python.c_str(), const_cast<char* const*>(argv.data()));
+  throw std::runtime_error(fmt::format("--ray: cannot run {} ({})", python, std::strerror(errno)));
+#else
+  throw std::runtime_error("--ray: this envgi was built without its Python package (ENVGI_PYTHON), which runs the "
+                           "study on Ray");
+#endif
 }
 
 }  // namespace
@@ -445,7 +517,18 @@ void addStudyCommand(CLI::App& app) {
       ->check(finiteNumber());
   c->add_option("--min-spp", a->minSpp, "With --noise-threshold: samples every pixel takes first (default 16)")
       ->check(atLeast(2));
-  c->callback([a] { runStudy(*a); });
+  // For envgi.distributed.study, which renders the runs as Ray tasks, writes their files, then
+  // runs the study once more to gather them into the same results and report.
+  c->add_option("--plan", a->plan,
+                "Check the settings, make the folder, and write the runs still to do (and the reference, where it "
+                "is missing) to this JSON file instead of rendering them");
+  c->add_option("--ray", a->ray,
+                "Run the study on a Ray cluster: its address (HOST:PORT, auto) or 'local' to start Ray here; the "
+                "same results and report (needs the Python package and Ray: scripts/install-deps.sh)");
+  c->callback([a] {
+    if (!a->ray.empty()) runStudyOnRay(*a);
+    runStudy(*a);
+  });
 }
 
 }  // namespace envgi::cli

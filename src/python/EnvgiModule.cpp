@@ -1,6 +1,7 @@
 // The native half of `import envgi` (pybind11): scenes loaded once and rendered many times,
 // environment maps and images as NumPy arrays. python/envgi/__init__.py wraps it with the
 // progress bar and the keyword defaults a Python user sees.
+#include <fmt/format.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -27,6 +28,7 @@
 #include "render/Renderer.h"
 #include "scene/NameTables.h"
 #include "scene/SceneLoader.h"
+#include "study/ErrorMetrics.h"
 
 namespace py = pybind11;
 
@@ -204,9 +206,13 @@ py::array_t<T> arrayOf(std::vector<T>&& v, std::vector<py::ssize_t> shape) {
 
 py::object render(LoadedScene& ls, std::optional<int> spp, std::optional<std::string> integrator,
                   std::optional<std::string> strategy, std::optional<uint32_t> seed, const std::string& device,
-                  double timeLimit, int threads, const py::object& onProgress, std::optional<std::pair<int, int>> range) {
+                  double timeLimit, int threads, const py::object& onProgress, std::optional<std::pair<int, int>> range,
+                  float noiseThreshold, int minSpp, bool withStats) {
   if (spp && *spp <= 0) throw BadInput("spp must be positive, not " + std::to_string(*spp));
   if (timeLimit < 0.0) throw BadInput("time_limit must be positive (or 0: none)");
+  if (!(noiseThreshold >= 0.f) || !std::isfinite(noiseThreshold))
+    throw BadInput("noise_threshold must be finite and not negative (0: off)");
+  if (minSpp < 2) throw BadInput("min_spp must be at least 2, not " + std::to_string(minSpp));
   Scene& scene = *ls.scene;
   Overrides set(scene, integrator, strategy, seed);
   requireLight(scene);
@@ -221,14 +227,17 @@ py::object render(LoadedScene& ls, std::optional<int> spp, std::optional<std::st
   ro.checkpointSeconds = 0.0;
   ro.cancel = &cancel;
   ro.timeLimitSeconds = timeLimit;
+  ro.noiseThreshold = noiseThreshold;
+  ro.adaptiveMinSpp = minSpp;
   FilmSums film;
   if (range) {  // the preparation refuses other integrators and a time limit (requireShareable)
     ro.firstSample = range->first, ro.sampleEnd = range->second;
     ro.filmOut = &film;
   }
   requireFilmFits(scene.camera, ro, physicalMemoryBytes());
+  RenderStats st;
+  std::string deviceName = "cpu";
   auto work = [&]() -> Image {
-    RenderStats st;
     if (!cuda) {
       if (!ls.accel) ls.accel = std::make_unique<EmbreeAccel>(scene);
       return envgi::render(scene, *ls.accel, ro, &st);
@@ -238,10 +247,21 @@ py::object render(LoadedScene& ls, std::optional<int> spp, std::optional<std::st
     if (scene.integrator.type == IntegratorType::Photon && !ls.accel) ls.accel = std::make_unique<EmbreeAccel>(scene);
     size_t bytes = 0;
     PreparedRender pr = gpu::prepareCudaRender(scene, *ls.bvh, ls.accel.get(), ro, 0, &bytes);
+    deviceName = pr.executor->deviceName();
     return renderPasses(*pr.executor, scene.camera.width, scene.camera.height, pr.spp, ro, &st);
   };
   py::array_t<float> img = toArray(runInterruptibly(work, &cancel, &fraction, onProgress));
-  if (!range) return std::move(img);
+  // The render's own seconds (without loading or the GPU's upload), as the study times its runs.
+  auto withStatsIfAsked = [&](py::object result) -> py::object {
+    if (!withStats) return result;
+    py::dict d;
+    d["seconds"] = st.seconds;
+    d["spp"] = st.sppDone;
+    d["mean_spp"] = double(st.pixelSamples) / (double(scene.camera.width) * double(scene.camera.height));
+    d["device"] = deviceName;
+    return py::make_tuple(result, d);
+  };
+  if (!range) return withStatsIfAsked(std::move(img));
   const size_t n = film.sum.size();
   const py::ssize_t H = scene.camera.height, W = scene.camera.width;
   std::vector<float> sum(3 * n);
@@ -251,7 +271,7 @@ py::object render(LoadedScene& ls, std::optional<int> spp, std::optional<std::st
   out["weight"] = film.weightSum.empty() ? py::object(py::none()) : py::object(arrayOf(std::move(film.weightSum), {H, W}));
   out["samples"] = range->second - range->first;
   out["image"] = img;
-  return std::move(out);
+  return withStatsIfAsked(std::move(out));
 }
 
 std::unique_ptr<LoadedScene> loadFile(const std::string& path, const py::kwargs& params) {
@@ -337,7 +357,23 @@ PYBIND11_MODULE(_envgi, m) {
   m.def("load_string", &loadString, py::arg("xml"));
   m.def("render", &envgi::python::render, py::arg("scene"), py::arg("spp"), py::arg("integrator"), py::arg("strategy"),
         py::arg("seed"), py::arg("device"), py::arg("time_limit"), py::arg("threads"), py::arg("on_progress"),
-        py::arg("sample_range"));
+        py::arg("sample_range"), py::arg("noise_threshold"), py::arg("min_spp"), py::arg("stats"));
+  m.def(
+      "image_error",
+      [](const py::array_t<float, py::array::c_style | py::array::forcecast>& image,
+         const py::array_t<float, py::array::c_style | py::array::forcecast>& reference) {
+        const Image a = fromArray(image), r = fromArray(reference);
+        if (a.width != r.width || a.height != r.height)
+          throw BadInput(fmt::format("image_error: the image is {}x{}, the reference {}x{}", a.width, a.height,
+                                     r.width, r.height));
+        const ImageError e = imageError(a, r);
+        py::dict d;
+        d["rmse"] = e.rmse;
+        d["relmse"] = e.relMse;
+        d["worst_region_rmse"] = e.worstRegionRmse;
+        return d;
+      },
+      py::arg("image"), py::arg("reference"));
 
   py::class_<EnvironmentMap>(m, "EnvironmentMap")
       .def(py::init([](const std::string& path, const std::string& layout) {

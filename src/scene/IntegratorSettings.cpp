@@ -141,7 +141,32 @@ bool IntegratorSettings::hidesEmitters() const {
   return false;
 }
 
+namespace {
+
+// N of "points-N" or "points-draw-N" where `name` is base + "-" + digits; 0 where it is not.
+long long sizeIn(const std::string& name, const std::string& base) {
+  const std::string prefix = base + "-";
+  if (name.rfind(prefix, 0) != 0) return 0;
+  const std::string digits = name.substr(prefix.size());
+  if (digits.empty() || digits.size() > 12 || !std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; }))
+    return 0;
+  return std::stoll(digits);
+}
+
+}  // namespace
+
 void IntegratorSettings::setStrategy(const std::string& name) {
+  for (const char* base : {"points-draw", "points"}) {
+    const std::string b = base;
+    if (name.rfind(b + "-", 0) != 0 || (b == "points" && name.rfind("points-draw", 0) == 0)) continue;
+    const long long n = sizeIn(name, b);
+    if (n < 1 || n > kMaxCollapsedPoints)
+      throw std::runtime_error("strategy '" + name + "': " + b + "-N needs a whole N from 1 to " +
+                               std::to_string(kMaxCollapsedPoints));
+    setStrategy(b);
+    env.pointCount = int(n);
+    return;
+  }
   findStrategy(name);
   env.strategy = name;
   direct.emitterSamples = direct.bsdfSamples = -1;

@@ -107,7 +107,8 @@ struct IntegratorSettings {
   // Reads the settings `type` takes (and the environment's); the others keep their defaults.
   static IntegratorSettings fromProperties(IntegratorType type, Properties& p);
   // Sets the strategy by name (checked) with its own sample counts (bsdf: BSDF samples only,
-  // mis: one of each), not those the scene file set.
+  // mis: one of each), not those the scene file set. The collapsed map's strategies may carry
+  // their size, as the study names them: points-64, points-draw-256.
   void setStrategy(const std::string& name);
   // The hide_emitters of the integrator `type` runs (SPPM has none: false).
   bool hidesEmitters() const;

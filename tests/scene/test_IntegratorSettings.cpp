@@ -150,6 +150,22 @@ TEST(IntegratorSettings, SetStrategyResetsDirectsCountsToTheStrategys) {
   EXPECT_THROW(s.setStrategy("nope"), std::runtime_error);
 }
 
+// The study's names carry the collapsed map's size; the same names work wherever a strategy is set.
+TEST(IntegratorSettings, CollapsedMapStrategiesMayCarryTheirSize) {
+  IntegratorSettings s;
+  s.setStrategy("points-256");
+  EXPECT_EQ(s.env.strategy, "points");
+  EXPECT_EQ(s.env.pointCount, 256);
+  s.setStrategy("points-draw-8");
+  EXPECT_EQ(s.env.strategy, "points-draw");
+  EXPECT_EQ(s.env.pointCount, 8);
+  s.setStrategy("points");  // the size the scene set stays
+  EXPECT_EQ(s.env.pointCount, 8);
+  for (const char* bad : {"points-0", "points-", "points-12x", "points-draw-99999999999", "points--3", "points-draw-"})
+    EXPECT_THROW(s.setStrategy(bad), std::runtime_error) << bad;
+  EXPECT_EQ(s.env.strategy, "points");
+}
+
 // Every listed name finds its value and back; aliases find theirs but are not listed.
 TEST(NameTables, NamesRoundTripAndUnknownNamesAreErrors) {
   for (const auto& n : kIntegratorNames) {
