@@ -50,10 +50,6 @@ struct ExitStatus {
 // -D name=value pairs into a map; throws on a pair without '='.
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds);
 
-// --device cpu|cuda|auto: whether to render on CUDA (auto: where a device is present, and says
-// so in the log when not); cuda without a device or a bad name throws.
-bool chooseCuda(const std::string& device);
-
 // A map strategy's name (scene/NameTables.h, map strategies only) as an EnvStrategy; throws on others.
 int parseStrategyName(const std::string& name);
 

@@ -157,13 +157,7 @@ void runRender(const RenderArgs& a) {
                  "points-draw do)",
                  scene.integrator.env.strategy);
   requireLight(scene);  // as photons says it
-  bool cuda = chooseCuda(a.device);
-  if (cuda && a.device == "auto") {
-    if (const std::string why = gpu::whyNotOnCuda(scene); !why.empty()) {
-      spdlog::info("device: CPU ({})", why);
-      cuda = false;
-    }
-  }
+  const bool cuda = gpu::chooseCuda(a.device, "--device", &scene);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   spdlog::info("scene {}: {} triangles, {} spheres, {} area-light primitives{}{}, {:.1f} MB of geometry, loaded in {:.2f} s",
                a.scene, scene.triangleCount(), scene.spheres.size(), scene.lightCount(),
@@ -333,17 +327,6 @@ void runRender(const RenderArgs& a) {
 }
 
 }  // namespace
-
-bool chooseCuda(const std::string& device) {
-  if (device != "cpu" && device != "cuda" && device != "auto")
-    throw std::runtime_error("unknown device '" + device + "' (cpu, cuda, auto)");
-  if (device == "cpu") return false;
-  std::string why;
-  int n = gpu::deviceCount(&why);
-  if (device == "cuda" && n == 0) throw std::runtime_error("--device cuda: no CUDA device (" + why + ")");
-  if (n == 0) spdlog::info("device: CPU ({})", why);
-  return n > 0;
-}
 
 std::map<std::string, std::string> parseDefines(const std::vector<std::string>& ds) {
   std::map<std::string, std::string> out;

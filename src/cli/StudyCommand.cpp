@@ -285,7 +285,7 @@ void runStudy(const StudyArgs& a) {
     throw std::runtime_error("study: '" + a.scene + "' has no environment map, so every strategy renders the same "
                              "image; the study compares ways of sampling one (add an <emitter type=\"envmap\">)");
   scene.finalize();
-  bool cuda = chooseCuda(a.device);
+  const bool cuda = gpu::chooseCuda(a.device, "--device", &scene);
   EmbreeAccel accel(scene);
   Preparer prepare;
   if (cuda) {

@@ -44,7 +44,7 @@ void runView(const ViewArgs& a) {
   vo.maxSpp = a.maxSpp;
   vo.noiseThreshold = a.noiseThreshold;
   vo.adaptiveMinSpp = a.minSpp;
-  if (chooseCuda(a.device)) {
+  if (gpu::chooseCuda(a.device, "--device", scene.get())) {
     vo.prepare = gpu::cudaPreparer(a.gpu);
     spdlog::info("view: rendering on {}", gpu::deviceName(a.gpu));
   }

@@ -75,6 +75,11 @@ std::unique_ptr<PassExecutor> makeCudaGridExecutor(const Scene& scene, const Bvh
 // refuses it with this, and `--device auto` renders it on the CPU instead.
 std::string whyNotOnCuda(const Scene& scene);
 
+// Whether a render asked for on `device` (cpu, cuda or auto) runs on a GPU: cuda without one is
+// an error naming `option` (the caller's name for the setting); auto takes one where there is
+// one and, given the scene, where it runs there (whyNotOnCuda), logging why not.
+bool chooseCuda(const std::string& device, const std::string& option, const Scene* scene);
+
 // The scene's integrator on GPU `gpu`, as prepareRender does it on the CPU: path, direct, sppm
 // and grid wholly there; photon traces its maps there and needs accel for the rest.
 PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const EmbreeAccel* accel, RenderOptions opts,

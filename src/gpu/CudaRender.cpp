@@ -14,6 +14,21 @@ std::string whyNotOnCuda(const Scene& scene) {
   return "";
 }
 
+bool chooseCuda(const std::string& device, const std::string& option, const Scene* scene) {
+  if (device != "cpu" && device != "cuda" && device != "auto")
+    throw std::runtime_error("unknown device '" + device + "' (cpu, cuda, auto)");
+  if (device == "cpu") return false;
+  std::string why;
+  if (deviceCount(&why) == 0) {
+    if (device == "cuda") throw std::runtime_error(option + " cuda: no CUDA device (" + why + ")");
+    spdlog::info("device: CPU ({})", why);
+    return false;
+  }
+  if (device == "auto" && scene) why = whyNotOnCuda(*scene);
+  if (!why.empty()) spdlog::info("device: CPU ({})", why);
+  return why.empty();
+}
+
 PreparedRender prepareCudaRender(const Scene& scene, const Bvh& bvh, const EmbreeAccel* accel, RenderOptions opts,
                                  int gpu, size_t* deviceBytes) {
   requireShareable(scene, opts);

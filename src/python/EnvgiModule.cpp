@@ -136,18 +136,6 @@ class Overrides {
   bool changed_ = false;
 };
 
-bool useCuda(const Scene& scene, const std::string& device) {
-  if (device != "cpu" && device != "cuda" && device != "auto")
-    throw BadInput("unknown device '" + device + "' (cpu, cuda, auto)");
-  if (device == "cpu") return false;
-  std::string why;
-  const int n = gpu::deviceCount(&why);
-  if (device == "cuda" && n == 0) throw BadInput("device 'cuda': no CUDA device (" + why + ")");
-  if (n == 0) return false;
-  if (device == "auto" && !gpu::whyNotOnCuda(scene).empty()) return false;
-  return true;
-}
-
 // An image as a float32 array (H, W, 3) that owns its pixels.
 py::array_t<float> toArray(Image&& img) {
   auto* pixels = new std::vector<float>(std::move(img.rgb));
@@ -216,7 +204,7 @@ py::object render(LoadedScene& ls, std::optional<int> spp, std::optional<std::st
   Scene& scene = *ls.scene;
   Overrides set(scene, integrator, strategy, seed);
   requireLight(scene);
-  const bool cuda = useCuda(scene, device);
+  const bool cuda = gpu::chooseCuda(device, "device", &scene);
   std::atomic<bool> cancel{false};
   std::atomic<float> fraction{0.f};
   RenderOptions ro;
