@@ -3,12 +3,14 @@
 #include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
 #include <functional>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 #include <tuple>
 
@@ -23,6 +25,7 @@
 #include "gpu/CudaExecutor.h"
 #include "render/AovRenderer.h"
 #include "render/Renderer.h"
+#include "render/SplitRender.h"
 #include "scene/SceneLoader.h"
 #include "scene/NameTables.h"
 
@@ -66,8 +69,39 @@ struct RenderArgs {
   std::string device = "auto", sampler, pointMethod, filter;
   int points = 0;
   int gpu = 0;
+  std::string gpus;     // all | 0,1,2: the node's GPUs the render splits over
   std::string samples;  // S0:S1, a share of the render
 };
+
+// --gpus all | 0,1,2: the devices a render splits over, of the `present` this machine has;
+// the list's form is checked before the count is asked for.
+std::vector<int> gpusOf(const std::string& text, const std::function<int()>& present) {
+  std::vector<int> list;
+  if (text != "all") {
+    std::stringstream ss(text);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+      size_t used = 0;
+      int g = -1;
+      try {
+        g = std::stoi(item, &used);
+      } catch (const std::exception&) {
+      }
+      if (g < 0 || used != item.size() || item.empty())
+        throw std::runtime_error("--gpus " + text + ": give all, or device numbers separated by commas (0,1,2)");
+      if (std::find(list.begin(), list.end(), g) != list.end())
+        throw std::runtime_error(fmt::format("--gpus {}: names GPU {} twice", text, g));
+      list.push_back(g);
+    }
+    if (list.empty()) throw std::runtime_error("--gpus: give all, or device numbers separated by commas (0,1,2)");
+  }
+  const int n = present();
+  if (text == "all")
+    for (int g = 0; g < n; ++g) list.push_back(g);
+  for (int g : list)
+    if (g >= n) throw std::runtime_error(fmt::format("--gpus {}: there is no GPU {} ({} present)", text, g, n));
+  return list;
+}
 
 // --samples S0:S1: samples [S0, S1) of the render's sequence (0 <= S0 < S1; renderPasses checks
 // them against the spp).
@@ -157,7 +191,24 @@ void runRender(const RenderArgs& a) {
                  "points-draw do)",
                  scene.integrator.env.strategy);
   requireLight(scene);  // as photons says it
-  const bool cuda = gpu::chooseCuda(a.device, "--device", &scene);
+  if (!a.gpus.empty() && a.device == "cpu") throw std::runtime_error("--gpus: the render is on the CPU (--device cpu)");
+  std::vector<int> gpus;  // with more than one, the render splits over them
+  int gpuIndex = a.gpu;
+  if (!a.gpus.empty()) {
+    gpus = gpusOf(a.gpus, [] {
+      std::string why;
+      const int n = gpu::deviceCount(&why);
+      if (n == 0) throw std::runtime_error("--gpus: no CUDA device (" + why + ")");
+      return n;
+    });
+    const IntegratorType t = scene.integrator.type;
+    if (gpus.size() > 1 && t != IntegratorType::Path && t != IntegratorType::Direct)
+      throw std::runtime_error(fmt::format("--gpus: only path and direct split over several GPUs; {} renders on one "
+                                           "(--gpus N)",
+                                           integratorName(t)));
+    gpuIndex = gpus[0];
+  }
+  const bool cuda = gpu::chooseCuda(a.gpus.empty() ? a.device : "cuda", "--device", &scene);
   double loadSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   spdlog::info("scene {}: {} triangles, {} spheres, {} area-light primitives{}{}, {:.1f} MB of geometry, loaded in {:.2f} s",
                a.scene, scene.triangleCount(), scene.spheres.size(), scene.lightCount(),
@@ -248,12 +299,26 @@ void runRender(const RenderArgs& a) {
     if (accel) traceAovs(*accel, requestedSpp);
     if (scene.integrator.type != IntegratorType::Photon) accel.reset();
     auto t2 = std::chrono::steady_clock::now();
-    size_t bytes = 0;
-    PreparedRender pr = gpu::prepareCudaRender(scene, bvh, accel.get(), ro, a.gpu, &bytes);
-    spdlog::info("device: {}: ready in {:.2f} s, {:.1f} MB of device memory", pr.executor->deviceName(),
-                 secondsSince(t2), bytes / 1e6);
-    img = renderPasses(*pr.executor, scene.camera.width, scene.camera.height, pr.spp, ro, &st);
-    logExecutorStats(*pr.executor);
+    if (gpus.size() > 1) {
+      // Each GPU a share of the samples, its film added to the others' (render/SplitRender.h).
+      spdlog::info("splitting {} spp over {} GPUs; no checkpoints while they render", requestedSpp, gpus.size());
+      img = renderSplit(scene.camera.width, scene.camera.height, kernelSettings(scene, ro).spp, int(gpus.size()), ro,
+                        [&](const RenderOptions& share, int i) {
+                          size_t bytes = 0;
+                          PreparedRender pr = gpu::prepareCudaRender(scene, bvh, nullptr, share, gpus[size_t(i)], &bytes);
+                          spdlog::info("device: {}: ready in {:.2f} s, {:.1f} MB of device memory",
+                                       pr.executor->deviceName(), secondsSince(t2), bytes / 1e6);
+                          return pr;
+                        },
+                        &st);
+    } else {
+      size_t bytes = 0;
+      PreparedRender pr = gpu::prepareCudaRender(scene, bvh, accel.get(), ro, gpuIndex, &bytes);
+      spdlog::info("device: {}: ready in {:.2f} s, {:.1f} MB of device memory", pr.executor->deviceName(),
+                   secondsSince(t2), bytes / 1e6);
+      img = renderPasses(*pr.executor, scene.camera.width, scene.camera.height, pr.spp, ro, &st);
+      logExecutorStats(*pr.executor);
+    }
   } else {
     auto t1 = std::chrono::steady_clock::now();
     EmbreeAccel accel(scene);
@@ -380,7 +445,11 @@ void addRenderCommand(CLI::App& app) {
                 "replaces the scene's aov integrator's list ('' for none)")
       ->each([a](const std::string&) { a->aovGiven = true; });
   c->add_option("--device", a->device, "cpu | cuda | auto (default: auto, CUDA where a GPU is present)");
-  c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(atLeast(0));
+  CLI::Option* one = c->add_option("--gpu", a->gpu, "Which CUDA device (default 0)")->check(atLeast(0));
+  c->add_option("--gpus", a->gpus,
+                "Split the render's samples over several CUDA devices of this machine: all, or a list (0,1,2); "
+                "path and direct")
+      ->excludes(one);
   c->add_option("--filter", a->filter, "Pixel filter: " + nameList(kFilterNames) + " (overrides the scene)");
   c->add_option("--sampler", a->sampler, "Sample sequence: " + nameList(kSamplerNames) + " (overrides the scene)");
   c->callback([a] { runRender(*a); });

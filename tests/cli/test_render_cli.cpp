@@ -710,6 +710,34 @@ TEST(RenderCli, DeviceChoice) {
   }
 }
 
+// --gpus: a list's form is checked first, then the devices present; with one GPU or more the
+// render splits over them (render/SplitRender.h, tested on the CPU), and with none it is one
+// error line and no file.
+TEST(RenderCli, GpusListsAreChecked) {
+  TempDir d;
+  std::string scene = tinyScene(d, 16, 2);
+  const std::string out = " -o " + d.file("gpus.exr") + " --no-progress ";
+  auto expectError = [&](const std::string& args, const std::string& message) {
+    CliResult r = runCli("render " + scene + out + args);
+    EXPECT_TRUE(r.code == 1 || r.code == 2) << args << ": " << r.code << " " << r.output;
+    EXPECT_NE(r.output.find(message), std::string::npos) << args << ": " << r.output;
+    EXPECT_FALSE(fs::exists(d.file("gpus.exr"))) << args;
+  };
+  expectError("--gpus 0,x", "--gpus 0,x: give all, or device numbers separated by commas (0,1,2)");
+  expectError("--gpus 0,,1", "give all, or device numbers");
+  expectError("--gpus -1", "give all, or device numbers");
+  expectError("--gpus 1,0,1", "--gpus 1,0,1: names GPU 1 twice");
+  expectError("--gpus all --device cpu", "--gpus: the render is on the CPU (--device cpu)");
+  expectError("--gpus 0,1 --gpu 1", "--gpu excludes --gpus");
+  bool gpu = runCli("render " + scene + " -o " + d.file("probe.exr") + " --device cuda --no-progress").code == 0;
+  if (!gpu) {
+    expectError("--gpus all", "envgi: error: --gpus: no CUDA device");
+    expectError("--gpus 0,1 --integrator sppm", "envgi: error: --gpus: no CUDA device");
+  } else {
+    expectError("--gpus 4096", "--gpus 4096: there is no GPU 4096");
+  }
+}
+
 // The log flags work before or after the subcommand: -q leaves warnings and errors only (no
 // progress bar either), -v is accepted there too.
 TEST(RenderCli, LogFlagsBeforeOrAfterTheSubcommand) {
