@@ -71,6 +71,13 @@ std::unique_ptr<PassExecutor> makeCudaGridExecutor(const Scene& scene, const Bvh
                                                    SampleSequence seq, int gpu, bool keepVariance,
                                                    size_t* deviceBytes = nullptr);
 
+// The grid integrator in the paper's basis (`basis` = directions): M directions a point, as
+// DirectionalGridExecutor on the CPU, with the gather and the camera passes on GPU `gpu`.
+std::unique_ptr<PassExecutor> makeCudaDirectionalGridExecutor(const Scene& scene, const Bvh& bvh,
+                                                              GridExecutorSettings s, int directions,
+                                                              SampleSequence seq, int gpu, bool keepVariance,
+                                                              size_t* deviceBytes = nullptr);
+
 // Why the scene's integrator cannot render on a GPU ("" where it can): prepareCudaRender
 // refuses it with this, and `--device auto` renders it on the CPU instead.
 std::string whyNotOnCuda(const Scene& scene);

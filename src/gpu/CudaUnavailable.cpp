@@ -34,6 +34,11 @@ std::unique_ptr<PassExecutor> makeCudaGridExecutor(const Scene&, const Bvh&, Gri
   throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
 }
 
+std::unique_ptr<PassExecutor> makeCudaDirectionalGridExecutor(const Scene&, const Bvh&, GridExecutorSettings, int,
+                                                              SampleSequence, int, bool, size_t*) {
+  throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
+}
+
 std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene&, const Bvh&, const KernelSettings&, int, bool, size_t*) {
   throw std::runtime_error("no CUDA device: this envgi was built without CUDA");
 }

@@ -1,5 +1,7 @@
 #include "render/DirectionalGridBuilder.h"
 
+#include <spdlog/spdlog.h>
+
 #include <cmath>
 
 #include "core/PhysicalMemory.h"
@@ -40,6 +42,12 @@ DirectionalGrid makeDirectionalGrid(const Scene& scene, int resolution, int m, u
   std::vector<float> share;
   gridDirections(scene, m, seed, &dirs, &share);
   return DirectionalGrid(b.lo, b.hi, b.nx, b.ny, b.nz, std::move(dirs), std::move(share));
+}
+
+void logDirectionalGrid(const DirectionalGrid& grid, const GridBuildStats& stats) {
+  const DirectionalGridView& v = grid.view();
+  spdlog::info("grid: {}x{}x{} points x {} directions, {} samples each, {:.2f} M rays in {:.2f} s, {:.1f} MB", v.nx,
+               v.ny, v.nz, v.m, grid.samplesPerDirection(), stats.rays / 1e6, stats.seconds, grid.bytes() / 1e6);
 }
 
 }  // namespace envgi

@@ -18,4 +18,7 @@ void gridDirections(const Scene& scene, int m, uint32_t seed, std::vector<Vec3f>
 // refused where it would not fit in half the machine's memory.
 DirectionalGrid makeDirectionalGrid(const Scene& scene, int resolution, int m, uint32_t seed);
 
+// The log's line for a filled grid: its points, directions, samples, rays, time and size.
+void logDirectionalGrid(const DirectionalGrid& grid, const GridBuildStats& stats);
+
 }  // namespace envgi

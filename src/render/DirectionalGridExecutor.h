@@ -15,11 +15,13 @@
 #include "render/Cancellation.h"
 #include "render/CpuExecutor.h"
 #include "render/DirectionalGridBuilder.h"
+#include "render/RefiningExecutor.h"
 
 namespace envgi {
 
 template <class Tracer>
-class DirectionalGridExecutor final : public PassExecutor {
+class DirectionalGridExecutor final
+    : public RefiningExecutor<CpuExecutor<GridSample<Tracer, DirectionalGridView>>> {
  public:
   DirectionalGridExecutor(const Scene& scene, Tracer tracer, const GridExecutorSettings& s, int directions,
                           SampleSequence seq, int threads, bool keepVariance, int tileSize)
@@ -29,22 +31,9 @@ class DirectionalGridExecutor final : public PassExecutor {
     gather(0, samplesFor(s.gatherRays), s.cancel);
     GridSample<Tracer, DirectionalGridView> sample{&scene.view(), tracer, grid_.view(), caustic_.irradianceCache().view(),
                                          s.params};
-    camera_ = std::make_unique<CpuExecutor<GridSample<Tracer, DirectionalGridView>>>(scene.view().camera, seq, sample, threads,
+    this->camera_ = std::make_unique<CpuExecutor<GridSample<Tracer, DirectionalGridView>>>(scene.view().camera, seq, sample, threads,
                                                                            keepVariance, "cpu", tileSize);
   }
-  std::string deviceName() const override { return "cpu"; }
-  void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
-    if (passes_++ > 0) {
-      const int done = grid_.samplesPerDirection(), limit = samplesFor(settings_.maxGatherRays);
-      const int add = settings_.refineRays > 0 ? std::min(samplesFor(settings_.refineRays), limit - done) : 0;
-      if (add > 0) gather(done, add, nullptr);
-    }
-    camera_->runPass(s0, s1, progress, counters);
-  }
-  void readFilm(FilmSums* out) override { camera_->readFilm(out); }
-  bool restart(const Camera& cam) override { return camera_->restart(cam); }
-  bool setActivePixels(const std::vector<unsigned char>& mask) override { return camera_->setActivePixels(mask); }
-  bool keepsVariance() const override { return camera_->keepsVariance(); }
   const DirectionalGrid& grid() const { return grid_; }
   const PhotonShootStats& photonStats() const { return photonStats_; }
   const GridBuildStats& gridStats() const { return stats_; }
@@ -53,6 +42,12 @@ class DirectionalGridExecutor final : public PassExecutor {
   // The SH grid's ray budgets (gather_rays, refine_rays, max_gather_rays) are rays a point: the
   // same budget here is that many rays over the M directions, at least one sample each.
   int samplesFor(int rays) const { return std::max(1, rays / std::max(1, grid_.directions())); }
+
+  void refine() override {
+    const int done = grid_.samplesPerDirection(), limit = samplesFor(settings_.maxGatherRays);
+    const int add = settings_.refineRays > 0 ? std::min(samplesFor(settings_.refineRays), limit - done) : 0;
+    if (add > 0) gather(done, add, nullptr);
+  }
 
   void gather(int first, int samples, const std::atomic<bool>* cancel) {
     auto t0 = std::chrono::steady_clock::now();
@@ -80,12 +75,10 @@ class DirectionalGridExecutor final : public PassExecutor {
   const Scene& scene_;
   Tracer tracer_;
   GridExecutorSettings settings_;
-  int passes_ = 0;
   DirectionalGrid grid_;
   PhotonMap global_, caustic_;
   PhotonShootStats photonStats_;
   GridBuildStats stats_;
-  std::unique_ptr<CpuExecutor<GridSample<Tracer, DirectionalGridView>>> camera_;
 };
 
 }  // namespace envgi

@@ -157,10 +157,7 @@ PreparedRender prepareOnTracer(const Scene& scene, const Tracer& tracer, const R
                                                                     q.sequence, opts.threads, opts.keepsVariance(),
                                                                     opts.tileSize);
         logPhotonStats(ex->photonStats());
-        const DirectionalGridView& gv = ex->grid().view();
-        spdlog::info("grid: {}x{}x{} points x {} directions, {} samples each, {:.2f} M rays in {:.2f} s, {:.1f} MB",
-                     gv.nx, gv.ny, gv.nz, gv.m, ex->grid().samplesPerDirection(), ex->gridStats().rays / 1e6,
-                     ex->gridStats().seconds, ex->grid().bytes() / 1e6);
+        logDirectionalGrid(ex->grid(), ex->gridStats());
         return {std::move(ex), q.spp};
       }
       auto ex = std::make_unique<GridExecutor<Tracer>>(scene, tracer, ge, q.sequence, opts.threads,
