@@ -63,9 +63,15 @@ TEST(ViewBrowser, OrbitExposureSaveInHeadlessChromium) {
             " e.dispatchEvent(new Event('input')); })()");
   EXPECT_TRUE(page.waitFor("envgiTest.lastMeta.exposure === 2", 30));
 
-  // Save: a readable EXR beside the scene, named in the page (of the full film, once the
-  // move's coarse first frame has given way to it).
-  ASSERT_TRUE(page.waitFor("envgiTest.lastMeta.width === 96", 30)) << view.log();
+  // Save: a readable EXR beside the scene, named in the page (of the full film, once the view
+  // has settled: the last camera the page sent is the frame's, the move's preview integrator
+  // has given way to the page's own, and the coarse first frame to the full one; a slow build
+  // showed a full frame of an earlier camera, then the last camera's coarse one was saved).
+  ASSERT_TRUE(page.waitFor("envgiTest.lastMeta.cameraVersion === envgiTest.cameraSent && "
+                           "envgiTest.lastMeta.integrator === document.getElementById('integrator').value && "
+                           "envgiTest.lastMeta.width === 96",
+                           30))
+      << page.eval("JSON.stringify(envgiTest)").dump() << view.log();
   page.eval("document.getElementById('save').click()");
   ASSERT_TRUE(page.waitFor("envgiTest.saved !== null", 30)) << view.log();
   std::string saved = page.eval("envgiTest.saved");
