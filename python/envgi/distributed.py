@@ -196,13 +196,17 @@ def study(scene, output, address=None, strategies=None, spp=None, time=None, see
     written to output/runs at once, so a study stopped midway resumes from them; the results
     equal a local study's. The scene is read by path on every node (a shared path, as render's);
     the reference travels once through Ray's object store. Returns the records, as envgi.study."""
-    if device == "auto":
-        device = "cpu"  # each task's own device: a cluster's nodes may differ
+    if device not in ("auto", "cpu", "cuda"):
+        raise ValueError(f"unknown device '{device}' (cpu, cuda, auto)")
     scene = os.path.abspath(scene)
-    args = envgi._study_args(scene, output, strategies, spp, time, seeds, reference, reference_spp, integrator, device,
+    # The envgi command here only plans and gathers, on this machine, which need not have the
+    # workers' GPUs: its device is the CPU's (study.json does not record the device).
+    args = envgi._study_args(scene, output, strategies, spp, time, seeds, reference, reference_spp, integrator, "cpu",
                              params, noise_threshold, min_spp)
     plan = _plan(args)  # settings checked, the folder made: before any cluster is joined
     ray = _connect(address)
+    if device == "auto":  # the cluster's GPUs where it has any
+        device = "cuda" if ray.cluster_resources().get("GPU", 0) >= 1 else "cpu"
     _require_gpus(ray, device)
     settings = {"device": device, "integrator": plan.get("integrator") or (plan["reference"] or {}).get("integrator"),
                 "threads": threads}

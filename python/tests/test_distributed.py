@@ -92,11 +92,14 @@ def test_a_killed_worker_node_costs_a_retry_not_a_sample(cluster):
         assert not status.exists() or "State:\tZ" in status.read_text()
 
 
-def test_bad_input_is_a_clear_error_not_a_hang(cluster):
+def test_bad_input_is_a_clear_error_not_a_hang(cluster, tmp_path):
     with pytest.raises(FileNotFoundError, match="no-such-scene.xml"):
         ed.render(SOURCE / "no-such-scene.xml", spp=4, parts=2, progress=False)
     with pytest.raises(ValueError, match="no node of the Ray cluster has a GPU"):
         ed.render(BUDDHA, spp=4, parts=2, device="cuda", progress=False, res=8)
+    # The driver plans on its own CPU whatever the workers' device: the cluster refuses it.
+    with pytest.raises(ValueError, match="no node of the Ray cluster has a GPU"):
+        ed.study(BUDDHA, tmp_path, address=cluster, device="cuda", progress=False, spp=[1], reference_spp=4, res=8)
 
 
 STUDY = dict(strategies=["uniform", "importance", "points-8"], spp=[1, 4, 16], seeds=2, reference_spp=64,
@@ -161,7 +164,8 @@ def test_envgi_study_ray_is_the_same_study(cluster, local_study, tmp_path):
 def test_a_study_survives_a_killed_worker_node(cluster, local_study, tmp_path):
     # The reference (64 spp) takes most of a second: the node dies among the first runs.
     _, killed = kill_node_later(WORKER_PORTS[1], 1.0)
-    ed.study(BUDDHA, tmp_path, address=cluster, device="cpu", progress=False, **STUDY)
+    # auto: the cluster's GPUs where it has any, its CPUs here.
+    ed.study(BUDDHA, tmp_path, address=cluster, device="auto", progress=False, **STUDY)
     assert killed and killed[0] < time.monotonic()
     table = rows(tmp_path)  # rows() fails on a run counted twice
     assert len(table) == 3 * 4 * 2
