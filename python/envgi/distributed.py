@@ -137,7 +137,13 @@ def _render_shares(ray, scene_path, spp, parts, device, settings, max_retries, p
     for i, s0, s1 in sample_ranges(spp, parts):
         pending[task.remote(str(scene_path), params, spp, s0, s1, settings)] = (i, s0, s1)
     results = []
-    _gather(ray, pending, lambda info, share: results.append((*info, share)), progress)
+    try:
+        _gather(ray, pending, lambda info, share: results.append((*info, share)), progress)
+    except Exception as e:
+        # What finished is kept: (index, s0, s1, share) each, for merge_shares or a second try
+        # at the ranges that are missing.
+        e.finished_shares = results
+        raise
     return merge_checked(spp, results)
 
 
@@ -147,7 +153,8 @@ def render(scene_path, spp, parts=None, address=None, device="cpu", integrator=N
     "auto", "HOST:PORT", or None to start Ray here) and returns the merged float32 image, equal
     to envgi.render's of the same settings up to float rounding. parts defaults to the cluster's
     CPUs (GPUs with device="cuda"); each task takes `threads` CPUs. Keyword arguments are the
-    scene's parameters."""
+    scene's parameters. Where a task fails, its error is raised with the shares that finished
+    as its ``finished_shares``."""
     ray = _connect(address)
     settings = {"device": device, "integrator": integrator, "strategy": strategy, "seed": seed, "threads": threads}
     return _render_shares(ray, scene_path, spp, parts, device, settings, max_retries, progress, params)

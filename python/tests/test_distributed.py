@@ -93,8 +93,9 @@ def test_a_killed_worker_node_costs_a_retry_not_a_sample(cluster):
 
 
 def test_bad_input_is_a_clear_error_not_a_hang(cluster, tmp_path):
-    with pytest.raises(FileNotFoundError, match="no-such-scene.xml"):
+    with pytest.raises(FileNotFoundError, match="no-such-scene.xml") as failed:
         ed.render(SOURCE / "no-such-scene.xml", spp=4, parts=2, progress=False)
+    assert failed.value.finished_shares == []
     with pytest.raises(ValueError, match="no node of the Ray cluster has a GPU"):
         ed.render(BUDDHA, spp=4, parts=2, device="cuda", progress=False, res=8)
     # The driver plans on its own CPU whatever the workers' device: the cluster refuses it.
