@@ -173,7 +173,7 @@ class CudaDirectionalGridExecutor final
     view_.share = a.upload(hv.share, size_t(hv.m), "grid directions");
     view_.coeff = a.allocate<Color>(coeffs, "directional grid");
     view_.weight = a.allocate<float>(n_, "directional grid");
-    gather(0, samplesFor(s.gatherRays));
+    gather(0, directionalSamples(s.gatherRays, grid_.directions()));
     logPhotonStats(photonStats_);
     logDirectionalGrid(grid_, stats_);
     GridSample<BvhTracer, DirectionalGridView> sample{sceneView_, tracer_, view_, causticView_, s.params};
@@ -185,13 +185,9 @@ class CudaDirectionalGridExecutor final
 
  private:
   void refine() override {
-    const int done = grid_.samplesPerDirection(), limit = samplesFor(s_.maxGatherRays);
-    const int add = s_.refineRays > 0 ? std::min(samplesFor(s_.refineRays), limit - done) : 0;
+    const int done = grid_.samplesPerDirection(), add = directionalSamplesToAdd(s_, grid_.directions(), done);
     if (add > 0) gather(done, add);
   }
-
-  // The CPU's budgets (DirectionalGridExecutor::samplesFor): rays a point over the M directions.
-  int samplesFor(int rays) const { return std::max(1, rays / std::max(1, grid_.directions())); }
 
   // Samples [first, first + samples) of every direction of every point on the device; the host
   // adds them to the grid, averages, and uploads the coefficients and weights.
@@ -199,7 +195,7 @@ class CudaDirectionalGridExecutor final
     auto t0 = std::chrono::steady_clock::now();
     check(cudaMemset(rays_, 0, sizeof(unsigned long long)), "clearing counters");
     const std::atomic<bool>* cancel = first == 0 ? s_.cancel : nullptr;
-    const int length = std::max(samplesFor(s_.gatherRays), samplesFor(s_.maxGatherRays));
+    const int length = directionalSequenceLength(s_, grid_.directions());
     const int n = int(n_), m = grid_.directions();
     // Fewer points a launch where each carries M directions: a launch stays milliseconds.
     const int perLaunch = std::max(kThreads, kPointsPerLaunch / std::max(1, m / 16));

@@ -2,6 +2,7 @@
 // the sphere, and the grid over the scene's bounds that holds M coefficients a point.
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "photon/DirectionalGrid.h"
@@ -17,6 +18,20 @@ void gridDirections(const Scene& scene, int m, uint32_t seed, std::vector<Vec3f>
 // A directional grid over the scene's bounds, as makeIlluminationGrid places the SH grid's points;
 // refused where it would not fit in half the machine's memory.
 DirectionalGrid makeDirectionalGrid(const Scene& scene, int resolution, int m, uint32_t seed);
+
+// The basis's sample budgets, on either device. The SH grid's ray budgets (gather_rays,
+// refine_rays, max_gather_rays) are rays a point; here each is that many rays over the m
+// directions, at least one sample of each.
+inline int directionalSamples(int rays, int m) { return std::max(1, rays / std::max(1, m)); }
+// Samples of every direction to add before a pass, with `done` already taken.
+inline int directionalSamplesToAdd(const GridExecutorSettings& s, int m, int done) {
+  const int limit = directionalSamples(s.maxGatherRays, m);
+  return s.refineRays > 0 ? std::min(directionalSamples(s.refineRays, m), limit - done) : 0;
+}
+// The samples each direction's Sobol sequence is laid out for, refinement included.
+inline int directionalSequenceLength(const GridExecutorSettings& s, int m) {
+  return std::max(directionalSamples(s.gatherRays, m), directionalSamples(s.maxGatherRays, m));
+}
 
 // The log's line for a filled grid: its points, directions, samples, rays, time and size.
 void logDirectionalGrid(const DirectionalGrid& grid, const GridBuildStats& stats);

@@ -28,7 +28,7 @@ class DirectionalGridExecutor final
       : scene_(scene), tracer_(tracer), settings_(s) {
     grid_ = makeDirectionalGrid(scene, s.resolution, directions, s.seed);
     shootPhotons(scene, s.photons, &global_, &caustic_, &photonStats_);
-    gather(0, samplesFor(s.gatherRays), s.cancel);
+    gather(0, directionalSamples(s.gatherRays, grid_.directions()), s.cancel);
     GridSample<Tracer, DirectionalGridView> sample{&scene.view(), tracer, grid_.view(), caustic_.irradianceCache().view(),
                                          s.params};
     this->camera_ = std::make_unique<CpuExecutor<GridSample<Tracer, DirectionalGridView>>>(scene.view().camera, seq, sample, threads,
@@ -39,13 +39,9 @@ class DirectionalGridExecutor final
   const GridBuildStats& gridStats() const { return stats_; }
 
  private:
-  // The SH grid's ray budgets (gather_rays, refine_rays, max_gather_rays) are rays a point: the
-  // same budget here is that many rays over the M directions, at least one sample each.
-  int samplesFor(int rays) const { return std::max(1, rays / std::max(1, grid_.directions())); }
 
   void refine() override {
-    const int done = grid_.samplesPerDirection(), limit = samplesFor(settings_.maxGatherRays);
-    const int add = settings_.refineRays > 0 ? std::min(samplesFor(settings_.refineRays), limit - done) : 0;
+    const int done = grid_.samplesPerDirection(), add = directionalSamplesToAdd(settings_, grid_.directions(), done);
     if (add > 0) gather(done, add, nullptr);
   }
 
@@ -53,7 +49,7 @@ class DirectionalGridExecutor final
     auto t0 = std::chrono::steady_clock::now();
     const SceneView& sc = scene_.view();
     const IrradianceCacheView &g = global_.irradianceCache().view(), &c = caustic_.irradianceCache().view();
-    const int length = std::max(samplesFor(settings_.gatherRays), samplesFor(settings_.maxGatherRays));
+    const int length = directionalSequenceLength(settings_, grid_.directions());
     std::atomic<uint64_t> rays{0};
     tbb::parallel_for(size_t(0), grid_.pointCount(), [&](size_t i) {
       if (cancelRequested(cancel)) return;
