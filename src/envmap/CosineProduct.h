@@ -52,37 +52,16 @@ ENVGI_INLINE float insidePixel(int p, float r, int n) {
   return f;
 }
 
-// sample()'s chain of dependent loads walked one level at a time across a batch of draws
-// (CPU only): each level's address comes from the one before, so a batch that asks every draw
-// for a level before reading any of them overlaps the misses that sample() takes in a row.
-struct ProductDrawAhead {
+// A draw of sample() taken one level of its dependent loads at a time (descend0 to
+// descendToPixel, then descentEnd). Each level's address comes from the one before, so a batch
+// of draws that asks every draw for a level before reading any of them overlaps the cache misses
+// that sample() takes in a row. Host only: it prefetches.
+struct ProductDescent {
   int k = -1, c = -1;  // the bucket; the cell, once known
   int lo = 0, hi = 0;  // the guide's bracket at the level being asked for
-  int j = -1;          // the pixel inside the cell, once known (level 4)
+  int j = -1;          // the pixel inside the cell, once known
   Vec2f u;
   Vec3f nLocal;
-};
-
-// A product draw made ahead to its end (CosineProductView::aheadDraw): what sample() returns for
-// u and nLocal, which EnvironmentMapView::sample takes where it draws for the very same u and
-// normal (and draws afresh for any other).
-struct ProductDraw {
-  Vec2f u;
-  Vec3f nLocal;
-  Vec2f uv;
-  float pdfUV = 0.f;
-  bool drawn = false;  // sample()'s answer: false where it draws nothing
-  // uv and pdfUV already placed inside the pixel (EnvironmentMapView::placeInPixel), and the
-  // map's radiance there looked up (RoundLanes::placeDraws).
-  bool placed = false;
-  Color radiance;
-  // Its world direction (EnvironmentMapView::fromLocal(uvToDir(uv))), worked out ahead (the
-  // CPU's tile wavefront, for the BSDF's value there in lanes).
-  bool directed = false;
-  Vec3f dir;
-  ENVGI_HD bool isFor(Vec2f u2, Vec3f n2) const {
-    return u.x == u2.x && u.y == u2.y && nLocal.x == n2.x && nLocal.y == n2.y && nLocal.z == n2.z;
-  }
 };
 
 struct CosineProductView {
@@ -167,17 +146,17 @@ struct CosineProductView {
   }
 
   // The levels of sample(u, nLocal)'s loads, asked for in order: level 0 the bucket's guide
-  // entry, 1 its cdf bracket, 2 the cell's guide entry, 3 the cell's cdf bracket; level 4
-  // returns the pixel sample() will draw (false where it draws none); aheadDraw then ends the
-  // draw as sample() would, from the loads the levels made.
-  void aheadLevel0(Vec2f u, Vec3f nLocal, ProductDrawAhead* a) const {
+  // entry, 1 its cdf bracket, 2 the cell's guide entry, 3 the cell's cdf bracket; then the pixel
+  // sample() draws (false where it draws none), and descentEnd ends the draw as sample() does,
+  // from the loads the levels made.
+  void descend0(Vec2f u, Vec3f nLocal, ProductDescent* a) const {
     a->u = u;
     a->nLocal = nLocal;
     a->k = bucket(nLocal);
     if (!(bucketInt[a->k] > 0.f)) { a->k = -1; return; }
     prefetchLine(bucketGuide + size_t(a->k) * (bucketGuideSize + 1) + guideSlot(u.x, bucketGuideSize));
   }
-  void aheadLevel1(ProductDrawAhead* a) const {
+  void descend1(ProductDescent* a) const {
     if (a->k < 0) return;
     const int* g = bucketGuide + size_t(a->k) * (bucketGuideSize + 1) + guideSlot(a->u.x, bucketGuideSize);
     const float* cdf = bucketCdf + size_t(a->k) * (cells() + 1);
@@ -185,14 +164,14 @@ struct CosineProductView {
     prefetchLine(cdf + a->lo);
     prefetchLine(cdf + a->hi);
   }
-  void aheadLevel2(ProductDrawAhead* a) const {
+  void descend2(ProductDescent* a) const {
     if (a->k < 0) return;
     const float* cdf = bucketCdf + size_t(a->k) * (cells() + 1);
     a->c = findIntervalBetweenNoBranch(cdf, a->lo, a->hi, a->u.x);
     prefetchLine(cellGuide + size_t(a->c) * (cellGuideSize + 1) + guideSlot(a->u.y, cellGuideSize));
     prefetchLine(cellCdfStart + a->c);
   }
-  void aheadLevel3(ProductDrawAhead* a) const {
+  void descend3(ProductDescent* a) const {
     if (a->k < 0) return;
     const int* g = cellGuide + size_t(a->c) * (cellGuideSize + 1) + guideSlot(a->u.y, cellGuideSize);
     const float* pc = cellCdf + cellCdfStart[a->c];
@@ -200,7 +179,7 @@ struct CosineProductView {
     prefetchLine(pc + a->lo);
     prefetchLine(pc + a->hi);
   }
-  bool aheadLevel4(ProductDrawAhead* a, int* px, int* py) const {
+  bool descendToPixel(ProductDescent* a, int* px, int* py) const {
     if (a->k < 0) return false;
     const float* pc = cellCdf + cellCdfStart[a->c];
     const int j = a->j = findIntervalBetweenNoBranch(pc, a->lo, a->hi, a->u.y);
@@ -210,11 +189,9 @@ struct CosineProductView {
     *px = x0 + (j - jy * cw), *py = cellStartY[cy] + jy;
     return true;
   }
-  ProductDraw aheadDraw(const ProductDrawAhead& a) const {
-    ProductDraw d;
-    d.u = a.u, d.nLocal = a.nLocal;
-    if (a.k >= 0) d.drawn = drawIn(a.u, a.k, a.c, a.j, &d.uv, &d.pdfUV);
-    return d;
+  // sample()'s answer for the descent's u and nLocal: the same uv and density to the bit.
+  bool descentEnd(const ProductDescent& a, Vec2f* uv, float* pdfOut) const {
+    return a.k >= 0 && drawIn(a.u, a.k, a.c, a.j, uv, pdfOut);
   }
 
   // Where pdf() reads for (uv, nLocal): the bucket, the cell and the pixel inside the cell.
@@ -231,7 +208,7 @@ struct CosineProductView {
     const Step s = stepAt(uv, nLocal);
     return pdfUV(s.k, s.c, s.j);
   }
-  // The two cdf entries pdf(uv, nLocal) reads first, asked for ahead (CPU only).
+  // The two cdf entries pdf(uv, nLocal) reads first, prefetched (host only).
   void prefetchPdf(Vec2f uv, Vec3f nLocal) const {
     const Step s = stepAt(uv, nLocal);
     prefetchLine(bucketCdf + size_t(s.k) * (cells() + 1) + s.c);

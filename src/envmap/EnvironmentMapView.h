@@ -101,8 +101,8 @@ struct EnvironmentMapView {
     return {st * std::sin(phi), std::cos(theta), -st * std::cos(phi)};
   }
 
-  // A texel's radiance. Index: what the texel's offset is counted in. 32 bits unsigned lets a loop of lookups gather
-  // (RoundLanes::mapRadiance), for a map of at most 2^30 pixels (fitsUnsignedIndex).
+  // A texel's radiance. Index: what the texel's offset is counted in. 32 bits unsigned lets a
+  // loop of lookups gather, for a map of at most 2^30 pixels (fitsUnsignedIndex).
   template <class Index = size_t>
   ENVGI_HD static Color texelIn(const float* texels, int width, int x, int y) {
     const Index i = (Index(y) * Index(width) + Index(x)) * Index(4);
@@ -112,8 +112,8 @@ struct EnvironmentMapView {
 
   // Bilinear between pixel centres, wrapping across the phi seam and clamping at the poles.
   ENVGI_HD Color lookupUV(Vec2f uv) const { return lookupIn(texels, width, height, rowsFromPoles, scale, bilinear, uv); }
-  // lookupUV from the members it reads, passed one by one: a loop over many lookups
-  // (RoundLanes::mapRadiance) holds them in registers and vectorises.
+  // lookupUV from the members it reads, passed one by one: a loop over many lookups holds them
+  // in registers and vectorises.
   template <class Index = size_t>
   ENVGI_HD static Color lookupIn(const float* texels, int width, int height, bool rowsFromPoles, float scale,
                                  bool bilinear, Vec2f uv) {
@@ -146,8 +146,7 @@ struct EnvironmentMapView {
     neighbourhoodLuminanceIn(texels, width, height, px, py, l);
   }
   // The members' forms of these functions take what they read as arguments (the static ...In
-  // forms), so that a loop over many draws (RoundLanes::placeDraws) holds it in registers; Index
-  // as in texelIn.
+  // forms), so that a loop over many draws holds it in registers; Index as in texelIn.
   template <class Index = size_t>
   ENVGI_HD static void neighbourhoodLuminanceIn(const float* texels, int width, int height, int px, int py,
                                                 float l[3][3]) {
@@ -201,7 +200,7 @@ struct EnvironmentMapView {
   }
   // Settle false leaves out insidePixel's last steps, which a loop over many draws cannot
   // vectorise: its answer is warpInPixel's where each coordinate lands in pixel p (insidePixel's
-  // steps then take none), and is redone by warpInPixel elsewhere (RoundLanes::placeDraws).
+  // steps then take none), and is redone by warpInPixel elsewhere.
   template <class Index = size_t, bool Settle = true>
   ENVGI_HD static Vec2f warpInPixelIn(const float* texels, int width, int height, const PixelPoint& p, float* rel) {
     float v[3][3];
@@ -303,9 +302,9 @@ struct EnvironmentMapView {
   // tried too and cost more than they saved.
   void prefetchEmission(Vec2f u) const { prefetchLine(emission.bins + emission.column(u)); }
 
-  // Asks for what evalWithPdf(s, worldDir, normal) reads from the map (CPU only: a round of
-  // escaped rays prefetches them all before shading, so that their misses overlap): the texel
-  // rows the lookup and the in-pixel density read and, for product, its two cdf steps.
+  // Asks for what evalWithPdf(s, worldDir, normal) reads from the map (host only: a batch of
+  // directions prefetched before any is read overlaps its misses): the texel rows the lookup and
+  // the in-pixel density read and, for product, its two cdf steps.
   // uv: where the direction meets the map (dirToUV's).
   void prefetchEvalWithPdf(EnvStrategy s, Vec2f uv, Vec3f normal) const {
     const PixelPoint p = pixelPoint(uv);
@@ -344,14 +343,10 @@ struct EnvironmentMapView {
 
   // Draws a direction; `normal` (world space) is used by the cosine and product strategies
   // only. A zero normal (a BSDF that also transmits) means the whole sphere: the cosine strategy
-  // then samples uniformly and the product strategy by Algorithm 1's density. drawn: a product
-  // draw made ahead (CPU: the tile wavefront's walk), taken where it is for this u and normal.
-  ENVGI_HD EnvSample sample(EnvStrategy s, Vec2f u, Vec3f normal = Vec3f(0.f, 1.f, 0.f),
-                            const ProductDraw* drawn = nullptr) const {
+  // then samples uniformly and the product strategy by Algorithm 1's density.
+  ENVGI_HD EnvSample sample(EnvStrategy s, Vec2f u, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
     EnvSample out;
     Vec3f local;
-    const Color* lookedUp = nullptr;  // the radiance at out.uv, where a draw made ahead looked it up
-    const Vec3f* dirAhead = nullptr;  // and out.dir, where it was worked out ahead
     switch (strategyFor(s, normal)) {
       case EnvStrategy::Uniform: {
         local = sampleUniformSphere(u);
@@ -396,20 +391,9 @@ struct EnvironmentMapView {
       }
       case EnvStrategy::Product: {
         float pdfUV;
-        const Vec3f nLocal = toLocalUnnormalized(normal);
-        const bool ahead = drawn && drawn->isFor(u, nLocal);
-        if (ahead) {
-          if (!drawn->drawn) return out;
-          out.uv = drawn->uv, pdfUV = drawn->pdfUV;
-        } else if (!product.sample(u, nLocal, &out.uv, &pdfUV)) {
-          return out;
-        }
-        if (ahead && drawn->placed) lookedUp = &drawn->radiance;
-        else out.uv = placeInPixel(out.uv, &pdfUV);
-        if (ahead && drawn->directed) dirAhead = &drawn->dir;
-        else local = uvToDir(out.uv);
-        out.pdf = solidAnglePdf(pdfUV, out.uv.y);
-        break;
+        Vec2f uv;
+        if (!product.sample(u, toLocalUnnormalized(normal), &uv, &pdfUV)) return out;
+        return productSample(uv, pdfUV);
       }
       case EnvStrategy::Points: {
         // One light chosen by its share of the irradiance: radiance / pmf estimates sum_i f E_i.
@@ -430,8 +414,26 @@ struct EnvironmentMapView {
       }
       case EnvStrategy::PointsAll: return out;  // summed whole, never drawn
     }
-    out.dir = dirAhead ? *dirAhead : fromLocal(local);
-    out.radiance = out.pdf > 0.f ? (lookedUp ? *lookedUp : lookupUV(out.uv)) : Color(0.f);
+    out.dir = fromLocal(local);
+    out.radiance = out.pdf > 0.f ? lookupUV(out.uv) : Color(0.f);
+    return out;
+  }
+
+  // The product strategy's sample once its pixel is drawn (CosineProductView::sample's uv and
+  // density, or a ProductDescent's end): placed inside the pixel, turned into a direction and
+  // looked up.
+  ENVGI_HD EnvSample productSample(Vec2f uv, float pdfUV) const {
+    uv = placeInPixel(uv, &pdfUV);
+    return placedProductSample(uv, pdfUV, fromLocal(uvToDir(uv)), lookupUV(uv));
+  }
+  // The same where the placing, the direction and the lookup were done apart (placeInPixel's uv
+  // and density, fromLocal(uvToDir(uv)) and lookupUV(uv)), as for a batch of draws.
+  ENVGI_HD EnvSample placedProductSample(Vec2f uv, float pdfUV, Vec3f dir, Color radiance) const {
+    EnvSample out;
+    out.uv = uv;
+    out.pdf = solidAnglePdf(pdfUV, uv.y);
+    out.dir = dir;
+    out.radiance = out.pdf > 0.f ? radiance : Color(0.f);
     return out;
   }
 
@@ -447,10 +449,14 @@ struct EnvironmentMapView {
   ENVGI_HD Color evalWithPdf(EnvStrategy s, Vec3f worldDir, Vec3f normal, float* pdfOut) const {
     return evalWithPdfAt(s, worldDir, dirToUV(toLocalUnnormalized(worldDir)), normal, pdfOut);
   }
-  // evalWithPdf where worldDir's (u, v) is known (RoundLanes::mapUV).
+  // evalWithPdf where worldDir's (u, v) is known.
   ENVGI_HD Color evalWithPdfAt(EnvStrategy s, Vec3f worldDir, Vec2f uv, Vec3f normal, float* pdfOut) const {
-    *pdfOut = pdfAt(strategyFor(s, normal), worldDir, uv, normal);
+    *pdfOut = pdfAtUV(s, worldDir, uv, normal);
     return lookupUV(uv);
+  }
+  // pdf where worldDir's (u, v) is known.
+  ENVGI_HD float pdfAtUV(EnvStrategy s, Vec3f worldDir, Vec2f uv, Vec3f normal) const {
+    return pdfAt(strategyFor(s, normal), worldDir, uv, normal);
   }
 
  private:

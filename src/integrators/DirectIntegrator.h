@@ -63,7 +63,9 @@ ENVGI_HD Color directLighting(const SceneView& sc, const Tracer& tracer, const S
 
   for (int j = 0; j < bsdfSamples; ++j) {
     BsdfSample bs;
-    if (!drawBsdfSample(bsdf, woLocal, drawBsdf(bsdf, smp), &bs) || (skipDelta && bs.delta)) continue;
+    const SampledParts parts{sc};
+    const BsdfDraws u = drawBsdf(bsdf, smp, parts);
+    if (!parts.bsdfSample(bsdf, woLocal, u.uc, u.ub, &bs) || (skipDelta && bs.delta)) continue;
     if (partner) bsdfMixReweight(*partner, si.partnerWeight, woLocal, &bs);
     Vec3f wi = si.shading.toWorld(bs.wi);
     Ray r2{offsetRayOrigin(si.p, si.ng, wi, si.t), wi, INFINITY};

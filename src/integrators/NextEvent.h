@@ -4,10 +4,8 @@
 // copy that path, direct and the photon mappers share.
 #pragma once
 
-#include "lights/LightSampling.h"
-#include "materials/BsdfMix.h"
+#include "integrators/BounceParts.h"
 #include "sampling/Mis.h"
-#include "sampling/Sampler.h"
 
 namespace envgi {
 
@@ -21,54 +19,33 @@ struct LightSampleLd {
   bool needsRay = false;
 };
 
-// The BSDF's value and density for a light direction, worked out ahead (the CPU's
-// RoundLanes::evalRoughPlastic, a round's rough plastic evaluations in vector lanes): bsdfEvalPdf's
-// for wi in the shading frame, which prepareLd takes where its direction is wi to the bit.
-struct BsdfEvalAhead {
-  Vec3f wi;
-  Color f;
-  float pdf = 0.f;
-  bool made = false;
-};
-
-// A light sample's draws, in the order the sampler lays them out: the dimension a choice of the
+// Where a light sample's draws lie past the sampler's position: the dimension a choice of the
 // light's kind once took (skipped: sampleLight picks the kind by uL.x, and later draws keep
 // their dimensions), the light's pair, and the area light's second pair (skipped where the map
-// is the only light). uLAhead: the light's pair drawn elsewhere for that dimension (an
-// executor's lanes, at bounceLayout's offset), stepped over here.
+// is the only light). drawLight draws at these offsets, and so does any batch of the same draws.
+struct LightDrawLayout {
+  static constexpr uint32_t pair = 1, second = 3, size = 5;
+};
 struct LightDraws {
   Vec2f uL, uL2;
 };
-ENVGI_HD inline LightDraws drawLight(const SceneView& sc, Sampler& smp, const Vec2f* uLAhead = nullptr) {
+template <class Parts>
+ENVGI_HD inline LightDraws drawLight(const SceneView& sc, Sampler& smp, const Parts& parts) {
+  const uint32_t base = smp.dim;
   LightDraws u;
-  smp.skip1D();
-  if (uLAhead) u.uL = *uLAhead, smp.skip2D();
-  else u.uL = smp.get2D();
+  smp.skipTo(base + LightDrawLayout::pair);
+  u.uL = parts.pair(smp, BouncePair::Light);
+  smp.skipTo(base + LightDrawLayout::second);
   u.uL2 = smp.get2DIf(!(sc.envSelectProb() == 1.f));  // sampleLight takes the map for any uL then
   return u;
 }
+ENVGI_HD inline LightDraws drawLight(const SceneView& sc, Sampler& smp) { return drawLight(sc, smp, SampledParts{sc}); }
 
-// One light sample from the draws u. `partner` is a blend's other material (sc.partnerAt(si)),
-// evaluated beside bsdf at si.partnerWeight (materials/BsdfMix.h). productDrawn: the map's
-// product draw for u.uL, made ahead (sampleLight's); evalAhead: the BSDF (without a partner)
-// evaluated ahead for the direction that draw gives.
-ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
-                                        Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
-                                        MisHeuristic heuristic, const LightDraws& u, const Bsdf* partner = nullptr,
-                                        const ProductDraw* productDrawn = nullptr,
-                                        const BsdfEvalAhead* evalAhead = nullptr) {
+// A light sample ls's contribution before its shadow ray, given the BSDF's value f and density
+// bsdfPdf in its direction: MIS-weighted against nB BSDF samples out of nE light samples.
+ENVGI_HD inline LightSampleLd lightSampleLd(const SurfaceInteraction& si, const LightSample& ls, Color f,
+                                            float bsdfPdf, float nE, float nB, MisHeuristic heuristic) {
   LightSampleLd out;
-  LightSample ls;
-  if (bsdfMixIsDelta(bsdf, partner) || !sampleLight(sc, si, axis, strategy, u.uL, u.uL2, &ls, productDrawn))
-    return out;
-  Vec3f wiLocal = si.shading.toLocal(ls.dir);
-  float bsdfPdfOfLight;
-  Color f;
-  if (evalAhead && evalAhead->made && !partner && sameBits(wiLocal, evalAhead->wi)) {
-    f = evalAhead->f, bsdfPdfOfLight = evalAhead->pdf;
-  } else {
-    f = bsdfMixEvalPdf(bsdf, partner, si.partnerWeight, woLocal, wiLocal, &bsdfPdfOfLight);
-  }
   if (isBlack(f) || isBlack(ls.radiance)) return out;
   out.o = offsetRayOrigin(si.p, si.ng, ls.dir, si.t);
   out.d = ls.dir;
@@ -84,10 +61,29 @@ ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceIntera
     out.d = to / len;
     out.tMax = len * (1.f - 1e-4f);
   }
-  float w = nB > 0.f && !ls.delta ? misHeuristic(heuristic, nE, ls.pdf, nB, bsdfPdfOfLight) : 1.f;
+  float w = nB > 0.f && !ls.delta ? misHeuristic(heuristic, nE, ls.pdf, nB, bsdfPdf) : 1.f;
   out.value = f * ls.radiance * (w / (ls.pdf * nE));
   out.needsRay = true;
   return out;
+}
+
+// One light sample from the draws u, its parts from parts. `partner` is a blend's other
+// material (sc.partnerAt(si)), evaluated beside bsdf at si.partnerWeight (materials/BsdfMix.h).
+// Out of line on the GPU, where the path kernel and directLighting each inlined it spilt more.
+template <class Parts>
+inline ENVGI_HD_NOINLINE LightSampleLd prepareLd(const Parts& parts, const SurfaceInteraction& si, const Bsdf& bsdf,
+                                        Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
+                                        MisHeuristic heuristic, const LightDraws& u, const Bsdf* partner) {
+  LightSample ls;
+  if (bsdfMixIsDelta(bsdf, partner) || !parts.lightSample(si, axis, strategy, u.uL, u.uL2, &ls)) return {};
+  float bsdfPdf;
+  const Color f = parts.bsdfValue(bsdf, partner, si, woLocal, si.shading.toLocal(ls.dir), &bsdfPdf);
+  return lightSampleLd(si, ls, f, bsdfPdf, nE, nB, heuristic);
+}
+ENVGI_HD inline LightSampleLd prepareLd(const SceneView& sc, const SurfaceInteraction& si, const Bsdf& bsdf,
+                                        Vec3f woLocal, Vec3f axis, EnvStrategy strategy, float nE, float nB,
+                                        MisHeuristic heuristic, const LightDraws& u, const Bsdf* partner = nullptr) {
+  return prepareLd(SampledParts{sc}, si, bsdf, woLocal, axis, strategy, nE, nB, heuristic, u, partner);
 }
 
 // The sample's contribution once its shadow ray's answer is known.
@@ -95,39 +91,25 @@ ENVGI_HD inline Color resolvedLd(const LightSampleLd& ld, bool occluded) {
   return ld.needsRay && !occluded ? ld.value : Color(0.f);
 }
 
-// bsdfSample's answer for a draw made ahead, worked out ahead too (the CPU's
-// RoundLanes::sampleRoughPlastic, a round's rough plastic samples in vector lanes).
-struct BsdfSampleAhead {
-  BsdfSample s;
-  bool ok = false;    // bsdfSample's return
-  bool made = false;  // s and ok hold bsdfSample's answer for the bounce's BSDF draws
+// Where a BSDF sample's draws lie past the sampler's position: uc, only where bsdfSample reads
+// it beside the pair (skipped, not drawn, elsewhere, so later draws keep their dimensions), then
+// the pair. drawBsdf draws at these offsets, and so does any batch of the same draws.
+struct BsdfDrawLayout {
+  static constexpr uint32_t lobe = 0, pair = 1, size = 3;
 };
-
-// A bounce's BSDF draws as path and direct take them: uc only where bsdfSample reads it beside
-// ub (skipped, not drawn, elsewhere, so later draws keep their dimensions), then the pair.
-// ubAhead: the pair drawn elsewhere for that dimension (an executor's lanes), stepped over here.
 struct BsdfDraws {
   float uc = 0.f;
   Vec2f ub;
 };
-ENVGI_HD inline BsdfDraws drawBsdf(const Bsdf& bsdf, Sampler& smp, const Vec2f* ubAhead = nullptr) {
+template <class Parts>
+ENVGI_HD inline BsdfDraws drawBsdf(const Bsdf& bsdf, Sampler& smp, const Parts& parts) {
+  const uint32_t base = smp.dim;
   BsdfDraws u;
+  smp.skipTo(base + BsdfDrawLayout::lobe);
   u.uc = smp.get1DIf(bsdfReadsUcBesideU(bsdf));
-  if (ubAhead) u.ub = *ubAhead, smp.skip2D();
-  else u.ub = smp.get2D();
+  smp.skipTo(base + BsdfDrawLayout::pair);
+  u.ub = parts.pair(smp, BouncePair::Bsdf);
   return u;
-}
-
-// The BSDF sampled from the draws u, the lobe from ub where the BSDF can take it from there
-// (bsdfLobeFromU). sampled: bsdfSample's answer for these draws, where it was worked out
-// ahead (uc-free: sampleRoughPlastic's).
-ENVGI_HD inline bool drawBsdfSample(const Bsdf& bsdf, Vec3f woLocal, const BsdfDraws& u, BsdfSample* bs,
-                                    const BsdfSampleAhead* sampled = nullptr) {
-  if (sampled && sampled->made) {
-    *bs = sampled->s;
-    return sampled->ok;
-  }
-  return bsdfSample(bsdf, woLocal, u.uc, u.ub, bs, true);
 }
 
 // Traces the sample's shadow ray, if it has one (counted in *rayCount): whether it is blocked.

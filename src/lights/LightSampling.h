@@ -29,11 +29,14 @@ ENVGI_INLINE bool envSeenByBsdfSampling(EnvStrategy s, bool prevDelta) { return 
 
 // The map's radiance along an escaping BSDF-sampled direction and, through *lightPdf, the
 // density next-event estimation would have drawn it with (selection included).
-ENVGI_INLINE Color envRadianceAndPdf(const SceneView& sc, EnvStrategy s, Vec3f dir, Vec3f axis, float* lightPdf,
-                                     const Vec2f* uv = nullptr) {
-  Color Le = uv ? sc.env.evalWithPdfAt(s, dir, *uv, axis, lightPdf) : sc.env.evalWithPdf(s, dir, axis, lightPdf);
+ENVGI_INLINE Color envRadianceAndPdf(const SceneView& sc, EnvStrategy s, Vec3f dir, Vec3f axis, float* lightPdf) {
+  Color Le = sc.env.evalWithPdf(s, dir, axis, lightPdf);
   *lightPdf *= sc.envSelectProb();
   return Le;
+}
+// That density alone, where dir's (u, v) on the map is known.
+ENVGI_INLINE float envLightPdfAt(const SceneView& sc, EnvStrategy s, Vec3f dir, Vec2f uv, Vec3f axis) {
+  return sc.env.pdfAtUV(s, dir, uv, axis) * sc.envSelectProb();
 }
 
 // Solid-angle density of reaching light primitive `light` at point lp (normal ln) from p.
@@ -89,24 +92,33 @@ inline ENVGI_HD_NOINLINE bool sampleDeltaOrAreaLight(const SceneView& sc, const 
 // that light's own draw (sample reuse, as Mitsuba's emitter selection does): the draws that land
 // on one kind keep the sequence's strata, where a draw of their own handed each kind a random
 // subset of the points. With the map the only light, u is the map's draw as it is.
-// productDrawn: the map's product draw made ahead (EnvironmentMapView::sample's drawn).
-ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si, Vec3f axis, EnvStrategy strategy,
-                              Vec2f u, Vec2f u2, LightSample* ls, const ProductDraw* productDrawn = nullptr) {
-  float pe = sc.envSelectProb();
-  if (!(u.x < pe)) return sampleDeltaOrAreaLight(sc, si, pe, u, u2, ls);
-  // The whole collapsed map is added at every point (collapsedMapLighting): a light sample
-  // that picks the map carries nothing, and the other lights' shares stay unbiased.
-  if (strategy == EnvStrategy::PointsAll) return false;
-  if (pe < 1.f) u.x = stretchedDraw(u.x, 0.f, pe);
-  EnvSample es = sc.env.sample(strategy, u, axis, productDrawn);
+// Whether u picks the map, with *u then stretched to the map's own draw. The whole collapsed
+// map is added at every point (collapsedMapLighting): a light sample that picks it carries
+// nothing, and the other lights' shares stay unbiased.
+ENVGI_INLINE bool lightDrawPicksMap(const SceneView& sc, EnvStrategy strategy, Vec2f* u) {
+  const float pe = sc.envSelectProb();
+  if (!(u->x < pe) || strategy == EnvStrategy::PointsAll) return false;
+  if (pe < 1.f) u->x = stretchedDraw(u->x, 0.f, pe);
+  return true;
+}
+
+// The map's sample es as a light sample (its selection included).
+ENVGI_INLINE bool mapLightSample(const SceneView& sc, const EnvSample& es, LightSample* ls) {
   if (!(es.pdf > 0.f)) return false;
   ls->dir = es.dir;
   ls->dist = INFINITY;
   ls->radiance = es.radiance;
-  ls->pdf = es.pdf * pe;
+  ls->pdf = es.pdf * sc.envSelectProb();
   ls->environment = true;
   ls->delta = es.delta;
   return true;
+}
+
+ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si, Vec3f axis, EnvStrategy strategy,
+                              Vec2f u, Vec2f u2, LightSample* ls) {
+  const float pe = sc.envSelectProb();
+  if (!(u.x < pe)) return sampleDeltaOrAreaLight(sc, si, pe, u, u2, ls);
+  return lightDrawPicksMap(sc, strategy, &u) && mapLightSample(sc, sc.env.sample(strategy, u, axis), ls);
 }
 
 }  // namespace envgi

@@ -214,8 +214,7 @@ ENVGI_INLINE float roughCoatReflectance(const Bsdf& b, const CoatNode& n, float 
 // What rough plastic's eval and pdf share for one pair of directions (both above the surface):
 // the half vector, D there, wo's Smith lambda, the coat's tables at this roughness and its
 // reflectance at wo. bsdfEvalPdf computes them once for both.
-// d and coat: microfacet(b) and roughCoat(b), which RoundLanes::sampleRoughPlastic works out
-// once for a round's lanes of one material.
+// d and coat: microfacet(b) and roughCoat(b), which a batch of one material works out once.
 struct RoughPlasticShared {
   Vec3f m;
   float D, lambdaO, fo;
@@ -265,8 +264,8 @@ ENVGI_INLINE float roughPlasticPdf(const Bsdf& b, const RoughPlasticShared& r, V
   return ps * (visible / (4.f * cosOM)) + (1.f - ps) * cosineHemispherePdf(wi.z);
 }
 // evalPdfInFrame's rough plastic with its coat's tables, for directions above the surface, its
-// two table lookups done ahead (fo: roughCoatReflectanceAt at wo, ti: t(wi)): the value, and
-// the density in *pdf. RoundLanes' sampling and evaluation loops both end with it.
+// two table lookups given (fo: roughCoatReflectanceAt at wo, ti: t(wi)): the value, and the
+// density in *pdf. Apart, so that a batch of lookups can be made first.
 ENVGI_INLINE Color roughPlasticTabledEvalPdf(const Bsdf& b, const MicrofacetDistribution& d, const CoatNode& coat,
                                              float fo, float ti, Vec3f wo, Vec3f wi, float* pdf) {
   const RoughPlasticShared r = roughPlasticShared(d, coat, fo, wo, wi);
@@ -275,7 +274,7 @@ ENVGI_INLINE Color roughPlasticTabledEvalPdf(const Bsdf& b, const MicrofacetDist
 }
 
 // Rough plastic's sample with the lobe from u.x (bsdfLobeFromU, as path and direct draw it) in
-// the steps of sampleInFrame's that RoundLanes::sampleRoughPlastic runs in vector lanes around
+// the steps of sampleInFrame's that a batch of samples can run in vector lanes around
 // libm's sine and cosine (fromPolar), one lane at a time: the lobe's draw (plasticLobeDraw),
 // its disk point in polar form, the direction from the point, then roughPlasticTabledEvalPdf.
 // wo is above the surface (a two-sided one's seen from the front); d: microfacet(b), GGX's.

@@ -44,7 +44,7 @@ ENVGI_INLINE float coatEntry(const CoatNode& n, int i) { return n.a[i] + n.w * (
 
 // Where mu = cos theta falls among t's nodes: the node i below it and the share t of the way on
 // to i + 1. Apart from the lookup (coatTransmittanceAt) so that vector lanes can keep the node
-// in an array between two loops (RoundLanes::sampleRoughPlastic): inside one, GCC turned the
+// in an array between two loops: inside one, GCC turned the
 // clamp's branches into a choice between addresses, which it does not gather from.
 struct CoatPlace {
   int i;

@@ -114,7 +114,7 @@ ENVGI_INLINE uint32_t sobolShuffledIndex(uint32_t h, uint32_t indexInPixel, Inde
 
 // Sampler::get2D's Sobol draw in dimensions (d, d + 1) as a pure function of the pixel's hash and
 // the sample, so that an executor can draw one dimension pair of many pixels in a loop the
-// compiler vectorises (RoundLanes.h); get2D itself calls it. Independent shuffles per dimension
+// compiler vectorises; get2D itself calls it. Independent shuffles per dimension
 // pair decorrelate the pairs (Burley 2020).
 ENVGI_INLINE Vec2f sobolDraw2D(uint64_t pixelHash, uint32_t d, uint32_t indexInPixel, IndexBlock block,
                                uint32_t blockSeed) {
@@ -167,7 +167,7 @@ struct Sampler {
   }
 
   // startPixel for Sobol, where the pixel's hash is known and its first `drawn` dimensions were
-  // drawn elsewhere, from sobolDraw2D (RoundLanes): the next draw is the one after them.
+  // drawn elsewhere, from sobolDraw2D: the next draw is the one after them.
   ENVGI_HD void startPixelAt(uint64_t hash, uint32_t drawn) {
     pixelHash = hash;
     dim = drawn;
@@ -200,6 +200,13 @@ struct Sampler {
   ENVGI_HD void skip2D() {
     dim += 2;
     if (type != SamplerType::Sobol) rng.nextUInt(), rng.nextUInt();
+  }
+  // Past every draw before dimension d (at or after the position), as skip1D would go: where a
+  // layout places a draw at an offset past a position.
+  ENVGI_HD void skipTo(uint32_t d) {
+    if (type == SamplerType::Sobol) dim = d > dim ? d : dim;
+    else
+      while (dim < d) skip1D();
   }
   // A draw that is taken only where it is used (zero where it is skipped).
   ENVGI_HD float get1DIf(bool used) {

@@ -38,8 +38,8 @@ ENVGI_INLINE Vec3f sampleUniformCone(Vec2f u, float cosMax) {
 ENVGI_INLINE float uniformConePdf(float cosMax) { return 1.f / (2.f * kPi * (1.f - cosMax)); }
 
 // A point of a disk as (r cos angle, r sin angle), in two steps: the disk warps below find r
-// and the angle, fromPolar calls libm. RoundLanes::sampleRoughPlastic runs the steps around
-// libm's sine and cosine in vector lanes and those one lane at a time, to the same bits.
+// and the angle, fromPolar calls libm. A batch can run the steps around libm's sine and
+// cosine in vector lanes and those one lane at a time, to the same bits.
 struct PolarPoint {
   float r, angle;
 };
@@ -80,7 +80,7 @@ ENVGI_INLINE float twoLinearPieces(float x, float n0, float n1, float n2) {
 // A point of [0, 1) with density proportional to twoLinearPieces(x, n0, n1, n2): a piece by its
 // area, then sampleLinear inside it. Uniform where the function is zero throughout.
 // (x < k ? x : k is fminf's answer for every x, NaN included, and a loop over many draws
-// vectorises it: RoundLanes::placeDraws.)
+// vectorises it.)
 ENVGI_INLINE float sampleTwoLinearPieces(float u, float n0, float n1, float n2) {
   float left = n0 + n1, right = n1 + n2, t = u * (left + right);
   if (!(left + right > 0.f)) return u;

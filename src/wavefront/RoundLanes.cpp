@@ -287,7 +287,7 @@ void RoundLanes::make(const Camera& cam, const Sampler& first, int n) {
   }
 }
 
-void RoundLanes::drawAhead(const Sampler& first, int n, uint32_t lightAt, uint32_t bsdfAt) {
+void RoundLanes::drawPairs(const Sampler& first, int n, uint32_t lightAt, uint32_t bsdfAt) {
   sobolDrawsAt(n, hash.data(), dims.data(), lightAt, first.indexInPixel, first.block, first.blockSeed, lightU0.data(),
                lightU1.data());
   sobolDrawsAt(n, hash.data(), dims.data(), bsdfAt, first.indexInPixel, first.block, first.blockSeed, bsdfU0.data(),

@@ -13,11 +13,18 @@
 #include <vector>
 
 #include "envmap/EnvironmentMapView.h"
-#include "integrators/NextEvent.h"
+#include "materials/Bsdf.h"
 #include "sampling/Sampler.h"
 #include "scene/Camera.h"
 
 namespace envgi {
+
+// A BSDF's value f and density pdf for the direction wi, as bsdfEvalPdf gives them.
+struct LaneBsdfValue {
+  Vec3f wi;
+  Color f;
+  float pdf = 0.f;
+};
 
 struct RoundLanes {
   // In: each lane's pixel. Out: its hash (Sampler::pixelHash), the filter's weight, the ray.
@@ -28,12 +35,12 @@ struct RoundLanes {
   std::vector<float> u, v;  // mapUV: where each direction (dx, dy, dz) meets the map
   std::vector<int> picked;            // mapRadiance: in, the lanes it looks up
   std::vector<float> red, green, blue;  // and out, the map's radiance there, by place in picked
-  // placeDraws: in, the round's product draws (CosineProductView::aheadDraw's uv and pdfUV);
+  // placeDraws: in, the round's product draws (CosineProductView::descentEnd's uv and pdfUV);
   // out, the same placed inside their pixels (u, v, placedPdf), with the radiance there in red,
   // green, blue.
   std::vector<float> drawU, drawV, drawPdf, placedPdf;
   std::vector<unsigned char> redo;
-  // drawAhead: in, each lane's sampler (its pixel's hash, its position); out, two pairs of it.
+  // drawPairs: in, each lane's sampler (its pixel's hash, its position); out, two pairs of it.
   std::vector<uint32_t> dims;
   std::vector<float> lightU0, lightU1, bsdfU0, bsdfU1;
   // sampleRoughPlastic: in, each lane's wo in its shading frame and its BSDF pair; between its
@@ -66,11 +73,10 @@ struct RoundLanes {
   void setDirection(int i, Vec3f d) { dx[i] = d.x, dy[i] = d.y, dz[i] = d.z; }
   Ray rayOf(int i) const { return Ray{Vec3f(ox[i], oy[i], oz[i]), Vec3f(dx[i], dy[i], dz[i]), tMax[i]}; }
 
-  // A round's hits: lane j's sampler, and the two 2D draws pathShade will make there, at
-  // lightAt and bsdfAt dimensions past its position (bounceLayout's offsets), for sample
-  // first.index (first as in make()).
+  // A round's hits: lane j's sampler, and the two 2D draws at lightAt and bsdfAt dimensions past
+  // its position, for sample first.index (first as in make()).
   void setSampler(int j, const Sampler& smp) { hash[j] = smp.pixelHash, dims[j] = smp.dim; }
-  void drawAhead(const Sampler& first, int n, uint32_t lightAt, uint32_t bsdfAt);
+  void drawPairs(const Sampler& first, int n, uint32_t lightAt, uint32_t bsdfAt);
   Vec2f lightDraw(int j) const { return {lightU0[j], lightU1[j]}; }
   Vec2f bsdfDraw(int j) const { return {bsdfU0[j], bsdfU1[j]}; }
 
@@ -108,12 +114,11 @@ struct RoundLanes {
     woX[j] = wo.x, woY[j] = wo.y, woZ[j] = wo.z, wiX[j] = wi.x, wiY[j] = wi.y, wiZ[j] = wi.z;
   }
   void evalRoughPlastic(const Bsdf& b, int n);
-  BsdfEvalAhead bsdfEvalOf(int j) const {
-    BsdfEvalAhead e;
+  LaneBsdfValue bsdfEvalOf(int j) const {
+    LaneBsdfValue e;
     e.wi = Vec3f(wiX[j], wiY[j], wiZ[j]);
     e.f = sampled[j] ? Color(weightR[j], weightG[j], weightB[j]) : Color(0.f);
     e.pdf = sampled[j] ? samplePdf[j] : 0.f;
-    e.made = true;
     return e;
   }
   // Lane j's answer: false where bsdfSample gives no sample, else the sample in *s.

@@ -63,17 +63,11 @@ struct SampleIntegrator {
   }
   // The path that shade() follows: path's own, or direct's as a one-bounce path.
   ENVGI_HD PathParams shadedPath() const { return type == SampleIntegratorType::Path ? path : directAsPath(direct); }
-  template <class Shadow>
+  // parts: where the bounce's parts come from (integrators/BounceParts.h).
+  template <class Shadow, class Parts>
   ENVGI_HD bool shade(PathState* st, bool found, const Hit& h, Sampler& smp, const Shadow& shadow,
-                      const ShadeAhead* ahead = nullptr) const {
-    return pathShade(*scene, st, found, h, smp, shadedPath(), shadow, ahead);
-  }
-  // What shade() will read for a path whose ray escaped, asked for ahead (CPU only).
-  void prefetchEscape(const PathState& st, Vec2f uv) const { pathPrefetchEscape(*scene, st, shadedPath(), uv); }
-  // shade()'s first steps for a hit, done ahead (pathShadeAhead; CPU only).
-  bool shadeAhead(const PathState& st, const Hit& h, const Sampler& smp, ShadeAhead* ahead, ProductDrawAhead* draw,
-                  const Vec2f* uL = nullptr) const {
-    return pathShadeAhead(*scene, st, h, smp, shadedPath(), ahead, draw, uL);
+                      const Parts& parts) const {
+    return pathShade(*scene, st, found, h, smp, shadedPath(), shadow, parts);
   }
 };
 

@@ -6,8 +6,7 @@
 
 #include <vector>
 
-#include "integrators/PathIntegrator.h"
-#include "wavefront/RoundLanes.h"
+#include "wavefront/PreparedHit.h"
 
 namespace envgi {
 
@@ -23,8 +22,8 @@ struct TileQueues {
   std::vector<Color> acc;         // each pixel's sums over the tile's samples
   std::vector<double> accSq;
   std::vector<float> accW;
-  std::vector<ShadeAhead> ahead;       // each hit's interaction and draws, worked out ahead
-  std::vector<ProductDrawAhead> draw;  // each hit's product draw, walked level by level
+  std::vector<PreparedHit> prepared;      // each path's parts, worked out before it is shaded
+  std::vector<ProductDescent> descent;  // each hit's product draw, taken level by level
 
   // The queues, of slots: the round's live paths, those whose ray escaped, those whose ray hit,
   // the hits with a product draw, the paths whose light sample has a shadow ray; and the
@@ -37,7 +36,7 @@ struct TileQueues {
     if (state.size() >= n) return;
     state.resize(n), sampler.resize(n), hit.resize(n), found.resize(n), going.resize(n), blocked.resize(n);
     ld.resize(n), ldBeta.resize(n), weight.resize(n), acc.resize(n), accSq.resize(n), accW.resize(n);
-    ahead.resize(n), draw.resize(n);
+    prepared.resize(n), descent.resize(n);
     for (std::vector<int>* q : {&live, &escaped, &hits, &productDraws, &shadowRays, &sampling, &picking}) q->resize(n);
     lanes.resize(n);
   }

@@ -86,8 +86,8 @@ inline void keepHit(TileQueues* q, int i, bool found, const Hit& h) {
 }
 
 // The camera round in lanes: the rays made and traced from the lanes' arrays; a ray that escapes
-// adds what it sees (cameraEscape, the map looked up at mapUV's coordinates) and ends there, and
-// only the rays that hit become paths. Returns the count of those, left in q->live.
+// adds what it sees (pathAddEscape, the map looked up in lanes at mapUV's coordinates) and ends
+// there, and only the rays that hit become paths. Returns the count of those, left in q->live.
 template <class I>
 int traceCameraLanes(const TileRound<I>& r, int live) {
   TileQueues* q = r.q;
@@ -111,12 +111,9 @@ int traceCameraLanes(const TileRound<I>& r, int live) {
     const int k = q->live[i];
     q->weight[k] = lanes.weight[i];
     if (!q->found[k]) {
-      const Vec2f uv = lanes.uvOf(i);
-      const Color Le = sc.hasEnvironment ? lanes.radianceOf(e++) : Color(0.f);
-      finishPath(q, k,
-                 cameraEscape(sc, lanes.rayOf(i), pp, sc.hasEnvironment ? &uv : nullptr,
-                              sc.hasEnvironment ? &Le : nullptr),
-                 r.counters);
+      PathState st = pathBegin(lanes.rayOf(i));
+      if (sc.hasEnvironment) pathAddEscape(sc, &st, pp, LaneEscapeParts{lanes.uvOf(i), lanes.radianceOf(e++)});
+      finishPath(q, k, st.L, r.counters);
       continue;
     }
     q->sampler[k] = r.first;
@@ -149,12 +146,20 @@ void prefetchHits(const TileRound<I>& r, int live) {
     if (q->found[q->live[i]]) r.scene().prefetchVertices(q->hit[q->live[i]]);
 }
 
+// What pathAddEscape will read from the map for a path whose ray escaped and meets it at uv,
+// prefetched where it reads the map's density (past a non-delta bounce).
+inline void prefetchEscape(const SceneView& sc, const PathState& st, const PathParams& pp, Vec2f uv) {
+  if (sc.hasEnvironment && !st.prevDelta && envSeenByBsdfSampling(pp.envStrategy, false))
+    sc.env.prefetchEvalWithPdf(pp.envStrategy, uv, st.prevAxis);
+}
+
 // The rays that escaped meet the map: where, lane by lane (RoundLanes::mapUV), then, past the
-// camera's round, what their MIS weights will read there, asked for ahead.
+// camera's round, what their MIS weights will read there, prefetched.
 template <class I>
 void meetMap(const TileRound<I>& r, int live, bool cameraRays) {
   if (!r.scene().hasEnvironment) return;
   TileQueues* q = r.q;
+  const PathParams pp = r.integ.shadedPath();
   int escapes = 0;
   for (int i = 0; i < live; ++i)
     if (!q->found[q->live[i]]) {
@@ -163,16 +168,40 @@ void meetMap(const TileRound<I>& r, int live, bool cameraRays) {
     }
   q->lanes.mapUV(r.scene().env, escapes);
   for (int j = 0; j < escapes; ++j) {
-    ShadeAhead& a = q->ahead[q->escaped[j]];
-    a.escaped = true;
-    a.uv = q->lanes.uvOf(j);
-    if (!cameraRays) r.integ.prefetchEscape(q->state[q->escaped[j]], a.uv);
+    const int k = q->escaped[j];
+    q->prepared[k].uv = q->lanes.uvOf(j);
+    if (!cameraRays) prefetchEscape(r.scene(), q->state[k], pp, q->prepared[k].uv);
   }
 }
 
-// The hits queued in q->hits, each with its interaction and light draw (in lanes with Sobol's
-// draws, at bounceLayout's offsets, with the BSDF's pair), and the rough plastics' BSDF samples
-// in lanes. The hits whose light sample is a product draw go to q->productDraws: returns their
+// A hit's parts before it is shaded: its interaction and, where the path goes on to next-event
+// estimation, its light pair (uL where inLanes, else the sampler's, from a copy of it). Where
+// that light sample is a product draw, its descent begins in *d, and it returns true.
+inline bool prepareHit(const SceneView& sc, const PathState& st, const Hit& h, const Sampler& smp,
+                       const PathParams& pp, bool inLanes, Vec2f uL, PreparedHit* p, ProductDescent* d) {
+  p->si = sc.interaction(st.ray, h);
+  p->product.ended = p->product.placed = false;
+  p->sampled = p->valued = false;
+  p->lightDrawn = pp.lightSample && !(pp.maxDepth >= 0 && st.depth >= pp.maxDepth);
+  if (!p->lightDrawn) return false;
+  if (inLanes) {
+    p->uL = uL;
+  } else {
+    Sampler peek = smp;
+    p->uL = drawLight(sc, peek).uL;
+  }
+  // The material's own entry, untextured: its type is all that is asked of it here.
+  const Bsdf& bsdf = sc.bsdfs[p->si.bsdf];
+  Vec2f u = p->uL;
+  if (!sc.hasEnvironment || bsdfIsDelta(bsdf) || !lightDrawPicksMap(sc, pp.envStrategy, &u)) return false;
+  const Vec3f axis = envSamplingAxis(p->si, -st.ray.d, bsdf);
+  if (sc.env.strategyFor(pp.envStrategy, axis) != EnvStrategy::Product) return false;
+  sc.env.product.descend0(u, sc.env.toLocalUnnormalized(axis), d);
+  return d->k >= 0;
+}
+
+// The hits queued in q->hits, each prepared (prepareHit; in lanes with Sobol's draws, its light's
+// and BSDF's pairs at bounceLayout's offsets), and the rough plastics' BSDF samples in lanes. The hits whose light sample is a product draw go to q->productDraws: returns their
 // count.
 template <class I>
 int prepareHits(const TileRound<I>& r, int live) {
@@ -185,50 +214,53 @@ int prepareHits(const TileRound<I>& r, int live) {
   const BounceLayout layout = bounceLayout(pp);
   if (r.inLanes) {
     for (int j = 0; j < hits; ++j) lanes.setSampler(j, q->sampler[q->hits[j]]);
-    lanes.drawAhead(r.first, hits, layout.light, layout.bsdf);
+    lanes.drawPairs(r.first, hits, layout.light, layout.bsdf);
   }
   int draws = 0;
   for (int j = 0; j < hits; ++j) {
     const int k = q->hits[j];
-    const Vec2f uL = r.inLanes ? lanes.lightDraw(j) : Vec2f();
-    q->ahead[k].bsdfDrawn = r.inLanes;
-    if (r.inLanes) q->ahead[k].ub = lanes.bsdfDraw(j);
-    if (r.integ.shadeAhead(q->state[k], q->hit[k], q->sampler[k], &q->ahead[k], &q->draw[k], r.inLanes ? &uL : nullptr))
+    PreparedHit& p = q->prepared[k];
+    p.bsdfDrawn = r.inLanes;
+    if (r.inLanes) p.ub = lanes.bsdfDraw(j);
+    if (prepareHit(r.scene(), q->state[k], q->hit[k], q->sampler[k], pp, r.inLanes,
+                   r.inLanes ? lanes.lightDraw(j) : Vec2f(), &p, &q->descent[k]))
       q->productDraws[draws++] = k;
   }
   if (r.inLanes) sampleBsdfsInLanes(r.scene(), pp, q, hits);
   return draws;
 }
 
-// The product draws' dependent loads a level at a time across the round
-// (CosineProductView::aheadLevel1-4), then the texels of the pixels they land in, then each
-// draw's end, which prepareLd takes instead of drawing again. In lanes, each draw is then placed
-// inside its pixel, the map looked up there, and the rough plastics evaluated at it.
+// The product draws' dependent loads a level at a time across the round (ProductDescent), then
+// the texels of the pixels they land in, then each draw's end. In lanes, each draw is then placed
+// inside its pixel, the map looked up there, and the rough plastics evaluated in its direction.
 template <class I>
 void walkProductDraws(const TileRound<I>& r, int draws) {
   TileQueues* q = r.q;
   const EnvironmentMapView& env = r.scene().env;
   const int* d = q->productDraws.data();
-  for (int i = 0; i < draws; ++i) env.product.aheadLevel1(&q->draw[d[i]]);
-  for (int i = 0; i < draws; ++i) env.product.aheadLevel2(&q->draw[d[i]]);
-  for (int i = 0; i < draws; ++i) env.product.aheadLevel3(&q->draw[d[i]]);
+  for (int i = 0; i < draws; ++i) env.product.descend1(&q->descent[d[i]]);
+  for (int i = 0; i < draws; ++i) env.product.descend2(&q->descent[d[i]]);
+  for (int i = 0; i < draws; ++i) env.product.descend3(&q->descent[d[i]]);
   for (int i = 0; i < draws; ++i) {
     int px, py;
-    if (env.product.aheadLevel4(&q->draw[d[i]], &px, &py)) env.prefetchPixel(px, py);
+    if (env.product.descendToPixel(&q->descent[d[i]], &px, &py)) env.prefetchPixel(px, py);
   }
   int placing = 0;
   for (int i = 0; i < draws; ++i) {
-    ShadeAhead& a = q->ahead[d[i]];
-    a.product = env.product.aheadDraw(q->draw[d[i]]);
-    a.productAhead = true;
-    if (r.inLanes && a.product.drawn) q->lanes.setDraw(placing++, a.product.uv, a.product.pdfUV);
+    const ProductDescent& a = q->descent[d[i]];
+    DescendedDraw& p = q->prepared[d[i]].product;
+    p.ended = true;
+    p.u = a.u, p.nLocal = a.nLocal;
+    p.drawn = env.product.descentEnd(a, &p.uv, &p.pdfUV);
+    if (r.inLanes && p.drawn) q->lanes.setDraw(placing++, p.uv, p.pdfUV);
   }
   if (placing == 0) return;
   q->lanes.placeDraws(env, placing);
   for (int i = 0, j = 0; i < draws; ++i) {
-    ProductDraw& p = q->ahead[d[i]].product;
+    DescendedDraw& p = q->prepared[d[i]].product;
     if (!p.drawn) continue;
     q->lanes.placedDraw(j++, &p.uv, &p.pdfUV, &p.radiance);
+    p.dir = env.fromLocal(EnvironmentMapView::uvToDir(p.uv));  // EnvironmentMapView::productSample's
     p.placed = true;
   }
   evalBsdfsInLanes(r.scene(), q, draws);
@@ -251,12 +283,11 @@ struct ShadowRayLater {
 template <class I>
 int shadeRound(const TileRound<I>& r, int live) {
   TileQueues* q = r.q;
-  const bool seesMap = r.scene().hasEnvironment;
   for (int i = 0; i < live; ++i) {
     const int k = q->live[i];
     q->ld[k].needsRay = false;
     q->going[k] = r.integ.shade(&q->state[k], q->found[k] != 0, q->hit[k], q->sampler[k], ShadowRayLater{q},
-                                q->found[k] || seesMap ? &q->ahead[k] : nullptr);
+                                PreparedParts{r.scene(), q->prepared[k]});
   }
   int shadows = 0;
   for (int i = 0; i < live; ++i)

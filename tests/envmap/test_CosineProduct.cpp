@@ -250,11 +250,11 @@ TEST(CosineProduct, PrefetchingAnEscapeReadsInsideTheTables) {
       }
 }
 
-// The draw walked a level at a time across a batch (renderTileByBounce's prefetching) reaches
-// the pixel sample() draws for the same u and normal, in odd-sized maps too; it gives up only
-// where sample() draws nothing (a bucket that sees no light).
-// Ended there (aheadDraw), it is sample()'s draw to the bit, and says which u and normal it is for.
-TEST(CosineProduct, ADrawWalkedLevelByLevelReachesTheDrawnPixel) {
+// The draw taken a level at a time (ProductDescent) reaches the pixel sample() draws for the same
+// u and normal, in odd-sized maps too; it gives up only where sample() draws nothing (a bucket
+// that sees no light). Ended there (descentEnd), it is sample()'s draw to the bit, and the map's
+// sample from it is EnvironmentMapView::sample's.
+TEST(CosineProduct, ADrawTakenLevelByLevelReachesTheDrawnPixel) {
   Image below(64, 32);  // lit from below the horizon only
   for (int y = 0; y < 32; ++y)
     for (int x = 0; x < 64; ++x) below.set(x, y, Color(y < 16 ? 0.f : 1.f));
@@ -268,26 +268,32 @@ TEST(CosineProduct, ADrawWalkedLevelByLevelReachesTheDrawnPixel) {
     for (int i = 0; i < 20000; ++i) {
       const Vec3f nl = sampleUniformSphere(Vec2f(rng.nextFloat(), rng.nextFloat()));
       const Vec2f u(rng.nextFloat(), rng.nextFloat());
-      ProductDrawAhead a;
-      p.aheadLevel0(u, nl, &a);
-      p.aheadLevel1(&a);
-      p.aheadLevel2(&a);
-      p.aheadLevel3(&a);
+      ProductDescent a;
+      p.descend0(u, nl, &a);
+      p.descend1(&a);
+      p.descend2(&a);
+      p.descend3(&a);
       int px = -1, py = -1;
-      const bool walked = p.aheadLevel4(&a, &px, &py);
+      const bool walked = p.descendToPixel(&a, &px, &py);
       Vec2f uv;
       float pdf;
       const bool drawn = p.sample(u, nl, &uv, &pdf);
       ASSERT_TRUE(walked || !drawn) << i;
-      // Walked to its end, the draw is sample()'s to the bit (prepareLd then takes it).
-      const ProductDraw ended = p.aheadDraw(a);
-      ASSERT_EQ(ended.drawn, drawn) << i;
-      ASSERT_TRUE(ended.isFor(u, nl)) << i;
-      ASSERT_FALSE(ended.isFor(Vec2f(u.x, 1.f - u.y), nl)) << i;
+      Vec2f endUV;
+      float endPdf;
+      ASSERT_EQ(p.descentEnd(a, &endUV, &endPdf), drawn) << i;
       if (!drawn) continue;
-      ASSERT_EQ(ended.uv.x, uv.x) << i;
-      ASSERT_EQ(ended.uv.y, uv.y) << i;
-      ASSERT_EQ(ended.pdfUV, pdf) << i;
+      ASSERT_EQ(endUV.x, uv.x) << i;
+      ASSERT_EQ(endUV.y, uv.y) << i;
+      ASSERT_EQ(endPdf, pdf) << i;
+      // The map's sample from the descent's end is sample()'s, for a normal whose local form is nl.
+      const EnvironmentMapView& v = env.view();
+      const Vec3f n = v.fromLocal(nl);
+      if (sameBits(v.toLocalUnnormalized(n), nl)) {
+        const EnvSample es = v.sample(EnvStrategy::Product, u, n), fromEnd = v.productSample(endUV, endPdf);
+        ASSERT_TRUE(sameBits(es.dir, fromEnd.dir) && es.pdf == fromEnd.pdf && sameBits(es.radiance, fromEnd.radiance))
+            << i;
+      }
       ++reached;
       ASSERT_EQ(px, std::min(int(uv.x * float(img.width)), img.width - 1)) << i;
       ASSERT_EQ(py, std::min(int(uv.y * float(img.height)), img.height - 1)) << i;

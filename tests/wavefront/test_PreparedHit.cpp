@@ -1,19 +1,19 @@
-// pathShade given its first steps done ahead (pathShadeAhead: the interaction and the light's
-// 2D draw, which renderTileByBounce works out for a whole round before shading it) against
-// pathShade doing them itself: the same light sample, the same next ray and the same sampler
-// position, to the bit, at every bounce, on scenes that take each branch (the product's draw,
-// an area light's share, glass, a blend's partner, a textured material). With Sobol's draws,
-// the light's and the BSDF's pairs are drawn ahead too, at bounceLayout's offsets past the
-// sampler (RoundLanes::drawAhead), and pathShade takes them unchecked: they are drawBounce's
-// own draws to the bit, and on the buddha a wrong pair put there changes the path.
+// pathShade given a hit prepared as the tile wavefront prepares it (prepareHit: the interaction
+// and the light's pair; the product draw taken level by level to its end, and placed as the
+// lanes place it; with Sobol's draws, the light's and the BSDF's pairs at bounceLayout's offsets)
+// through PreparedParts, against pathShade working each part out itself (SampledParts): the same
+// light sample, the same next ray and the same sampler position, to the bit, at every bounce, on
+// scenes that take each branch (the product's draw, an area light's share, glass, a blend's
+// partner, a textured material). PreparedParts takes the pairs unchecked, and on the buddha a
+// wrong pair put there changes the path.
 #include <gtest/gtest.h>
 
 #include <memory>
 
 #include "accel/Bvh.h"
-#include "integrators/PathIntegrator.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
+#include "wavefront/TileStages.h"
 
 using namespace envgi;
 
@@ -42,9 +42,27 @@ Vec2f drawAt(const Sampler& smp, uint32_t dim) {
   return at.get2D();
 }
 
+// A descent begun by prepareHit, taken to its end as walkProductDraws takes it; placed, looked
+// up and turned into a direction as the lanes do, where place.
+void endDescent(const EnvironmentMapView& env, ProductDescent* a, bool place, DescendedDraw* p) {
+  env.product.descend1(a);
+  env.product.descend2(a);
+  env.product.descend3(a);
+  int px, py;
+  env.product.descendToPixel(a, &px, &py);
+  p->ended = true;
+  p->u = a->u, p->nLocal = a->nLocal;
+  p->drawn = env.product.descentEnd(*a, &p->uv, &p->pdfUV);
+  if (!place || !p->drawn) return;
+  p->uv = env.placeInPixel(p->uv, &p->pdfUV);
+  p->radiance = env.lookupUV(p->uv);
+  p->dir = env.fromLocal(EnvironmentMapView::uvToDir(p->uv));
+  p->placed = true;
+}
+
 }  // namespace
 
-TEST(PathIntegrator, ShadingWithItsFirstStepsDoneAheadIsTheSame) {
+TEST(PreparedHit, ShadingAPreparedHitIsTheSame) {
   for (std::string name : {"buddha", "cornell-box", "teapot-glass", "blend", "textured", "bunny-sunrise"}) {
     Scene scene;
     loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/" + name + ".xml", {{"res", "16"}}, scene);
@@ -72,43 +90,36 @@ TEST(PathIntegrator, ShadingWithItsFirstStepsDoneAheadIsTheSame) {
             Sampler sa = smp, sb = smp;
             LightSampleLd lda, ldb;
             const bool ga = pathShade(sc, &a, found, h, sa, k.path, KeepLd{&lda});
-            ShadeAhead ahead;
-            ProductDrawAhead draw;
-            const ShadeAhead* pre = nullptr;
-            Vec2f uL;
+            PreparedHit prepared;
+            ProductDescent descent;
             if (found && sobol) {
               const BounceLayout layout = bounceLayout(k.path);
-              uL = drawAt(smp, smp.dim + layout.light);
-              ahead.ub = drawAt(smp, smp.dim + layout.bsdf);
-              ahead.bsdfDrawn = true;
-              // The layout is where drawBounce draws.
-              Sampler sd = smp;
-              BsdfScratch textured;
-              const BounceDraws u =
-                  drawBounce(sc, sc.bsdfAt(sc.interaction(st.ray, h), &textured), k.path, st.depth, sd, nullptr);
-              ASSERT_EQ(u.light.uL.x, uL.x) << name;
-              ASSERT_EQ(u.light.uL.y, uL.y) << name;
-              ASSERT_EQ(u.bsdf.ub.x, ahead.ub.x) << name;
-              ASSERT_EQ(u.bsdf.ub.y, ahead.ub.y) << name;
+              prepared.uL = drawAt(smp, smp.dim + layout.light);
+              prepared.ub = drawAt(smp, smp.dim + layout.bsdf);
+              prepared.bsdfDrawn = true;
             }
             if (found) {
-              productDraws += pathShadeAhead(sc, st, h, smp, k.path, &ahead, &draw, sobol ? &uL : nullptr);
-              pre = &ahead;
+              if (prepareHit(sc, st, h, smp, k.path, sobol, prepared.uL, &prepared, &descent)) {
+                endDescent(sc.env, &descent, productDraws % 2 == 1, &prepared.product);
+                ++productDraws;
+              }
+            } else {
+              prepared.uv = EnvironmentMapView::dirToUV(sc.env.toLocalUnnormalized(st.ray.d));
             }
             if (found && sobol) {
               // A pair that is not the draw, where the BSDF's should be: taken, it moves the path.
               PathState c = st;
               Sampler sc2 = smp;
-              ShadeAhead wrong = ahead;
-              wrong.ub = Vec2f(0.5f * (ahead.ub.x + 0.37f), 1.f - ahead.ub.y);
+              PreparedHit wrong = prepared;
+              wrong.ub = Vec2f(0.5f * (prepared.ub.x + 0.37f), 1.f - prepared.ub.y);
               LightSampleLd ldc;
-              const bool gc = pathShade(sc, &c, found, h, sc2, k.path, KeepLd{&ldc}, &wrong);
+              const bool gc = pathShade(sc, &c, found, h, sc2, k.path, KeepLd{&ldc}, PreparedParts{sc, wrong});
               Sampler sa2 = smp;
               PathState a2 = st;
               const bool ga2 = pathShade(sc, &a2, found, h, sa2, k.path, KeepLd{&ldc});
               bsdfDrawsTaken += gc != ga2 || c.ray.d.x != a2.ray.d.x || c.ray.d.y != a2.ray.d.y;
             }
-            const bool gb = pathShade(sc, &b, found, h, sb, k.path, KeepLd{&ldb}, pre);
+            const bool gb = pathShade(sc, &b, found, h, sb, k.path, KeepLd{&ldb}, PreparedParts{sc, prepared});
             const std::string where = name + " pixel " + std::to_string(x) + "," + std::to_string(y) + " depth " +
                                       std::to_string(st.depth);
             ASSERT_EQ(ga, gb) << where;
@@ -130,7 +141,7 @@ TEST(PathIntegrator, ShadingWithItsFirstStepsDoneAheadIsTheSame) {
     if (name == "buddha") {
       EXPECT_GT(productDraws, 100) << "buddha's map is drawn by the product strategy";
       ASSERT_TRUE(sobol) << "buddha's ldsampler is Sobol's";
-      EXPECT_GT(bsdfDrawsTaken, shaded / 2) << "the BSDF's pair drawn ahead is the one pathShade takes";
+      EXPECT_GT(bsdfDrawsTaken, shaded / 2) << "the BSDF's pair prepared is the one pathShade takes";
     }
   }
 }
