@@ -16,7 +16,7 @@ ENVGI_INLINE float polyAtan2(float y, float x) {
   float ax = std::fabs(x), ay = std::fabs(y);
   float hi = ax > ay ? ax : ay, lo = ax > ay ? ay : ax;
   // Divided whatever hi is, then chosen: with no division under a condition, loops over many
-  // directions vectorise (RoundLanes::mapUV).
+  // directions vectorise.
   const float q = lo / hi;
   float a = hi == 0.f ? 0.f : q;  // a NaN stays NaN
   float s = a * a;

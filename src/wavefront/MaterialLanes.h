@@ -1,4 +1,4 @@
-// The BSDF work of a round's hits on rough plastics (RoundLanes::samplesInLanes), done in vector
+// The BSDF work of a round's hits on rough plastics (RoughPlasticLanes::takes), done in vector
 // lanes a material at a time: the BSDF samples, and the values at the product draws' directions,
 // which PreparedParts then hands to pathShade.
 #pragma once
@@ -41,16 +41,16 @@ inline void sampleBsdfsInLanes(const SceneView& sc, const PathParams& pp, TileQu
   for (int j = 0; j < hits; ++j) {
     const int k = q->hits[j];
     if (!(pp.maxDepth >= 0 && q->state[k].depth >= pp.maxDepth) &&
-        RoundLanes::samplesInLanes(sc.bsdfs[q->prepared[k].si.bsdf]))
+        RoughPlasticLanes::takes(sc.bsdfs[q->prepared[k].si.bsdf]))
       q->sampling[count++] = k;
   }
-  RoundLanes& lanes = q->lanes;
+  RoughPlasticLanes& lanes = q->roughPlastic;
   byMaterial(
-      q, count, [&](int n, int k) { lanes.setBsdfDraw(n, preparedWo(q, k), q->prepared[k].ub); },
-      [&](int material, int n) { lanes.sampleRoughPlastic(sc.bsdfs[material], n); },
+      q, count, [&](int n, int k) { lanes.setSample(n, preparedWo(q, k), q->prepared[k].ub); },
+      [&](int material, int n) { lanes.sample(sc.bsdfs[material], n); },
       [&](int j, int k) {
         PreparedHit& p = q->prepared[k];
-        p.sampleTaken = lanes.bsdfSampleOf(j, &p.sample);
+        p.sampleTaken = lanes.sampleOf(j, &p.sample);
         p.sampled = true;
       });
 }
@@ -64,19 +64,19 @@ inline void evalBsdfsInLanes(const SceneView& sc, TileQueues* q, int draws) {
   for (int i = 0; i < draws; ++i) {
     const int k = q->productDraws[i];
     const PreparedHit& p = q->prepared[k];
-    if (p.product.drawn && p.product.placed && p.si.partner < 0 && RoundLanes::samplesInLanes(sc.bsdfs[p.si.bsdf]))
+    if (p.product.drawn && p.product.placed && p.si.partner < 0 && RoughPlasticLanes::takes(sc.bsdfs[p.si.bsdf]))
       q->sampling[count++] = k;
   }
-  RoundLanes& lanes = q->lanes;
+  RoughPlasticLanes& lanes = q->roughPlastic;
   byMaterial(
       q, count,
       [&](int n, int k) {
         const PreparedHit& p = q->prepared[k];
-        lanes.setBsdfEval(n, preparedWo(q, k), p.si.shading.toLocal(p.product.dir));
+        lanes.setEval(n, preparedWo(q, k), p.si.shading.toLocal(p.product.dir));
       },
-      [&](int material, int n) { lanes.evalRoughPlastic(sc.bsdfs[material], n); },
+      [&](int material, int n) { lanes.eval(sc.bsdfs[material], n); },
       [&](int j, int k) {
-        q->prepared[k].value = lanes.bsdfEvalOf(j);
+        q->prepared[k].value = lanes.evalOf(j);
         q->prepared[k].valued = true;
       });
 }

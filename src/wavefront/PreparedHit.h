@@ -5,7 +5,7 @@
 #pragma once
 
 #include "integrators/PathIntegrator.h"
-#include "wavefront/RoundLanes.h"
+#include "materials/RoughPlasticLanes.h"
 
 namespace envgi {
 
@@ -32,7 +32,7 @@ struct PreparedHit {
   bool sampled = false, sampleTaken = false;
   BsdfSample sample;
   bool valued = false;
-  LaneBsdfValue value;
+  BsdfEvaluation value;
   DescendedDraw product;
   Vec2f uv;  // a ray that escaped: where it meets the map
 };

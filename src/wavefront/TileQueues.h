@@ -6,7 +6,9 @@
 
 #include <vector>
 
+#include "envmap/MapLanes.h"
 #include "wavefront/PreparedHit.h"
+#include "wavefront/SampleLanes.h"
 
 namespace envgi {
 
@@ -30,7 +32,11 @@ struct TileQueues {
   // material lanes' scratch (MaterialLanes.h).
   std::vector<int> live, escaped, hits, productDraws, shadowRays;
   std::vector<int> sampling, picking;
-  RoundLanes lanes;  // the round's work done lane by lane
+  // The round's work done lane by lane: its samples, its rays' and draws' meetings with the
+  // map, and its rough plastics.
+  SampleLanes lanes;
+  MapLanes map;
+  RoughPlasticLanes roughPlastic;
 
   void resize(size_t n) {
     if (state.size() >= n) return;
@@ -38,7 +44,7 @@ struct TileQueues {
     ld.resize(n), ldBeta.resize(n), weight.resize(n), acc.resize(n), accSq.resize(n), accW.resize(n);
     prepared.resize(n), descent.resize(n);
     for (std::vector<int>* q : {&live, &escaped, &hits, &productDraws, &shadowRays, &sampling, &picking}) q->resize(n);
-    lanes.resize(n);
+    lanes.resize(n), map.resize(n), roughPlastic.resize(n);
   }
 };
 

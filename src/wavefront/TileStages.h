@@ -91,7 +91,7 @@ inline void keepHit(TileQueues* q, int i, bool found, const Hit& h) {
 template <class I>
 int traceCameraLanes(const TileRound<I>& r, int live) {
   TileQueues* q = r.q;
-  RoundLanes& lanes = q->lanes;
+  SampleLanes& lanes = q->lanes;
   const SceneView& sc = r.scene();
   lanes.make(r.cam, r.first, live);
   r.integ.tracer.intersectCoherent(
@@ -99,20 +99,20 @@ int traceCameraLanes(const TileRound<I>& r, int live) {
   r.counters->rays += uint64_t(live);
   int escapes = 0;
   if (sc.hasEnvironment) {
-    lanes.mapUV(sc.env, live);
+    q->map.findUV(sc.env, live, lanes.dx.data(), lanes.dy.data(), lanes.dz.data());
     for (int i = 0; i < live; ++i)
-      if (!q->found[q->live[i]]) lanes.picked[escapes++] = i;
-    lanes.mapRadiance(sc.env, escapes);
+      if (!q->found[q->live[i]]) q->map.picked[escapes++] = i;
+    q->map.lookUp(sc.env, escapes);
   }
   const PathParams pp = r.integ.shadedPath();
-  const uint32_t dims = RoundLanes::dimensions(r.cam);
+  const uint32_t dims = SampleLanes::dimensions(r.cam);
   int hits = 0;
   for (int i = 0, e = 0; i < live; ++i) {
     const int k = q->live[i];
     q->weight[k] = lanes.weight[i];
     if (!q->found[k]) {
       PathState st = pathBegin(lanes.rayOf(i));
-      if (sc.hasEnvironment) pathAddEscape(sc, &st, pp, LaneEscapeParts{lanes.uvOf(i), lanes.radianceOf(e++)});
+      if (sc.hasEnvironment) pathAddEscape(sc, &st, pp, LaneEscapeParts{q->map.uvOf(i), q->map.radianceOf(e++)});
       finishPath(q, k, st.L, r.counters);
       continue;
     }
@@ -153,7 +153,7 @@ inline void prefetchEscape(const SceneView& sc, const PathState& st, const PathP
     sc.env.prefetchEvalWithPdf(pp.envStrategy, uv, st.prevAxis);
 }
 
-// The rays that escaped meet the map: where, lane by lane (RoundLanes::mapUV), then, past the
+// The rays that escaped meet the map: where, lane by lane (MapLanes::findUV), then, past the
 // camera's round, what their MIS weights will read there, prefetched.
 template <class I>
 void meetMap(const TileRound<I>& r, int live, bool cameraRays) {
@@ -164,12 +164,12 @@ void meetMap(const TileRound<I>& r, int live, bool cameraRays) {
   for (int i = 0; i < live; ++i)
     if (!q->found[q->live[i]]) {
       q->escaped[escapes] = q->live[i];
-      q->lanes.setDirection(escapes++, q->state[q->live[i]].ray.d);
+      q->map.setDirection(escapes++, q->state[q->live[i]].ray.d);
     }
-  q->lanes.mapUV(r.scene().env, escapes);
+  q->map.findUV(r.scene().env, escapes);
   for (int j = 0; j < escapes; ++j) {
     const int k = q->escaped[j];
-    q->prepared[k].uv = q->lanes.uvOf(j);
+    q->prepared[k].uv = q->map.uvOf(j);
     if (!cameraRays) prefetchEscape(r.scene(), q->state[k], pp, q->prepared[k].uv);
   }
 }
@@ -206,7 +206,7 @@ inline bool prepareHit(const SceneView& sc, const PathState& st, const Hit& h, c
 template <class I>
 int prepareHits(const TileRound<I>& r, int live) {
   TileQueues* q = r.q;
-  RoundLanes& lanes = q->lanes;
+  SampleLanes& lanes = q->lanes;
   int hits = 0;
   for (int i = 0; i < live; ++i)
     if (q->found[q->live[i]]) q->hits[hits++] = q->live[i];
@@ -252,14 +252,14 @@ void walkProductDraws(const TileRound<I>& r, int draws) {
     p.ended = true;
     p.u = a.u, p.nLocal = a.nLocal;
     p.drawn = env.product.descentEnd(a, &p.uv, &p.pdfUV);
-    if (r.inLanes && p.drawn) q->lanes.setDraw(placing++, p.uv, p.pdfUV);
+    if (r.inLanes && p.drawn) q->map.setDraw(placing++, p.uv, p.pdfUV);
   }
   if (placing == 0) return;
-  q->lanes.placeDraws(env, placing);
+  q->map.placeDraws(env, placing);
   for (int i = 0, j = 0; i < draws; ++i) {
     DescendedDraw& p = q->prepared[d[i]].product;
     if (!p.drawn) continue;
-    q->lanes.placedDraw(j++, &p.uv, &p.pdfUV, &p.radiance);
+    q->map.placedDraw(j++, &p.uv, &p.pdfUV, &p.radiance);
     p.dir = env.fromLocal(EnvironmentMapView::uvToDir(p.uv));  // EnvironmentMapView::productSample's
     p.placed = true;
   }

@@ -19,7 +19,7 @@ void renderTileWavefront(const Camera& cam, const SampleSequence& seq, const Int
   for (int s = s0; s < s1; ++s) {
     Sampler first = sequenceSampler(seq);
     first.setIndex(uint32_t(s));
-    const TileRound<Integrator> r{cam, integ, film, q, counters, x0, y0, x1, y1, first, RoundLanes::handles(first)};
+    const TileRound<Integrator> r{cam, integ, film, q, counters, x0, y0, x1, y1, first, SampleLanes::handles(first)};
     int live = startCameraSamples(r);
     // Made in lanes, the camera round is traced with them: every path left is a hit.
     const bool laneRound = r.inLanes && live > 0;
