@@ -232,111 +232,130 @@ void logPhotonStats(const PhotonShootStats& st) {
                st.storedGlobal + st.storedCaustic > 0 ? st.bytes / (st.storedGlobal + st.storedCaustic) : 0);
 }
 
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The photons the streams have stored in each map so far, how many photons each map's stream
+// emitted, and when the pass began and last logged.
+struct PhotonHarvest {
+  std::vector<Photon> global, caustic;
+  uint64_t globalEmitted = 0, causticEmitted = 0;
+  Clock::time_point start = Clock::now();
+  double lastLog = 0.0;
+};
+
+// Shoots one stream into the maps whose done flag is given (null: that map's photons are not
+// this stream's) until each is full, given up or `cap` photons are emitted.
+void fillFromStream(const PhotonShootSettings& s, PhotonBatchTracer* tracer, const PhotonEmitter& emitter,
+                    uint32_t stream, bool aimed, uint64_t cap, PhotonHarvest* h, bool* globalDone, bool* causticDone) {
+  std::vector<Photon>& g = h->global;
+  std::vector<Photon>& c = h->caustic;
+  std::vector<PhotonBatch> batches;
+  uint64_t emitted = 0;
+  // A map still empty after 2^20 photons stays empty rather than spin on to the cap: no mirror
+  // or glass leads light to a diffuse surface (caustic), or light reaches no second surface, a
+  // lone object or floor (global, which keeps only photons after a bounce).
+  auto giveUpIfEmpty = [&emitted](bool* done, const std::vector<Photon>& map, const char* paths, const char* name) {
+    if (*done || !map.empty() || emitted < (uint64_t(1) << 20)) return;
+    spdlog::info("no {} paths after {} photons: the {} map stays empty", paths, emitted, name);
+    *done = true;
+  };
+  bool gd = !globalDone || *globalDone, cd = !causticDone || *causticDone;
+  while (!(gd && cd) && emitted < cap) {
+    PhotonTraceRequest req;
+    req.first = emitted;
+    req.seed = s.seed;
+    req.stream = stream;
+    req.aimed = aimed;
+    req.maxDepth = s.maxDepth;
+    req.global = !gd;
+    req.caustic = !cd;
+    req.emitter = emitter;
+    throwIfCancelled(s.cancel);
+    tracer->trace(req, &batches);
+    // Sub-batches are taken in order and the maps checked after each, whatever the device
+    // traced at once: the same seed fills the same maps.
+    for (PhotonBatch& b : batches) {
+      if ((gd && cd) || emitted >= cap) break;
+      if (!gd) g.insert(g.end(), b.global.begin(), b.global.end());
+      if (!cd) c.insert(c.end(), b.caustic.begin(), b.caustic.end());
+      emitted += uint64_t(kPhotonSubBatch);
+      if (!gd) h->globalEmitted = emitted;
+      if (!cd) h->causticEmitted = emitted;
+      gd = gd || g.size() >= s.globalPhotons;
+      cd = cd || c.size() >= s.causticPhotons;
+      giveUpIfEmpty(&cd, c, "caustic", "caustic");
+      giveUpIfEmpty(&gd, g, "indirect", "global");
+    }
+    double t = std::chrono::duration<double>(Clock::now() - h->start).count();
+    if (s.progress && t - h->lastLog >= 2.0) {
+      h->lastLog = t;
+      spdlog::info("photon pass{}: {} emitted, {}/{} global, {}/{} caustic stored, {:.1f} s",
+                   aimed ? " (caustics, aimed)" : "", emitted, g.size(), s.globalPhotons, c.size(), s.causticPhotons,
+                   t);
+    }
+  }
+  if (globalDone) *globalDone = gd;
+  if (causticDone) *causticDone = cd;
+}
+
+// The maps' kd-trees, and their irradiance estimates where s asks for them.
+void buildMaps(const PhotonShootSettings& s, std::vector<Photon> g, std::vector<Photon> c, PhotonMap* global,
+               PhotonMap* caustic) {
+  // nanoflann (1.4 in Debian 12) builds a tree on one thread: the two maps' trees side by side.
+  tbb::parallel_invoke([&] { global->build(std::move(g)); }, [&] { caustic->build(std::move(c)); });
+  if (s.irradianceStride <= 0) return;
+  auto precompute = [&](PhotonMap* map, float radius) {
+    size_t n = map->beginIrradiance(s.irradianceStride);
+    const std::vector<uint32_t> order = map->irradianceOrder();
+    tbb::parallel_for(size_t(0), n, [&](size_t j) { map->estimateIrradiance(order[j], s.irradianceLookup, radius); });
+    map->endIrradiance();
+  };
+  precompute(global, s.irradianceRadius);
+  precompute(caustic, s.causticIrradianceRadius);
+}
+
+}  // namespace
+
 void shootPhotons(const Scene& scene, const PhotonShootSettings& s, PhotonMap* global, PhotonMap* caustic,
                   PhotonShootStats* stats) {
-  using Clock = std::chrono::steady_clock;
-  auto t0 = Clock::now();
+  PhotonHarvest h;
   const SceneView& sc = scene.view();
   if (!s.tracer) throw std::logic_error("shootPhotons: no photon tracer");
   requirePhotonMapsFit(s.globalPhotons + s.causticPhotons, physicalMemoryBytes());
   PhotonBatchTracer* tracer = s.tracer.get();
   PhotonEmitter emitter = makePhotonEmitter(scene, s.aimCaustics);
-  bool anyLight = emitter.emitsLight(sc);
-  std::vector<Photon> g, c;
   bool gDone = s.globalPhotons == 0, cDone = s.causticPhotons == 0;
-  uint64_t gEmitted = 0, cEmitted = 0;
   // A scene without caustic paths never fills its caustic map: stop after a generous bound.
   const uint64_t cap = 64 * std::max(s.globalPhotons, s.causticPhotons) + 100000;
-  double lastLog = 0.0;
-  if (!anyLight) {
+  if (!emitter.emitsLight(sc)) {
     spdlog::warn("the scene emits no light: no photons shot");
     gDone = cDone = true;
   }
   // One stream fills both maps; or, with targets to aim at, the global map's stream keeps only
   // its global photons and a second, aimed stream fills the caustic map.
   bool aim = emitter.targetCount > 0 && !cDone;  // targets only where s.aimCaustics
-  std::vector<PhotonBatch> batches;
-  // Shoots one stream into the maps whose done flag is given (null: that map's photons are not
-  // this stream's) until each is full, given up or the cap is reached.
-  auto fill = [&](uint32_t stream, bool aimed, bool* globalDone, bool* causticDone) {
-    uint64_t emitted = 0;
-    // A map still empty after 2^20 photons stays empty rather than spin on to the cap: no mirror
-    // or glass leads light to a diffuse surface (caustic), or light reaches no second surface, a
-    // lone object or floor (global, which keeps only photons after a bounce).
-    auto giveUpIfEmpty = [&emitted](bool* done, const std::vector<Photon>& map, const char* paths, const char* name) {
-      if (*done || !map.empty() || emitted < (uint64_t(1) << 20)) return;
-      spdlog::info("no {} paths after {} photons: the {} map stays empty", paths, emitted, name);
-      *done = true;
-    };
-    bool gd = !globalDone || *globalDone, cd = !causticDone || *causticDone;
-    while (!(gd && cd) && emitted < cap) {
-      PhotonTraceRequest req;
-      req.first = emitted;
-      req.seed = s.seed;
-      req.stream = stream;
-      req.aimed = aimed;
-      req.maxDepth = s.maxDepth;
-      req.global = !gd;
-      req.caustic = !cd;
-      req.emitter = emitter;
-      throwIfCancelled(s.cancel);
-      tracer->trace(req, &batches);
-      // Sub-batches are taken in order and the maps checked after each, whatever the device
-      // traced at once: the same seed fills the same maps.
-      for (PhotonBatch& b : batches) {
-        if ((gd && cd) || emitted >= cap) break;
-        if (!gd) g.insert(g.end(), b.global.begin(), b.global.end());
-        if (!cd) c.insert(c.end(), b.caustic.begin(), b.caustic.end());
-        emitted += uint64_t(kPhotonSubBatch);
-        if (!gd) gEmitted = emitted;
-        if (!cd) cEmitted = emitted;
-        gd = gd || g.size() >= s.globalPhotons;
-        cd = cd || c.size() >= s.causticPhotons;
-        giveUpIfEmpty(&cd, c, "caustic", "caustic");
-        giveUpIfEmpty(&gd, g, "indirect", "global");
-      }
-      double t = std::chrono::duration<double>(Clock::now() - t0).count();
-      if (s.progress && t - lastLog >= 2.0) {
-        lastLog = t;
-        spdlog::info("photon pass{}: {} emitted, {}/{} global, {}/{} caustic stored, {:.1f} s",
-                     aimed ? " (caustics, aimed)" : "", emitted, g.size(), s.globalPhotons, c.size(),
-                     s.causticPhotons, t);
-      }
-    }
-    if (globalDone) *globalDone = gd;
-    if (causticDone) *causticDone = cd;
-  };
   if (!aim) {
-    fill(kPhotonMapStream, false, &gDone, &cDone);
+    fillFromStream(s, tracer, emitter, kPhotonMapStream, false, cap, &h, &gDone, &cDone);
   } else {
-    fill(kPhotonMapStream, false, &gDone, nullptr);
-    fill(kCausticPhotonStream, true, nullptr, &cDone);
+    fillFromStream(s, tracer, emitter, kPhotonMapStream, false, cap, &h, &gDone, nullptr);
+    fillFromStream(s, tracer, emitter, kCausticPhotonStream, true, cap, &h, nullptr, &cDone);
   }
-  for (Photon& p : g) p.power = p.power / float(std::max<uint64_t>(gEmitted, 1));
-  for (Photon& p : c) p.power = p.power / float(std::max<uint64_t>(cEmitted, 1));
+  for (Photon& p : h.global) p.power = p.power / float(std::max<uint64_t>(h.globalEmitted, 1));
+  for (Photon& p : h.caustic) p.power = p.power / float(std::max<uint64_t>(h.causticEmitted, 1));
   auto t1 = Clock::now();
   if (stats) {
-    stats->emittedGlobal = gEmitted;
-    stats->emittedCaustic = cEmitted;
-    stats->storedGlobal = g.size();
-    stats->storedCaustic = c.size();
+    stats->emittedGlobal = h.globalEmitted;
+    stats->emittedCaustic = h.causticEmitted;
+    stats->storedGlobal = h.global.size();
+    stats->storedCaustic = h.caustic.size();
     stats->causticTargets = aim ? emitter.targetCount : 0;
     stats->device = tracer->deviceName();
   }
-  // nanoflann (1.4 in Debian 12) builds a tree on one thread: the two maps' trees side by side.
-  tbb::parallel_invoke([&] { global->build(std::move(g)); }, [&] { caustic->build(std::move(c)); });
-  if (s.irradianceStride > 0) {
-    auto precompute = [&](PhotonMap* map, float radius) {
-      size_t n = map->beginIrradiance(s.irradianceStride);
-      const std::vector<uint32_t> order = map->irradianceOrder();
-      tbb::parallel_for(size_t(0), n, [&](size_t j) { map->estimateIrradiance(order[j], s.irradianceLookup, radius); });
-      map->endIrradiance();
-    };
-    precompute(global, s.irradianceRadius);
-    precompute(caustic, s.causticIrradianceRadius);
-  }
+  buildMaps(s, std::move(h.global), std::move(h.caustic), global, caustic);
   if (stats) {
-    stats->traceSeconds = std::chrono::duration<double>(t1 - t0).count();
+    stats->traceSeconds = std::chrono::duration<double>(t1 - h.start).count();
     stats->buildSeconds = std::chrono::duration<double>(Clock::now() - t1).count();
     stats->bytes = global->bytes() + caustic->bytes();
   }

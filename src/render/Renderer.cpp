@@ -301,22 +301,30 @@ void requireFilmFits(const Camera& cam, const RenderOptions& opts, double memory
                                                  : "render fewer pixels (the film's width and height)");
 }
 
+namespace {
+
 // The most of a render's time that checkpoints may take.
 constexpr double kCheckpointShare = 0.1;
 
-Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts, RenderStats* stats) {
-  // Passes double the samples done (1, 1, 2, 4, ...) up to the executor's limit (64 samples on
-  // the CPU), so a checkpoint comes early, and each pass ends at a power of two or a multiple of
-  // the limit: there a pixel's Sobol samples so far are a net (Sampler::shuffledIndex), so a
-  // checkpoint or a time-limited render is as even as a render of that many samples.
-  // A pass also takes at most the executor's maxPassPixelSamples() (halving the limit, so it
-  // stays a power of two): on a large image a checkpoint, the time limit and Ctrl-C then come
-  // every few seconds, not after passes of 64 samples of every pixel (at 4096^2, minutes each).
-  // The passes depend on the image's size alone, so the same render sums the same film.
+// A render's passes: samples [first, end), the pass that starts at s0 ending at passEnd(s0).
+// Passes double the samples done (1, 1, 2, 4, ...) up to the executor's limit (64 samples on
+// the CPU), so a checkpoint comes early, and each pass ends at a power of two or a multiple of
+// the limit: there a pixel's Sobol samples so far are a net (Sampler::shuffledIndex), so a
+// checkpoint or a time-limited render is as even as a render of that many samples.
+// A pass also takes at most the executor's maxPassPixelSamples() (halving the limit, so it
+// stays a power of two): on a large image a checkpoint, the time limit and Ctrl-C then come
+// every few seconds, not after passes of 64 samples of every pixel (at 4096^2, minutes each).
+// The passes depend on the image's size alone, so the same render sums the same film.
+struct PassPlan {
+  int first, end, maxPass;
+  // One pass at a time: a list of them all (33 million for --spp 2147483647 and a time limit)
+  // and s0 + n in int had overflowed into a hang.
+  int passEnd(int s0) const { return int(std::min<int64_t>(end, int64_t(s0) + std::clamp(s0, 1, maxPass))); }
+};
+
+PassPlan planPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts) {
   int maxPass = std::max(1, ex.maxPassSize());
   while (maxPass > 1 && double(maxPass) * double(W) * double(H) > double(ex.maxPassPixelSamples())) maxPass /= 2;
-  // Where the pass that starts at s0 ends, one pass at a time: a list of them all (33 million
-  // for --spp 2147483647 and a time limit) and s0 + n in int had overflowed into a hang.
   const int first = opts.firstSample, end = opts.sampleEnd < 0 ? spp : opts.sampleEnd;
   if (first < 0 || first >= end || end > spp)
     throw std::runtime_error("the samples " + std::to_string(first) + ":" + std::to_string(end) +
@@ -324,17 +332,79 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   if (first > 0 && opts.noiseThreshold > 0.f)
     throw std::runtime_error("adaptive sampling decides from each pixel's samples so far: it cannot render a range "
                              "that does not start at 0");
-  auto passEnd = [&](int s0) { return int(std::min<int64_t>(end, int64_t(s0) + std::clamp(s0, 1, maxPass))); };
+  return {first, end, maxPass};
+}
+
+// When checkpoints are written. A checkpoint stops the passes while it is written (an 8192²
+// EXR: seconds), so the next waits at least ten times as long as this one took: they cost at
+// most a tenth of the render.
+class CheckpointClock {
+ public:
+  explicit CheckpointClock(double seconds) : seconds_(seconds), gap_(seconds), last_(Clock::now()) {}
+  bool due() const { return seconds_ > 0.0 && std::chrono::duration<double>(Clock::now() - last_).count() >= gap_; }
+  void written(Clock::time_point start) {
+    last_ = Clock::now();
+    const double took = std::chrono::duration<double>(last_ - start).count();
+    gap_ = std::max(seconds_, took / kCheckpointShare);
+    if (gap_ > seconds_ && !said_) {
+      spdlog::info("checkpoints every {:.0f} s or more, not {:g}: writing one took {:.1f} s", gap_, seconds_, took);
+      said_ = true;
+    }
+  }
+
+ private:
+  double seconds_, gap_;
+  Clock::time_point last_;
+  bool said_ = false;
+};
+
+// Each pixel's variance of the mean of its samples' luminance, from the film's sums.
+void pixelVariances(const FilmSums& film, const std::vector<int>& samples, size_t pixels, std::vector<float>* out) {
+  if (film.sumSqLum.empty()) throw std::runtime_error("this executor kept no per-pixel variance");
+  out->assign(pixels, 0.f);
+  for (size_t i = 0; i < film.sum.size(); ++i) {
+    int n = std::max(samples[i], 1);
+    double mean = luminance(film.sum[i]) / n;
+    double var = std::max(0.0, film.sumSqLum[i] / n - mean * mean);
+    (*out)[i] = float(var / std::max(1, n - 1));
+  }
+}
+
+// Where a render's passes stopped, and why.
+struct PassesDone {
+  int sppDone = 0, sppAhead = 0;  // every pixel's samples; a cut pass's end, where Ctrl-C cut one
+  size_t pixelsAhead = 0;         // the pixels that took the cut pass whole
+  bool cancelled = false, timeLimited = false;
+};
+
+void recordStats(const PassesDone& done, const PassCounters& counters, const ActivePixels& pixels, size_t px,
+                 double seconds, RenderStats* stats) {
+  stats->seconds = seconds;
+  stats->sppDone = done.sppDone;
+  stats->rays = counters.rays;
+  stats->nonFiniteSamples = counters.dropped;
+  stats->cancelled = done.cancelled;
+  stats->timeLimited = done.timeLimited;
+  stats->pixelSamples = pixels.pixelSamples();
+  stats->pixelsStopped = px - pixels.activeCount();  // 0 unless adaptive
+  stats->converged = pixels.converged();
+  stats->pixelsAhead = done.pixelsAhead;
+  stats->sppAhead = done.sppAhead;
+}
+
+}  // namespace
+
+Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions& opts, RenderStats* stats) {
+  const PassPlan plan = planPasses(ex, W, H, spp, opts);
+  const int first = plan.first, end = plan.end;
   Progress progress(size_t(W) * H * size_t(end - first), opts.progress, opts.timeLimitSeconds, opts.progressFraction);
   PassCounters counters;
   FilmSums film;
   auto t0 = Clock::now();
-  auto lastCheckpoint = t0;
-  double checkpointGap = opts.checkpointSeconds;
-  bool gapSaid = false;
-  int sppDone = first, sppAhead = 0;
-  size_t pixelsAhead = 0;
-  bool cancelled = false, timeLimited = false;
+  CheckpointClock checkpoints(opts.checkpoint ? opts.checkpointSeconds : 0.0);
+  PassesDone done;
+  int& sppDone = done.sppDone;
+  sppDone = first;
   const size_t px = size_t(W) * size_t(H);
   // Each pixel's samples so far, and adaptive sampling's mask: every pixel starts active.
   ActivePixels pixels(W, H, opts.noiseThreshold);
@@ -352,29 +422,24 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
   auto pastTimeLimit = [&](int s0) {
     if (opts.timeLimitSeconds <= 0.0 || pixels.pixelSamples() == 0) return false;
     double spent = std::chrono::duration<double>(Clock::now() - t0).count();
-    return spent + spent / double(pixels.pixelSamples()) * double(pixels.activeCount()) * (passEnd(s0) - s0) >
+    return spent + spent / double(pixels.pixelSamples()) * double(pixels.activeCount()) * (plan.passEnd(s0) - s0) >
            opts.timeLimitSeconds;
   };
   bool nextPastTimeLimit = false;
   for (int s0 = first, s1 = first; s0 < end; s0 = s1) {
-    s1 = passEnd(s0);
-    if (opts.cancel && opts.cancel->load()) {
-      cancelled = true;
-      break;
-    }
-    if (nextPastTimeLimit) {
-      timeLimited = true;
-      break;
-    }
+    s1 = plan.passEnd(s0);
+    done.cancelled = opts.cancel && opts.cancel->load();
+    done.timeLimited = !done.cancelled && nextPastTimeLimit;
+    if (done.cancelled || done.timeLimited) break;
     // Ctrl-C stops a pass at its next tile, but for the first, which every pixel takes whole
     // (an image with black tiles would not be finished work). The finished tiles' samples are
     // kept: each pixel's mean is over its own count.
     ex.watchCancel(s0 > first ? opts.cancel : nullptr);
     ex.runPass(s0, s1, progress, &counters);
     if (const std::vector<unsigned char>* took = ex.cutPass()) {
-      pixelsAhead = pixels.passDone(s0, s1, *took);
-      sppAhead = s1;
-      cancelled = true;
+      done.pixelsAhead = pixels.passDone(s0, s1, *took);
+      done.sppAhead = s1;
+      done.cancelled = true;
       break;
     }
     pixels.passDone(s0, s1);
@@ -387,51 +452,19 @@ Image renderPasses(PassExecutor& ex, int W, int H, int spp, const RenderOptions&
       if (left == 0) break;  // every pixel has converged: the render is done
     }
     nextPastTimeLimit = sppDone < end && pastTimeLimit(sppDone);
-    double sinceCheckpoint = std::chrono::duration<double>(Clock::now() - lastCheckpoint).count();
-    if (opts.checkpoint && opts.checkpointSeconds > 0.0 && sinceCheckpoint >= checkpointGap && sppDone < end &&
-        !nextPastTimeLimit) {
+    if (checkpoints.due() && sppDone < end && !nextPastTimeLimit) {
       const auto start = Clock::now();
       opts.checkpoint(meanImage(), sppDone);
-      lastCheckpoint = Clock::now();
-      // A checkpoint stops the passes while it is written (an 8192² EXR: seconds), so the next
-      // waits at least ten times as long as this one took: they cost at most a tenth.
-      const double took = std::chrono::duration<double>(lastCheckpoint - start).count();
-      checkpointGap = std::max(opts.checkpointSeconds, took / kCheckpointShare);
+      checkpoints.written(start);
       nextPastTimeLimit = pastTimeLimit(sppDone);  // the write's time counts against the limit
-      if (checkpointGap > opts.checkpointSeconds && !gapSaid) {
-        spdlog::info("checkpoints every {:.0f} s or more, not {:g}: writing one took {:.1f} s", checkpointGap,
-                     opts.checkpointSeconds, took);
-        gapSaid = true;
-      }
     }
   }
   ex.watchCancel(nullptr);
   progress.finish();
   Image img = meanImage();
   if (opts.filmOut) *opts.filmOut = film;
-  if (stats) {
-    stats->seconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    stats->sppDone = sppDone;
-    stats->rays = counters.rays;
-    stats->nonFiniteSamples = counters.dropped;
-    stats->cancelled = cancelled;
-    stats->timeLimited = timeLimited;
-    stats->pixelSamples = pixels.pixelSamples();
-    stats->pixelsStopped = px - pixels.activeCount();  // 0 unless adaptive
-    stats->converged = pixels.converged();
-    stats->pixelsAhead = pixelsAhead;
-    stats->sppAhead = sppAhead;
-  }
-  if (opts.varianceOut && sppDone > 0) {
-    if (film.sumSqLum.empty()) throw std::runtime_error("this executor kept no per-pixel variance");
-    opts.varianceOut->assign(px, 0.f);
-    for (size_t i = 0; i < film.sum.size(); ++i) {
-      int n = std::max(pixels.samples()[i], 1);
-      double mean = luminance(film.sum[i]) / n;
-      double var = std::max(0.0, film.sumSqLum[i] / n - mean * mean);
-      (*opts.varianceOut)[i] = float(var / std::max(1, n - 1));
-    }
-  }
+  if (stats) recordStats(done, counters, pixels, px, std::chrono::duration<double>(Clock::now() - t0).count(), stats);
+  if (opts.varianceOut && sppDone > 0) pixelVariances(film, pixels.samples(), px, opts.varianceOut);
   if (opts.samplesOut) *opts.samplesOut = pixels.samples();
   if (counters.dropped > 0) spdlog::warn("{} samples were NaN, infinite or negative and were dropped", counters.dropped);
   return img;
