@@ -378,6 +378,16 @@ ENVGI_INLINE float pdfInFrame(const Bsdf& b, Vec3f wo, Vec3f wi) {
 // bsdfEval and bsdfPdf of one pair of directions, with the very values of the two calls apart.
 // Next-event estimation and BSDF sampling both want both (Mitsuba's eval_pdf); rough plastic,
 // the example scenes' glossy BSDF, then computes what the two share once instead of twice.
+// Rough conductor's value and density for wo and wi above the (front) surface: evalInFrame's and
+// pdfInFrame's, to the bit, from one half vector. Apart, for a batch of one material.
+ENVGI_INLINE Color roughConductorEvalPdf(const Bsdf& b, const MicrofacetDistribution& d, Vec3f wo, Vec3f wi,
+                                         float* pdf) {
+  const Vec3f m = normalize(wo + wi);
+  *pdf = d.visiblePdf(wo, m) / (4.f * std::fabs(dot(wo, m)));
+  const Color F = b.perfectMirror ? Color(1.f) : fresnelConductor(dot(wi, m), b.eta, b.k);
+  return b.specularReflectance * F * (d.D(m) * d.G(wo, wi) / (4.f * wo.z));
+}
+
 ENVGI_INLINE Color evalPdfInFrame(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
   if (b.type != BsdfType::RoughPlastic) {
     *pdf = pdfInFrame(b, wo, wi);

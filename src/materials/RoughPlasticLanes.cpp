@@ -140,10 +140,11 @@ ENVGI_LANES void roughPlasticEvals(int n, const Bsdf& bsdf, const CoatNode& node
 
 void RoughPlasticLanes::resize(size_t n) {
   if (woX.size() >= n) return;
-  for (std::vector<float>* a : {&woX, &woY, &woZ, &u0, &u1, &wiX, &wiY, &wiZ, &valueR, &valueG, &valueB, &pdf, &frontZ,
-                                &frontZi, &fo, &diskR, &diskAngle, &diskX, &diskY, &coatLobe, &coatShare, &coatShareI})
+  resizeShared(n);
+  for (std::vector<float>* a : {&frontZ, &frontZi, &fo, &diskR, &diskAngle, &diskX, &diskY, &coatLobe, &coatShare,
+                                &coatShareI})
     a->resize(n);
-  ok.resize(n), coatAt.resize(n), coatAtI.resize(n);
+  coatAt.resize(n), coatAtI.resize(n);
 }
 
 void RoughPlasticLanes::sample(const Bsdf& b, int n) {

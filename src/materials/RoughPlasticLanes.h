@@ -4,27 +4,11 @@
 // answer is bsdfSample's (the lobe from u) or bsdfEvalPdf's to the bit.
 #pragma once
 
-#include <vector>
-
-#include "materials/Bsdf.h"
+#include "materials/BsdfLanes.h"
 
 namespace envgi {
 
-// A BSDF's value f and density pdf for the direction wi, as bsdfEvalPdf gives them.
-struct BsdfEvaluation {
-  Vec3f wi;
-  Color f;
-  float pdf = 0.f;
-};
-
-struct RoughPlasticLanes {
-  // In: each lane's wo in its shading frame (both steps), its pair (sample) or wi (eval).
-  std::vector<float> woX, woY, woZ, u0, u1;
-  // wi: sample's out, eval's in. value and pdf: sample's weight and density, eval's value and
-  // density; ok: whether the sample counts (sample), whether both directions are above the
-  // surface (eval).
-  std::vector<float> wiX, wiY, wiZ, valueR, valueG, valueB, pdf;
-  std::vector<unsigned char> ok;
+struct RoughPlasticLanes : BsdfLanes {
   // Between the steps: wo's (and wi's) z seen from the front, the coat's reflectance at wo, the
   // disk points (polar, then Cartesian), the lobe (1: the coat), each direction's place among
   // the coat's nodes.
@@ -38,32 +22,12 @@ struct RoughPlasticLanes {
            !bsdfHasTexture(b) && !bsdfIsBlend(b) && b.coatNodes > 0;
   }
   void resize(size_t n);
-
-  // Lanes [0, n), all of material b (takes(b)): what bsdfSample(b, wo, 0, u, s, true) gives for
-  // each, to the bit: false where it gives no sample, else the sample in *s.
-  void setSample(int j, Vec3f wo, Vec2f u) { woX[j] = wo.x, woY[j] = wo.y, woZ[j] = wo.z, u0[j] = u.x, u1[j] = u.y; }
+  // Lanes [0, n) (setSample), all of material b (takes(b)): bsdfSample(b, wo, 0, u, s, true)'s
+  // answers, to the bit (sampleOf).
   void sample(const Bsdf& b, int n);
-  bool sampleOf(int j, BsdfSample* s) const {
-    s->wi = Vec3f(wiX[j], wiY[j], wiZ[j]);
-    s->weight = Color(valueR[j], valueG[j], valueB[j]);
-    s->pdf = pdf[j];
-    s->delta = false;
-    return ok[j] != 0;
-  }
-
-  // Lanes [0, n), all of material b (takes(b)): what bsdfEvalPdf(b, wo, wi, &pdf) gives for
-  // each, to the bit.
-  void setEval(int j, Vec3f wo, Vec3f wi) {
-    woX[j] = wo.x, woY[j] = wo.y, woZ[j] = wo.z, wiX[j] = wi.x, wiY[j] = wi.y, wiZ[j] = wi.z;
-  }
+  // Lanes [0, n) (setEval), all of material b (takes(b)): bsdfEvalPdf(b, wo, wi, &pdf)'s
+  // answers, to the bit (evalOf).
   void eval(const Bsdf& b, int n);
-  BsdfEvaluation evalOf(int j) const {
-    BsdfEvaluation e;
-    e.wi = Vec3f(wiX[j], wiY[j], wiZ[j]);
-    e.f = ok[j] ? Color(valueR[j], valueG[j], valueB[j]) : Color(0.f);
-    e.pdf = ok[j] ? pdf[j] : 0.f;
-    return e;
-  }
 };
 
 }  // namespace envgi

@@ -1,6 +1,6 @@
-// The BSDF work of a round's hits on rough plastics (RoughPlasticLanes::takes), done in vector
-// lanes a material at a time: the BSDF samples, and the values at the product draws' directions,
-// which PreparedParts then hands to pathShade.
+// The BSDF work of a round's hits on the materials with lanes (RoughPlasticLanes,
+// RoughConductorLanes), done in vector lanes a material at a time: the BSDF samples, and the
+// values at the product draws' directions, which PreparedParts then hands to pathShade.
 #pragma once
 
 #include "wavefront/TileQueues.h"
@@ -33,18 +33,17 @@ inline void byMaterial(TileQueues* q, int count, Put put, Run run, Take take) {
 // What pathShade's woLocal is for hit k (its interaction prepared).
 inline Vec3f preparedWo(const TileQueues* q, int k) { return q->prepared[k].si.shading.toLocal(-q->state[k].ray.d); }
 
-// The BSDF samples of hits [0, hits) of q->hits into each hit's prepared sample, from the pairs
-// drawn for the round (prepared.ub); a path that ends before its BSDF sample is left out.
-inline void sampleBsdfsInLanes(const SceneView& sc, const PathParams& pp, TileQueues* q, int hits) {
-  if (!pp.bsdfSample) return;
+// The BSDF samples of hits [0, hits) of q->hits on materials of one kind (Lanes::takes), into
+// each hit's prepared sample, from the pairs drawn for the round (prepared.ub); a path that ends
+// before its BSDF sample is left out.
+template <class Lanes>
+void sampleKindInLanes(const SceneView& sc, const PathParams& pp, TileQueues* q, int hits, Lanes& lanes) {
   int count = 0;
   for (int j = 0; j < hits; ++j) {
     const int k = q->hits[j];
-    if (!(pp.maxDepth >= 0 && q->state[k].depth >= pp.maxDepth) &&
-        RoughPlasticLanes::takes(sc.bsdfs[q->prepared[k].si.bsdf]))
+    if (!(pp.maxDepth >= 0 && q->state[k].depth >= pp.maxDepth) && Lanes::takes(sc.bsdfs[q->prepared[k].si.bsdf]))
       q->sampling[count++] = k;
   }
-  RoughPlasticLanes& lanes = q->roughPlastic;
   byMaterial(
       q, count, [&](int n, int k) { lanes.setSample(n, preparedWo(q, k), q->prepared[k].ub); },
       [&](int material, int n) { lanes.sample(sc.bsdfs[material], n); },
@@ -59,15 +58,15 @@ inline void sampleBsdfsInLanes(const SceneView& sc, const PathParams& pp, TileQu
 // product draw placed in lanes (prepared.product, with its direction): prepareLd's wiLocal.
 // Hits [0, draws) of q->productDraws; a hit with a blend's partner is left out (the two are
 // evaluated together).
-inline void evalBsdfsInLanes(const SceneView& sc, TileQueues* q, int draws) {
+template <class Lanes>
+void evalKindInLanes(const SceneView& sc, TileQueues* q, int draws, Lanes& lanes) {
   int count = 0;
   for (int i = 0; i < draws; ++i) {
     const int k = q->productDraws[i];
     const PreparedHit& p = q->prepared[k];
-    if (p.product.drawn && p.product.placed && p.si.partner < 0 && RoughPlasticLanes::takes(sc.bsdfs[p.si.bsdf]))
+    if (p.product.drawn && p.product.placed && p.si.partner < 0 && Lanes::takes(sc.bsdfs[p.si.bsdf]))
       q->sampling[count++] = k;
   }
-  RoughPlasticLanes& lanes = q->roughPlastic;
   byMaterial(
       q, count,
       [&](int n, int k) {
@@ -79,6 +78,18 @@ inline void evalBsdfsInLanes(const SceneView& sc, TileQueues* q, int draws) {
         q->prepared[k].value = lanes.evalOf(j);
         q->prepared[k].valued = true;
       });
+}
+
+// Each material kind with lanes of its own, its hits queued apart: rough plastics, then rough
+// conductors. Other materials are sampled and evaluated one path at a time, where pathShade asks.
+inline void sampleBsdfsInLanes(const SceneView& sc, const PathParams& pp, TileQueues* q, int hits) {
+  if (!pp.bsdfSample) return;
+  sampleKindInLanes(sc, pp, q, hits, q->roughPlastic);
+  sampleKindInLanes(sc, pp, q, hits, q->roughConductor);
+}
+inline void evalBsdfsInLanes(const SceneView& sc, TileQueues* q, int draws) {
+  evalKindInLanes(sc, q, draws, q->roughPlastic);
+  evalKindInLanes(sc, q, draws, q->roughConductor);
 }
 
 }  // namespace envgi

@@ -5,7 +5,7 @@
 #pragma once
 
 #include "integrators/PathIntegrator.h"
-#include "materials/RoughPlasticLanes.h"
+#include "materials/BsdfLanes.h"
 
 namespace envgi {
 

@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "envmap/MapLanes.h"
+#include "materials/RoughConductorLanes.h"
+#include "materials/RoughPlasticLanes.h"
 #include "wavefront/PreparedHit.h"
 #include "wavefront/SampleLanes.h"
 
@@ -33,10 +35,11 @@ struct TileQueues {
   std::vector<int> live, escaped, hits, productDraws, shadowRays;
   std::vector<int> sampling, picking;
   // The round's work done lane by lane: its samples, its rays' and draws' meetings with the
-  // map, and its rough plastics.
+  // map, and its materials' BSDFs, by kind.
   SampleLanes lanes;
   MapLanes map;
   RoughPlasticLanes roughPlastic;
+  RoughConductorLanes roughConductor;
 
   void resize(size_t n) {
     if (state.size() >= n) return;
@@ -44,7 +47,7 @@ struct TileQueues {
     ld.resize(n), ldBeta.resize(n), weight.resize(n), acc.resize(n), accSq.resize(n), accW.resize(n);
     prepared.resize(n), descent.resize(n);
     for (std::vector<int>* q : {&live, &escaped, &hits, &productDraws, &shadowRays, &sampling, &picking}) q->resize(n);
-    lanes.resize(n), map.resize(n), roughPlastic.resize(n);
+    lanes.resize(n), map.resize(n), roughPlastic.resize(n), roughConductor.resize(n);
   }
 };
 
