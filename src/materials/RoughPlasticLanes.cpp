@@ -129,7 +129,7 @@ ENVGI_LANES void roughPlasticEvals(int n, const Bsdf& bsdf, const CoatNode& node
     const Color f = detail::roughPlasticTabledEvalPdf(
         b, d, coat, detail::roughCoatReflectanceAt(coat, CoatPlace{ato[i], shareo[i]}),
         coatTransmittanceAt(coat, CoatPlace{ati[i], sharei[i]}), wo, wi, &p);
-    // Written whatever the sides; the zeros below the surface are chosen when read (bsdfEvalOf):
+    // Written whatever the sides; the zeros below the surface are chosen when read (evalOf):
     // chosen here, GCC made the table's gathers conditional, which it does not vectorise.
     above[i] = (wo.z > 0.f) & (wi.z > 0.f);
     fr[i] = f.x, fg[i] = f.y, fb[i] = f.z, pdf[i] = p;

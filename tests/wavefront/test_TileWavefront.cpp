@@ -70,7 +70,7 @@ TEST(TileWavefront, AddsTheSameSamplesAsRenderPixel) {
 }
 
 // With the map hidden from the camera (hide_emitters), the camera rays that escape add nothing,
-// whether they end in the camera round's lanes (cameraEscape) or in renderPixel's pathShade;
+// whether they end in the camera round's lanes (pathAddEscape) or in renderPixel's pathShade;
 // what the rays that hit see of the map is there, and the same to the bit.
 TEST(TileWavefront, HiddenEmittersEscapeTheSameWayByBounce) {
   SmallScene small("buddha", IntegratorType::Path);
