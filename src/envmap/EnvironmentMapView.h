@@ -263,8 +263,10 @@ struct EnvironmentMapView {
   ENVGI_HD Vec3f toLocalUnnormalized(Vec3f worldDir) const { return toWorld.inverseVector(worldDir); }
   ENVGI_HD Vec3f fromLocal(Vec3f localDir) const { return normalize(toWorld.vector(localDir)); }
 
+  // Where world direction d meets the map.
+  ENVGI_HD Vec2f uvOf(Vec3f d) const { return dirToUV(toLocalUnnormalized(d)); }
   // Radiance arriving from world direction d.
-  ENVGI_HD Color eval(Vec3f d) const { return lookupUV(dirToUV(toLocalUnnormalized(d))); }
+  ENVGI_HD Color eval(Vec3f d) const { return lookupUV(uvOf(d)); }
 
   // Density in solid angle of the importance density at (u, v): p(u,v) / (2 pi^2 sin theta).
   // A pixel from an alias table over the map and a position inside it from the bits the choice
@@ -359,7 +361,7 @@ struct EnvironmentMapView {
         Vec3f w = f.toWorld(sampleCosineHemisphere(u));
         out.dir = normalize(w);
         out.pdf = cosineHemispherePdf(dot(out.dir, normal));
-        out.uv = dirToUV(toLocalUnnormalized(out.dir));
+        out.uv = uvOf(out.dir);
         out.radiance = out.pdf > 0.f ? lookupUV(out.uv) : Color(0.f);
         return out;
       }
@@ -408,7 +410,7 @@ struct EnvironmentMapView {
         out.dir = points[i].dir;
         out.pdf = points[i].pmf;
         out.radiance = points[i].irradiance;
-        out.uv = dirToUV(toLocalUnnormalized(out.dir));
+        out.uv = uvOf(out.dir);
         out.delta = true;
         return out;
       }
@@ -440,14 +442,14 @@ struct EnvironmentMapView {
   ENVGI_HD float pdf(EnvStrategy s, Vec3f worldDir, Vec3f normal = Vec3f(0.f, 1.f, 0.f)) const {
     EnvStrategy t = strategyFor(s, normal);
     bool mapped = t != EnvStrategy::Uniform && t != EnvStrategy::Cosine && !isCollapsedMap(t);
-    return pdfAt(t, worldDir, mapped ? dirToUV(toLocalUnnormalized(worldDir)) : Vec2f(0.f, 0.f), normal);
+    return pdfAt(t, worldDir, mapped ? uvOf(worldDir) : Vec2f(0.f, 0.f), normal);
   }
 
   // Radiance from world direction d and, through *pdfOut, the density strategy s gives it about
   // `normal`: one mapping to (u, v) serves both, which is what a BSDF-sampled ray that escapes
   // needs (two atan2 calls and a rotation fewer than eval() and pdf() apart).
   ENVGI_HD Color evalWithPdf(EnvStrategy s, Vec3f worldDir, Vec3f normal, float* pdfOut) const {
-    return evalWithPdfAt(s, worldDir, dirToUV(toLocalUnnormalized(worldDir)), normal, pdfOut);
+    return evalWithPdfAt(s, worldDir, uvOf(worldDir), normal, pdfOut);
   }
   // evalWithPdf where worldDir's (u, v) is known.
   ENVGI_HD Color evalWithPdfAt(EnvStrategy s, Vec3f worldDir, Vec2f uv, Vec3f normal, float* pdfOut) const {

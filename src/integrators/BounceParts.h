@@ -20,7 +20,7 @@ struct SampledParts {
   ENVGI_HD SurfaceInteraction interaction(const Ray& ray, const Hit& h) const { return sc.interaction(ray, h); }
   // Where a ray that escaped meets the map (what eval and evalWithPdf find), and the map's
   // radiance there.
-  ENVGI_HD Vec2f mapUV(const Ray& ray) const { return EnvironmentMapView::dirToUV(sc.env.toLocalUnnormalized(ray.d)); }
+  ENVGI_HD Vec2f mapUV(const Ray& ray) const { return sc.env.uvOf(ray.d); }
   ENVGI_HD Color mapRadiance(Vec2f uv) const { return sc.env.lookupUV(uv); }
   // The pair `which` at the sampler's position.
   ENVGI_HD Vec2f pair(Sampler& smp, BouncePair) const { return smp.get2D(); }

@@ -88,13 +88,9 @@ inline ENVGI_HD_NOINLINE bool sampleDeltaOrAreaLight(const SceneView& sc, const 
   return ls->pdf > 0.f;
 }
 
-// u.x picks the kind of light by the kinds' shares and is then stretched back over [0, 1) for
-// that light's own draw (sample reuse, as Mitsuba's emitter selection does): the draws that land
-// on one kind keep the sequence's strata, where a draw of their own handed each kind a random
-// subset of the points. With the map the only light, u is the map's draw as it is.
-// Whether u picks the map, with *u then stretched to the map's own draw. The whole collapsed
-// map is added at every point (collapsedMapLighting): a light sample that picks it carries
-// nothing, and the other lights' shares stay unbiased.
+// Whether u picks the map, with *u then stretched to the map's own draw (sampleLight's choice).
+// The whole collapsed map is added at every point (collapsedMapLighting): a light sample that
+// picks it carries nothing, and the other lights' shares stay unbiased.
 ENVGI_INLINE bool lightDrawPicksMap(const SceneView& sc, EnvStrategy strategy, Vec2f* u) {
   const float pe = sc.envSelectProb();
   if (!(u->x < pe) || strategy == EnvStrategy::PointsAll) return false;
@@ -114,6 +110,10 @@ ENVGI_INLINE bool mapLightSample(const SceneView& sc, const EnvSample& es, Light
   return true;
 }
 
+// u.x picks the kind of light by the kinds' shares and is then stretched back over [0, 1) for
+// that light's own draw (sample reuse, as Mitsuba's emitter selection does): the draws that land
+// on one kind keep the sequence's strata, where a draw of their own handed each kind a random
+// subset of the points. With the map the only light, u is the map's draw as it is.
 ENVGI_INLINE bool sampleLight(const SceneView& sc, const SurfaceInteraction& si, Vec3f axis, EnvStrategy strategy,
                               Vec2f u, Vec2f u2, LightSample* ls) {
   const float pe = sc.envSelectProb();

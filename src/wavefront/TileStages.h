@@ -201,8 +201,9 @@ inline bool prepareHit(const SceneView& sc, const PathState& st, const Hit& h, c
 }
 
 // The hits queued in q->hits, each prepared (prepareHit; in lanes with Sobol's draws, its light's
-// and BSDF's pairs at bounceLayout's offsets), and the rough plastics' BSDF samples in lanes. The hits whose light sample is a product draw go to q->productDraws: returns their
-// count.
+// and BSDF's pairs at bounceLayout's offsets), and their BSDF samples in their material kind's
+// lanes (MaterialLanes.h). The hits whose light sample is a product draw go to q->productDraws:
+// returns their count.
 template <class I>
 int prepareHits(const TileRound<I>& r, int live) {
   TileQueues* q = r.q;
@@ -232,7 +233,8 @@ int prepareHits(const TileRound<I>& r, int live) {
 
 // The product draws' dependent loads a level at a time across the round (ProductDescent), then
 // the texels of the pixels they land in, then each draw's end. In lanes, each draw is then placed
-// inside its pixel, the map looked up there, and the rough plastics evaluated in its direction.
+// inside its pixel, the map looked up there, and the materials with lanes evaluated in its
+// direction.
 template <class I>
 void walkProductDraws(const TileRound<I>& r, int draws) {
   TileQueues* q = r.q;
