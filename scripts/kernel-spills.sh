@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
-# Registers, stack frame and spills of the path kernel (regenKernel over SampleIntegrator<BvhTracer>)
-# as ptxas reports them, for sm_90, without a GPU: the kernel alone is compiled (about 2 minutes)
-# for each resident-threads count given (ENVGI_CUDA_THREADS_PER_SM; default 1536, the build's;
-# docs/gpu.md). The figures are bytes of spill code (static), not traffic.
+# Registers, stack frame and spills as ptxas reports them, for sm_90, without a GPU: of the path
+# kernel (regenKernel over SampleIntegrator<BvhTracer>), compiled alone (about 2 minutes) for each
+# resident-threads count given (ENVGI_CUDA_THREADS_PER_SM; default 1536, the build's); then of
+# each wave stage's kernel at its own launch bounds (wavefront/CudaStageLaunch.cuh), as a table
+# (docs/gpu.md). The figures are bytes of spill code (static), not traffic.
 #
 #   bash scripts/kernel-spills.sh [SOURCE_TREE] [THREADS_PER_SM ...]
+# STAGES=0 leaves the stage kernels out; STAGES=only leaves the path kernel out.
 set -euo pipefail
 root=$(cd "${1:-$(dirname "$0")/..}" && pwd)
 shift || true
@@ -30,6 +32,8 @@ template __global__ void regenKernel<SampleIntegrator<BvhTracer>>(SampleIntegrat
                                                                   int, int, FilmView, unsigned long long*);
 }  // namespace envgi::gpu
 CU
+stages=${STAGES:-1}
+[[ $stages == only ]] && counts=()
 for n in "${counts[@]}"; do
   "$nvcc" -DENVGI_HAS_CUDA=1 -I"$root/src" -O3 -DNDEBUG --generate-code=arch=compute_90,code=sm_90 \
     --expt-relaxed-constexpr -std=c++17 -DENVGI_CUDA_THREADS_PER_SM=$n -Xptxas -v -x cu -c "$work/probe.cu" \
@@ -46,3 +50,49 @@ for n in "${counts[@]}"; do
     /stack frame/ { printf "  %-26s stack frame %5d B, spill stores %5d B, spill loads %5d B\n", n, $1, $5, $9 }
     /Used [0-9]+ registers/ && n == "kernel" { printf "  %-26s %d registers\n", "kernel", $5 }'
 done
+
+[[ $stages == 0 ]] && exit 0
+# The stage kernels, each instantiated alone: one a stage, and a shade stage a material kind.
+{
+  echo '#include "accel/BvhView.h"'
+  echo '#include "wavefront/CudaStageLaunch.cuh"'
+  echo 'namespace envgi {'
+  echo 'using I = SampleIntegrator<BvhTracer>;'
+  for st in 'CameraStage<I>' 'ClosestHitStage<I>' 'EscapeStage<I>' 'ShadowStage<I>' 'FilmStage'; do
+    echo "template __global__ void stageKernel<$st>($st, int, const int*);"
+  done
+  for k in 0 1 2 3 4 5 6 7 8 9; do
+    echo "template __global__ void stageKernel<ShadeStage<I, $k>>(ShadeStage<I, $k>, int, const int*);"
+  done
+  echo '}  // namespace envgi'
+} >"$work/stages.cu"
+"$nvcc" -DENVGI_HAS_CUDA=1 -I"$root/src" -O3 -DNDEBUG --generate-code=arch=compute_90,code=sm_90 \
+  --expt-relaxed-constexpr -std=c++17 -Xptxas -v -x cu -c "$work/stages.cu" -o "$work/stages.o" \
+  >"$work/stages.txt" 2>&1 || { cat "$work/stages.txt" >&2; exit 1; }
+# A row a kernel, then a row a function ptxas kept out of the kernels, named with the material
+# kind it was made for where it has one.
+echo "stage kernels (launch bounds 128 threads x 8 blocks an SM: at most 64 registers):"
+echo "| kernel | registers | stack frame (B) | spill stores / loads (B) |"
+echo "| --- | --- | --- | --- |"
+c++filt <"$work/stages.txt" | awk '
+  BEGIN { split("diffuse conductor roughconductor dielectric thindielectric roughdielectric plastic roughplastic principled blend", kind, " ") }
+  function kindOf(s) {
+    if (match(s, /ShadeStage<envgi::SampleIntegrator<envgi::BvhTracer>, [0-9]/)) return kind[substr(s, RSTART + RLENGTH - 1, 1) + 1]
+    if (match(s, /BsdfType\)[0-9]/)) return kind[substr(s, RSTART + RLENGTH - 1, 1) + 1]
+    return ""
+  }
+  /Function properties for/ {
+    n = $0; sub(/.*Function properties for /, "", n)
+    isKernel = n ~ /stageKernel/
+    k = kindOf(n)
+    if (isKernel) {
+      if (n ~ /ShadeStage/) n = "shade " k
+      else { sub(/Stage.*/, "", n); sub(/.*stageKernel<envgi::/, "", n); n = tolower(n) }
+    } else {
+      sub(/\(.*/, "", n); while (n ~ /<[^<>]*>/) gsub(/<[^<>]*>/, "", n); sub(/.* /, "", n); sub(/.*::/, "", n)
+      if (k != "") n = n " (" k ")"
+    }
+  }
+  /stack frame/ { stack = $1; stores = $5; loads = $9; if (!isKernel) other[++m] = sprintf("| %s, out of line | | %d | %d / %d |", n, stack, stores, loads) }
+  /Used [0-9]+ registers/ && isKernel { printf "| %s | %d | %d | %d / %d |\n", n, $5, stack, stores, loads }
+  END { for (i = 1; i <= m; ++i) print other[i] }'

@@ -45,4 +45,13 @@ ENVGI_INLINE void atomicAddRelaxed(uint32_t* p, uint32_t v) {
 #endif
 }
 
+// Adds v to *p and returns what *p held before: a place claimed in a queue by many threads.
+ENVGI_INLINE int atomicFetchAddRelaxed(int* p, int v) {
+#if defined(__CUDA_ARCH__)
+  return atomicAdd(p, v);
+#else
+  return __atomic_fetch_add(p, v, __ATOMIC_RELAXED);
+#endif
+}
+
 }  // namespace envgi

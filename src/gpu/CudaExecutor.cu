@@ -83,7 +83,8 @@ std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene& scene, const Bvh& bv
   integ.scene = ds->deviceView;
   integ.tracer = BvhTracer{ds->bvh};
   auto ex = std::make_unique<CudaPassExecutor<SampleIntegrator<BvhTracer>>>(std::move(ds), integ, scene.view().camera,
-                                                                            k.sequence, gpu, keepVariance);
+                                                                            k.sequence, gpu, keepVariance,
+                                                                            ShadeKindSet::of(scene.bsdfs));
   if (deviceBytes) *deviceBytes = ex->deviceBytes();
   return ex;
 }

@@ -1,5 +1,6 @@
 // The render loop's passes on a CUDA GPU for any per-sample integrator: path and direct by
-// path regeneration (regeneratePaths), others (the grid integrator's camera samples) one thread
+// path regeneration (regeneratePaths), or, with ENVGI_GPU_STAGES=1, a kernel a stage
+// (wavefront/WavePass.h) where the integrator shades after the trace; others (the grid integrator's camera samples) one thread
 // a pixel running renderPixel, the CPU executor's body, over its samples of the pass. The
 // device scene and whatever else the integrator reads live in the DeviceScene's arena, which
 // this executor owns. CUDA-only.
@@ -15,6 +16,8 @@
 
 #include "gpu/CudaExecutor.h"
 #include "gpu/DeviceScene.h"
+#include "wavefront/CudaStageLaunch.cuh"
+#include "wavefront/WavePass.h"
 
 namespace envgi::gpu {
 
@@ -64,9 +67,10 @@ int regenBlocksPerSM() {
 template <class Integrator>
 class CudaPassExecutor final : public PassExecutor {
  public:
+  // kinds: the shade kinds of the scene's materials, for the stages.
   CudaPassExecutor(std::unique_ptr<DeviceScene> scene, Integrator integ, const Camera& cam, SampleSequence seq,
-                   int gpu, bool keepVariance)
-      : gpu_(gpu), scene_(std::move(scene)), cam_(cam), seq_(seq), integ_(integ) {
+                   int gpu, bool keepVariance, ShadeKindSet kinds = {})
+      : gpu_(gpu), scene_(std::move(scene)), cam_(cam), seq_(seq), integ_(integ), kinds_(kinds) {
     DeviceArena& a = scene_->arena;
     size_t px = size_t(cam_.width) * cam_.height;
     film_.width = cam_.width;
@@ -84,6 +88,15 @@ class CudaPassExecutor final : public PassExecutor {
     counters_ = a.allocate<unsigned long long>(3, "counters");
     check(cudaMemset(counters_, 0, 3 * sizeof(unsigned long long)), "clearing counters");
     if constexpr (RunsByBounce<Integrator>::value) {
+      const char* st = std::getenv("ENVGI_GPU_STAGES");
+      if (st && std::strcmp(st, "1") == 0 && integ_.shadesAfterTrace()) {
+        // As many paths as pixels, up to 2^20 (pbrt-v4's wavefront holds 2^20 too).
+        const int capacity = int(std::min<size_t>(px, size_t(1) << 20));
+        const size_t bytes = layOutWave(0, capacity, px, &waveQueues_, &waveSums_);
+        layOutWave(reinterpret_cast<uintptr_t>(a.allocate(bytes, "the wave's queues")), capacity, px, &waveQueues_,
+                   &waveSums_);
+        return;
+      }
       // Path regeneration unless ENVGI_GPU_REGEN=0 asks for one thread a pixel: on an H200 it
       // drew 1.65x the samples a second on the Buddha and 1.45x on the dragon (docs/gpu.md).
       const char* e = std::getenv("ENVGI_GPU_REGEN");
@@ -99,10 +112,23 @@ class CudaPassExecutor final : public PassExecutor {
   double maxPassPixelSamples() const override { return double(1 << 28); }
 
   std::string deviceName() const override {
-    return "cuda:" + std::to_string(gpu_) + " (" + gpu::deviceName(gpu_) + (regenBlocks_ > 0 ? ", regeneration)" : ")");
+    return "cuda:" + std::to_string(gpu_) + " (" + gpu::deviceName(gpu_) +
+           (regenBlocks_ > 0 ? ", regeneration)" : waveQueues_.capacity > 0 ? ", stages)" : ")");
   }
 
   void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
+    if constexpr (RunsByBounce<Integrator>::value) {
+      if (waveQueues_.capacity > 0) {
+        PixelCounters pc;
+        CudaStageLaunch launch;
+        runWavePass(launch, WaveContext<Integrator>{integ_, cam_, seq_, film_, waveQueues_, waveSums_}, kinds_, s0, s1,
+                    &pc);
+        counters->rays += pc.rays;
+        counters->dropped += pc.dropped;
+        progress.add(activePixels() * size_t(s1 - s0));
+        return;
+      }
+    }
     if (regenBlocks_ > 0) {
       if constexpr (RunsByBounce<Integrator>::value) {
         size_t items = size_t(cam_.width) * cam_.height * size_t(s1 - s0);
@@ -184,6 +210,9 @@ class CudaPassExecutor final : public PassExecutor {
   size_t activeCount_ = 0;                  // its non-zero entries
   unsigned long long* counters_ = nullptr;  // rays, dropped samples, regeneration's next item
   int regenBlocks_ = 0;  // > 0: passes by path regeneration, this many blocks
+  ShadeKindSet kinds_;
+  WaveQueues waveQueues_;  // capacity > 0: passes by the stages
+  WaveSums waveSums_;
 };
 
 }  // namespace envgi::gpu

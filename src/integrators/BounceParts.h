@@ -8,6 +8,7 @@
 
 #include "lights/LightSampling.h"
 #include "materials/BsdfMix.h"
+#include "materials/ShadeKind.h"
 #include "sampling/Sampler.h"
 
 namespace envgi {
@@ -37,6 +38,19 @@ struct SampledParts {
   // Out of line on the GPU, as prepareLd.
   ENVGI_HD_NOINLINE bool bsdfSample(const Bsdf& bsdf, Vec3f wo, float uc, Vec2f u, BsdfSample* bs) const {
     return envgi::bsdfSample(bsdf, wo, uc, u, bs, true);
+  }
+};
+
+// SampledParts for a hit whose material is of type T and no blend (so it has no partner): the
+// BSDF's value and sample then hold type T's code alone, the same to the bit.
+template <BsdfType T>
+struct TypedParts : SampledParts {
+  ENVGI_HD Color bsdfValue(const Bsdf& bsdf, const Bsdf*, const SurfaceInteraction&, Vec3f wo, Vec3f wi,
+                           float* pdf) const {
+    return bsdfEvalPdfAs(bsdf, T, wo, wi, pdf);
+  }
+  ENVGI_HD_NOINLINE bool bsdfSample(const Bsdf& bsdf, Vec3f wo, float uc, Vec2f u, BsdfSample* bs) const {
+    return bsdfSampleAs(bsdf, T, wo, uc, u, bs, true);
   }
 };
 

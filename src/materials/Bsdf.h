@@ -296,10 +296,12 @@ ENVGI_INLINE Vec3f roughPlasticDirection(const MicrofacetDistribution& d, Vec3f 
 }
 }  // namespace detail
 
+// The dispatch over the types reads `type`, which is b.type: a caller that knows b's type gives
+// it as a constant, and the compiler keeps that type's code alone (materials/ShadeKind.h).
 namespace detail {
-ENVGI_INLINE Color evalInFrame(const Bsdf& b, Vec3f wo, Vec3f wi) {
+ENVGI_INLINE Color evalInFrame(const Bsdf& b, BsdfType type, Vec3f wo, Vec3f wi) {
   detail::toFrontSide(b, &wo, &wi);
-  switch (b.type) {
+  switch (type) {
     case BsdfType::Diffuse:
       if (wo.z <= 0.f || wi.z <= 0.f) return Color(0.f);
       return b.reflectance * (kInvPi * wi.z);
@@ -337,9 +339,9 @@ ENVGI_INLINE Color evalInFrame(const Bsdf& b, Vec3f wo, Vec3f wi) {
   return Color(0.f);
 }
 
-ENVGI_INLINE float pdfInFrame(const Bsdf& b, Vec3f wo, Vec3f wi) {
+ENVGI_INLINE float pdfInFrame(const Bsdf& b, BsdfType type, Vec3f wo, Vec3f wi) {
   detail::toFrontSide(b, &wo, &wi);
-  switch (b.type) {
+  switch (type) {
     case BsdfType::Diffuse:
       if (wo.z <= 0.f || wi.z <= 0.f) return 0.f;
       return cosineHemispherePdf(wi.z);
@@ -388,10 +390,10 @@ ENVGI_INLINE Color roughConductorEvalPdf(const Bsdf& b, const MicrofacetDistribu
   return b.specularReflectance * F * (d.D(m) * d.G(wo, wi) / (4.f * wo.z));
 }
 
-ENVGI_INLINE Color evalPdfInFrame(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
-  if (b.type != BsdfType::RoughPlastic) {
-    *pdf = pdfInFrame(b, wo, wi);
-    return evalInFrame(b, wo, wi);
+ENVGI_INLINE Color evalPdfInFrame(const Bsdf& b, BsdfType type, Vec3f wo, Vec3f wi, float* pdf) {
+  if (type != BsdfType::RoughPlastic) {
+    *pdf = pdfInFrame(b, type, wo, wi);
+    return evalInFrame(b, type, wo, wi);
   }
   detail::toFrontSide(b, &wo, &wi);
   if (wo.z <= 0.f || wi.z <= 0.f) {
@@ -404,8 +406,8 @@ ENVGI_INLINE Color evalPdfInFrame(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf)
 }
 
 // Non-delta lobes: the pdf of the sampled direction over all lobes, and weight = eval / pdf.
-ENVGI_INLINE bool finishSample(const Bsdf& b, Vec3f wo, BsdfSample* s) {
-  Color f = evalPdfInFrame(b, wo, s->wi, &s->pdf);
+ENVGI_INLINE bool finishSample(const Bsdf& b, BsdfType type, Vec3f wo, BsdfSample* s) {
+  Color f = evalPdfInFrame(b, type, wo, s->wi, &s->pdf);
   if (!(s->pdf > 0.f)) return false;
   s->weight = f / s->pdf;
   return true;
@@ -436,12 +438,13 @@ ENVGI_INLINE bool bsdfReadsUcBesideU(const Bsdf& b) {
 }
 
 namespace detail {
-ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s, bool lobeFromU) {
+ENVGI_INLINE bool sampleInFrame(const Bsdf& b, BsdfType type, Vec3f wo, float uc, Vec2f u, BsdfSample* s,
+                                bool lobeFromU) {
   bool flip = b.twoSided && wo.z < 0.f;
   if (flip) wo.z = -wo.z;
   bool ok = false;
   s->delta = false;
-  switch (b.type) {
+  switch (type) {
     case BsdfType::Diffuse: {
       if (wo.z <= 0.f) return false;
       s->wi = sampleCosineHemisphere(u);
@@ -464,7 +467,7 @@ ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, Bsdf
       Vec3f m = microfacet(b).sampleVisible(wo, u);
       s->wi = reflect(wo, m);
       if (s->wi.z <= 0.f) return false;
-      ok = detail::finishSample(b, wo, s);
+      ok = detail::finishSample(b, type, wo, s);
       break;
     }
     case BsdfType::Dielectric: {
@@ -520,20 +523,20 @@ ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, Bsdf
         }
         if (!refractDir(wo, n, e, &s->wi) || s->wi.z * wo.z >= 0.f) return false;
       }
-      ok = detail::finishSample(b, wo, s);
+      ok = detail::finishSample(b, type, wo, s);
       break;
     }
     case BsdfType::Plastic:
     case BsdfType::RoughPlastic: {
       if (wo.z <= 0.f) return false;
-      float fo = b.type == BsdfType::Plastic ? fresnelDielectric(wo.z, b.ior)
+      float fo = type == BsdfType::Plastic ? fresnelDielectric(wo.z, b.ior)
                                              : detail::roughCoatReflectance(b, detail::roughCoat(b), wo.z);
       float ps = detail::plasticSpecularProb(b, fo);
       if (lobeFromU) {  // bsdfLobeFromU: the coat below ps, the base above
         uc = u.x;
         u.x = plasticLobeDraw(ps, u.x);
       }
-      if (b.type == BsdfType::Plastic && uc < ps) {
+      if (type == BsdfType::Plastic && uc < ps) {
         s->wi = Vec3f(-wo.x, -wo.y, wo.z);
         s->pdf = ps;
         s->delta = true;
@@ -541,18 +544,18 @@ ENVGI_INLINE bool sampleInFrame(const Bsdf& b, Vec3f wo, float uc, Vec2f u, Bsdf
         ok = true;
         break;
       }
-      if (b.type == BsdfType::RoughPlastic && uc < ps) {
+      if (type == BsdfType::RoughPlastic && uc < ps) {
         s->wi = reflect(wo, microfacet(b).sampleVisible(wo, u));
       } else {
         s->wi = sampleCosineHemisphere(u);
       }
       if (s->wi.z <= 0.f) return false;
-      ok = detail::finishSample(b, wo, s);
+      ok = detail::finishSample(b, type, wo, s);
       break;
     }
     case BsdfType::Principled:
       if (!principled::sampleDirection(b.principled, b.ior, wo, uc, u, &s->wi, lobeFromU)) return false;
-      ok = detail::finishSample(b, wo, s);
+      ok = detail::finishSample(b, type, wo, s);
       break;
   }
   if (ok && flip) s->wi.z = -s->wi.z;
@@ -599,46 +602,54 @@ ENVGI_INLINE float bumpShadowingTerm(Vec3f n, Vec3f wi) {
 }  // namespace detail
 
 ENVGI_INLINE Color bsdfEval(const Bsdf& b, Vec3f wo, Vec3f wi) {
-  if (!bsdfIsNormalMapped(b)) return detail::evalInFrame(b, wo, wi);
+  if (!bsdfIsNormalMapped(b)) return detail::evalInFrame(b, b.type, wo, wi);
   Frame f = detail::mappedFrame(b, wo);
   Vec3f mi = f.toLocal(wi);
   if (!(wi.z * mi.z > 0.f)) return Color(0.f);
-  Color v = detail::evalInFrame(b, f.toLocal(wo), mi);
+  Color v = detail::evalInFrame(b, b.type, f.toLocal(wo), mi);
   return b.bumpShadowing ? v * detail::bumpShadowingTerm(f.n, wi) : v;
 }
 
 ENVGI_INLINE float bsdfPdf(const Bsdf& b, Vec3f wo, Vec3f wi) {
-  if (!bsdfIsNormalMapped(b)) return detail::pdfInFrame(b, wo, wi);
+  if (!bsdfIsNormalMapped(b)) return detail::pdfInFrame(b, b.type, wo, wi);
   Frame f = detail::mappedFrame(b, wo);
   Vec3f mi = f.toLocal(wi);
-  return wi.z * mi.z > 0.f ? detail::pdfInFrame(b, f.toLocal(wo), mi) : 0.f;
+  return wi.z * mi.z > 0.f ? detail::pdfInFrame(b, b.type, f.toLocal(wo), mi) : 0.f;
 }
 
-// Both at once, as evalPdfInFrame.
-ENVGI_INLINE Color bsdfEvalPdf(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
-  if (!bsdfIsNormalMapped(b)) return detail::evalPdfInFrame(b, wo, wi, pdf);
+// Both at once, as evalPdfInFrame; of a BSDF whose type is `type` (b.type, which a caller may
+// know as a constant).
+ENVGI_INLINE Color bsdfEvalPdfAs(const Bsdf& b, BsdfType type, Vec3f wo, Vec3f wi, float* pdf) {
+  if (!bsdfIsNormalMapped(b)) return detail::evalPdfInFrame(b, type, wo, wi, pdf);
   Frame f = detail::mappedFrame(b, wo);
   Vec3f mi = f.toLocal(wi);
   if (!(wi.z * mi.z > 0.f)) {
     *pdf = 0.f;
     return Color(0.f);
   }
-  Color v = detail::evalPdfInFrame(b, f.toLocal(wo), mi, pdf);
+  Color v = detail::evalPdfInFrame(b, type, f.toLocal(wo), mi, pdf);
   return b.bumpShadowing ? v * detail::bumpShadowingTerm(f.n, wi) : v;
+}
+ENVGI_INLINE Color bsdfEvalPdf(const Bsdf& b, Vec3f wo, Vec3f wi, float* pdf) {
+  return bsdfEvalPdfAs(b, b.type, wo, wi, pdf);
 }
 
 // uc picks a lobe, u the direction within it; with lobeFromU, u.x picks the lobe where
 // bsdfLobeFromU says it can, and uc goes unread there. Returns false when no direction is
-// produced.
-ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s, bool lobeFromU = false) {
-  if (!bsdfIsNormalMapped(b)) return detail::sampleInFrame(b, wo, uc, u, s, lobeFromU);
+// produced. bsdfSampleAs: of a BSDF whose type is `type`, as bsdfEvalPdfAs.
+ENVGI_INLINE bool bsdfSampleAs(const Bsdf& b, BsdfType type, Vec3f wo, float uc, Vec2f u, BsdfSample* s,
+                               bool lobeFromU = false) {
+  if (!bsdfIsNormalMapped(b)) return detail::sampleInFrame(b, type, wo, uc, u, s, lobeFromU);
   Frame f = detail::mappedFrame(b, wo);
-  if (!detail::sampleInFrame(b, f.toLocal(wo), uc, u, s, lobeFromU)) return false;
+  if (!detail::sampleInFrame(b, type, f.toLocal(wo), uc, u, s, lobeFromU)) return false;
   Vec3f mi = s->wi;
   s->wi = f.toWorld(mi);
   if (!(s->wi.z * mi.z > 0.f)) return false;
   if (b.bumpShadowing) s->weight *= detail::bumpShadowingTerm(f.n, s->wi);
   return true;
+}
+ENVGI_INLINE bool bsdfSample(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s, bool lobeFromU = false) {
+  return bsdfSampleAs(b, b.type, wo, uc, u, s, lobeFromU);
 }
 
 ENVGI_INLINE float bsdfEtaSquared(const Bsdf& b, Vec3f wo, Vec3f wi) {

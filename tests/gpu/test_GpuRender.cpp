@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <unistd.h>
 #include <tuple>
+#include <utility>
 
 #include "accel/Bvh.h"
 #include "accel/EmbreeAccel.h"
@@ -259,35 +260,60 @@ TEST(GpuRender, DirectionalGridMatchesTheCpu) {
   }
 }
 
+// Two GPU executors of the same scene, made under the environment settings `setA` and `setB`
+// (NAME=VALUE, or "" for none), render 32 spp: the same rays, and images whose largest relative
+// difference stays below 1e-3 (a sample lost or doubled of 32 is 3%). Returns the two executors'
+// device names, checked by the caller.
+std::pair<std::string, std::string> expectSameSamples(const std::string& name, IntegratorType type, const char* setA,
+                                                      const char* setB, const char* what) {
+  Scene s;
+  loadBundled(name, type, &s);
+  s.finalize();
+  Bvh bvh(s);
+  RenderOptions o = quietOptions(32);
+  auto make = [&](const char* set) {
+    std::string nv = set;
+    const size_t eq = nv.find('=');
+    if (eq != std::string::npos) setenv(nv.substr(0, eq).c_str(), nv.substr(eq + 1).c_str(), 1);
+    auto ex = gpu::makeCudaExecutor(s, bvh, kernelSettings(s, o), 0, false);
+    if (eq != std::string::npos) unsetenv(nv.substr(0, eq).c_str());
+    return ex;
+  };
+  auto a = make(setA), b = make(setB);
+  RenderStats sa, sb;
+  Image ia = renderPasses(*a, kRes, kRes, 32, o, &sa), ib = renderPasses(*b, kRes, kRes, 32, o, &sb);
+  EXPECT_EQ(sa.rays, sb.rays) << name;
+  EXPECT_EQ(sb.sppDone, 32);
+  double worst = 0.0;
+  for (size_t i = 0; i < ia.rgb.size(); ++i)
+    worst = std::max(worst, double(std::fabs(ia.rgb[i] - ib.rgb[i])) / (1e-3 + std::fabs(ia.rgb[i])));
+  std::printf("%-12s %-6s %s: largest relative difference %.2g, %.1f vs %.1f Mrays/s\n", name.c_str(),
+              type == IntegratorType::Path ? "path" : "direct", what, worst, sb.raysPerSecond() / 1e6,
+              sa.raysPerSecond() / 1e6);
+  EXPECT_LT(worst, 1e-3) << name;
+  return {a->deviceName(), b->deviceName()};
+}
+
 // Path regeneration (the default; ENVGI_GPU_REGEN=0 turns it off) draws the same samples as one
 // thread a pixel, so the same seed gives the same image up to the order in which the atomics
-// add a pixel's samples (largest relative difference measured on an H200: 8.7e-5; a sample
-// lost or doubled of 32 is 3%).
+// add a pixel's samples (largest relative difference measured on an H200: 8.7e-5).
 TEST(GpuRender, RegenerationMatchesOneThreadAPixel) {
   for (std::string name : {"buddha", "teapot-glass", "cornell-box"})
     for (IntegratorType type : {IntegratorType::Path, IntegratorType::Direct}) {
-      Scene s;
-      loadBundled(name, type, &s);
-      s.finalize();
-      Bvh bvh(s);
-      RenderOptions o = quietOptions(32);
-      RenderStats sa, sb;
-      setenv("ENVGI_GPU_REGEN", "0", 1);
-      auto a = gpu::makeCudaExecutor(s, bvh, kernelSettings(s, o), 0, false);
-      unsetenv("ENVGI_GPU_REGEN");
-      auto b = gpu::makeCudaExecutor(s, bvh, kernelSettings(s, o), 0, false);
-      EXPECT_EQ(a->deviceName().find("regeneration"), std::string::npos) << a->deviceName();
-      EXPECT_NE(b->deviceName().find("regeneration"), std::string::npos) << b->deviceName();
-      Image ia = renderPasses(*a, kRes, kRes, 32, o, &sa), ib = renderPasses(*b, kRes, kRes, 32, o, &sb);
-      EXPECT_EQ(sa.rays, sb.rays) << name;
-      EXPECT_EQ(sb.sppDone, 32);
-      double worst = 0.0;
-      for (size_t i = 0; i < ia.rgb.size(); ++i)
-        worst = std::max(worst, double(std::fabs(ia.rgb[i] - ib.rgb[i])) / (1e-3 + std::fabs(ia.rgb[i])));
-      std::printf("%-12s %-6s regeneration against one thread a pixel: largest relative difference %.2g, %.1f vs %.1f "
-                  "Mrays/s\n", name.c_str(), type == IntegratorType::Path ? "path" : "direct", worst,
-                  sb.raysPerSecond() / 1e6, sa.raysPerSecond() / 1e6);
-      EXPECT_LT(worst, 1e-3) << name;
+      auto [a, b] = expectSameSamples(name, type, "ENVGI_GPU_REGEN=0", "", "regeneration against one thread a pixel");
+      EXPECT_EQ(a.find("regeneration"), std::string::npos) << a;
+      EXPECT_NE(b.find("regeneration"), std::string::npos) << b;
+    }
+}
+
+// The stages (ENVGI_GPU_STAGES=1: a kernel a stage, hits shaded by material kind) draw the same
+// samples as path regeneration: the same rays, and the same image up to the order of
+// regeneration's atomic adds.
+TEST(GpuRender, StagesMatchRegeneration) {
+  for (std::string name : {"buddha", "teapot-glass", "cornell-box", "bunny-sunrise"})
+    for (IntegratorType type : {IntegratorType::Path, IntegratorType::Direct}) {
+      auto [a, b] = expectSameSamples(name, type, "", "ENVGI_GPU_STAGES=1", "stages against regeneration");
+      EXPECT_NE(b.find("stages"), std::string::npos) << b;
     }
 }
 

@@ -71,7 +71,9 @@ TEST(BounceLayout, DrawBounceDrawsAtTheLayoutsOffsets) {
             }
             const Vec2f b = drawAt(before, base + at.bsdf);
             EXPECT_TRUE(b.x == u.bsdf.ub.x && b.y == u.bsdf.ub.y) << where;
-            if (m == readsUc) EXPECT_EQ(u.bsdf.uc, draw1DAt(before, base + at.bsdf - BsdfDrawLayout::pair)) << where;
+            if (m == readsUc) {
+              EXPECT_EQ(u.bsdf.uc, draw1DAt(before, base + at.bsdf - BsdfDrawLayout::pair)) << where;
+            }
             if (depth >= pp.rrDepth) {
               EXPECT_EQ(u.rr, draw1DAt(before, base + at.roulette)) << where;
               EXPECT_EQ(smp.dim, base + at.roulette + 1) << where;

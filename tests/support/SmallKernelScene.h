@@ -2,6 +2,9 @@
 // 24 x 24 pixels, 8 spp, with the GPU's BVH over it.
 #pragma once
 
+#include <gtest/gtest.h>
+
+#include <cstring>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,10 +27,12 @@ struct SmallScene {
   Scene scene;
   KernelSettings k;
   std::unique_ptr<Bvh> bvh;
-  SmallScene(const std::string& name, IntegratorType type) {
+  // strategy: a name from kStrategyNames in place of the scene's own, where not empty.
+  SmallScene(const std::string& name, IntegratorType type, const std::string& strategy = "") {
     loadScene(std::string(ENVGI_SOURCE_DIR) + "/scenes/" + name + ".xml", {{"res", "24"}}, scene);
     scene.camera.width = scene.camera.height = 24;
     scene.integrator.type = type;
+    if (!strategy.empty()) scene.integrator.setStrategy(strategy);
     scene.finalize();
     RenderOptions o;
     o.spp = 8;
@@ -39,5 +44,22 @@ struct SmallScene {
   }
 };
 
+// After a pass, film a (renderPixel's) against film b (another body's over the same samples): the
+// same sums to the bit and the same dropped samples; for path the same rays, while direct as a
+// path leaves out the BSDF ray of a sample whose weight is zero (a black emitter's), which
+// directTrace traces for nothing.
+inline void expectSameSums(const Film& a, const Film& b, const PixelCounters& ca, const PixelCounters& cb, bool path,
+                           const std::string& what) {
+  if (path) {
+    EXPECT_EQ(ca.rays, cb.rays) << what;
+  } else {
+    EXPECT_LE(cb.rays, ca.rays) << what;
+    EXPECT_GE(double(cb.rays), 0.99 * double(ca.rays)) << what;
+  }
+  EXPECT_EQ(ca.dropped, cb.dropped) << what;
+  ASSERT_EQ(a.sum.size(), b.sum.size());
+  EXPECT_EQ(std::memcmp(a.sum.data(), b.sum.data(), a.sum.size() * sizeof(Color)), 0) << what;
+  EXPECT_EQ(std::memcmp(a.sumSq.data(), b.sumSq.data(), a.sumSq.size() * sizeof(double)), 0) << what;
+}
 
 }  // namespace envgi::test

@@ -51,17 +51,7 @@ TEST(TileWavefront, AddsTheSameSamplesAsRenderPixel) {
       TileQueues batch;
       for (auto [s0, s1] : {std::pair{0, 3}, std::pair{3, 8}}) {
         renderBothWays(cam, k.sequence, integ, s0, s1, &a, &b, &ca, &cb, &batch);
-        if (type == IntegratorType::Path) {
-          EXPECT_EQ(ca.rays, cb.rays) << name;
-        } else {
-          // direct as a path leaves out the BSDF ray of a sample whose weight is zero (a black
-          // emitter's), which directTrace traces for nothing.
-          EXPECT_LE(cb.rays, ca.rays) << name;
-          EXPECT_GE(double(cb.rays), 0.99 * double(ca.rays)) << name;
-        }
-        EXPECT_EQ(ca.dropped, cb.dropped) << name;
-        EXPECT_EQ(std::memcmp(a.sum.data(), b.sum.data(), npix * sizeof(Color)), 0) << name << " pass " << s0;
-        EXPECT_EQ(std::memcmp(a.sumSq.data(), b.sumSq.data(), npix * sizeof(double)), 0) << name << " pass " << s0;
+        test::expectSameSums(a, b, ca, cb, type == IntegratorType::Path, name + " pass " + std::to_string(s0));
       }
       double mean = 0.0;
       for (const Color& c : a.sum) mean += c.x + c.y + c.z;

@@ -1,0 +1,67 @@
+// A render pass of path or direct through the wave stages (WaveStages.h), for any device: a
+// Launch runs a stage over the indices [0, n) that are below *count (all of them where count is
+// null), and moves a value to or from the queues' memory (write, read). The host decides how
+// many rounds a wave takes from the counts it reads back after each round; every stage of a
+// round is sized by the round's rays, and a queue's own count (on the device) bounds its stage.
+#pragma once
+
+#include <algorithm>
+#include <utility>
+
+#include "wavefront/WaveStages.h"
+
+namespace envgi {
+
+// The shade kinds a scene's materials need a stage for (shadeKindOf of each material).
+struct ShadeKindSet {
+  bool used[kShadeKinds] = {};
+  template <class Bsdfs>
+  static ShadeKindSet of(const Bsdfs& bsdfs) {
+    ShadeKindSet s;
+    for (const Bsdf& b : bsdfs) s.used[shadeKindOf(b)] = true;
+    return s;
+  }
+};
+
+namespace detail {
+template <class I, class Launch, int... K>
+void shadeEachKind(Launch& launch, const WaveContext<I>& c, const ShadeKindSet& kinds, int parity, int live,
+                   std::integer_sequence<int, K...>) {
+  ((kinds.used[K] ? launch(ShadeStage<I, K>{c, parity}, live, &c.q.counts->round.kinds[K]) : void()), ...);
+}
+}  // namespace detail
+
+// Samples [s0, s1) of every pixel that takes samples, added to c.film; the rays traced and the
+// samples dropped are added to *counters.
+template <class I, class Launch>
+void runWavePass(Launch& launch, const WaveContext<I>& c, const ShadeKindSet& kinds, int s0, int s1,
+                 PixelCounters* counters) {
+  const uint64_t npix = uint64_t(c.cam.width) * uint64_t(c.cam.height), total = npix * uint64_t(s1 - s0);
+  launch.zero(c.sums.acc, npix * sizeof(Color));
+  launch.zero(c.sums.accSq, npix * sizeof(double));
+  launch.zero(c.sums.accW, npix * sizeof(float));
+  launch.write(&c.q.counts->dropped, 0u);
+  const uint64_t waveSize = std::min<uint64_t>(uint64_t(c.q.capacity), npix);
+  for (uint64_t base = 0; base < total; base += waveSize) {
+    launch.write(&c.q.counts->round, WaveRound{});
+    launch(CameraStage<I>{c, base, s0}, int(std::min(waveSize, total - base)), nullptr);
+    WaveRound r = launch.read(&c.q.counts->round);
+    for (int parity = 0; r.rays[parity] > 0; parity ^= 1) {
+      const int live = r.rays[parity];
+      counters->rays += uint64_t(live);
+      WaveRound next{};
+      next.rays[parity] = live;
+      launch.write(&c.q.counts->round, next);
+      launch(ClosestHitStage<I>{c, parity}, live, nullptr);
+      launch(EscapeStage<I>{c}, live, &c.q.counts->round.escaped);
+      detail::shadeEachKind(launch, c, kinds, parity, live, std::make_integer_sequence<int, kShadeKinds>{});
+      launch(ShadowStage<I>{c}, live, &c.q.counts->round.shadows);
+      r = launch.read(&c.q.counts->round);
+      counters->rays += uint64_t(r.shadows);
+    }
+  }
+  launch(FilmStage{c.film, c.sums}, int(npix), nullptr);
+  counters->dropped += launch.read(&c.q.counts->dropped);
+}
+
+}  // namespace envgi

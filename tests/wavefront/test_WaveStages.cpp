@@ -1,0 +1,105 @@
+// The wave stages (WaveStages.h, run by WavePass.h) against the per-pixel body (renderPixel):
+// a wave holds at most one sample of a pixel and a pass adds its sums at its end, so over the
+// GPU's BVH the film's sums agree to the bit, on the CPU's launcher, whose chunks run on many
+// threads as a GPU's threads would.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <set>
+#include <string>
+#include <utility>
+
+#include "scene/NameTables.h"
+#include "support/SmallKernelScene.h"
+#include "wavefront/HostStageLaunch.h"
+#include "wavefront/WavePass.h"
+
+using namespace envgi;
+using test::Film;
+using test::SmallScene;
+
+namespace {
+
+WaveContext<SampleIntegrator<BvhTracer>> waveContext(const SmallScene& small, HostWave* wave, FilmView film) {
+  return {small.integrator(), small.scene.view().camera, small.k.sequence, film, wave->queues, wave->sums};
+}
+
+// Passes (0, 3) and (3, 8) of every pixel through renderPixel and through the wave stages with
+// `capacity` paths a wave: the same sums to the bit (expectSameSums).
+void expectRenderPixelsSums(const SmallScene& small, int capacity, const std::string& what) {
+  const SampleIntegrator<BvhTracer> integ = small.integrator();
+  ASSERT_TRUE(integ.shadesAfterTrace()) << what;
+  const Camera& cam = small.scene.view().camera;
+  const size_t npix = size_t(cam.width) * cam.height;
+  Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
+  PixelCounters ca, cb;
+  HostWave wave(capacity, npix);
+  HostStageLaunch launch;
+  const ShadeKindSet kinds = ShadeKindSet::of(small.scene.bsdfs);
+  for (auto [s0, s1] : {std::pair{0, 3}, std::pair{3, 8}}) {
+    for (int y = 0; y < cam.height; ++y)
+      for (int x = 0; x < cam.width; ++x) renderPixel(cam, small.k.sequence, integ, x, y, s0, s1, a.view(cam), &ca);
+    runWavePass(launch, waveContext(small, &wave, b.view(cam)), kinds, s0, s1, &cb);
+    test::expectSameSums(a, b, ca, cb, integ.type == SampleIntegratorType::Path, what + " pass " + std::to_string(s0));
+  }
+  double mean = 0.0;
+  for (const Color& c : a.sum) mean += c.x + c.y + c.z;
+  EXPECT_GT(mean, 0.0) << what << ": an image, not a black film";
+}
+
+}  // namespace
+
+// path and direct (as the one-bounce path it is with a light and a BSDF sample) on the bundled
+// scenes; a wave of the whole film, waves of 100 paths (576 pixels: partial waves, and a pixel's
+// samples in different waves), and room for 1000 paths (a wave still takes 576).
+TEST(WaveStages, AddsTheSameSamplesAsRenderPixel) {
+  for (std::string name : {"teapot-glass", "buddha", "cornell-box", "bunny-sunrise", "sun-and-sky"})
+    for (IntegratorType type : {IntegratorType::Path, IntegratorType::Direct}) {
+      SmallScene small(name, type);
+      for (int capacity : {24 * 24, 100, 1000})
+        expectRenderPixelsSums(small, capacity, name + (type == IntegratorType::Path ? " path" : " direct") +
+                                                    " capacity " + std::to_string(capacity));
+    }
+}
+
+// direct under each of the study's strategies that take at most one light and one BSDF sample;
+// the collapsed map whole at every point (`points`) is no path and is refused by the stages.
+TEST(WaveStages, DirectUnderEveryStrategyAddsRenderPixelsSums) {
+  for (const StrategyName& s : kStrategyNames) {
+    SmallScene small("buddha", IntegratorType::Direct, s.name);
+    if (s.env == EnvStrategy::PointsAll) {
+      EXPECT_FALSE(small.integrator().shadesAfterTrace()) << s.name;
+      continue;
+    }
+    expectRenderPixelsSums(small, 24 * 24, std::string("direct ") + s.name);
+  }
+}
+
+// A round's hits go to the queue of their material's shade kind and to no other, so a shade
+// stage (and a GPU kernel) of one kind is handed only its own type: TypedParts' promise.
+TEST(WaveStages, HitsAreQueuedByTheirMaterialsShadeKind) {
+  SmallScene small("teapot-glass", IntegratorType::Path);
+  const Camera& cam = small.scene.view().camera;
+  const size_t npix = size_t(cam.width) * cam.height;
+  Film film{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)};
+  HostWave wave(int(npix), npix);
+  HostStageLaunch launch;
+  const auto c = waveContext(small, &wave, film.view(cam));
+  const WaveQueues& q = wave.queues;
+  launch.write(&q.counts->round, WaveRound{});
+  launch(CameraStage<SampleIntegrator<BvhTracer>>{c, 0, 0}, int(npix), nullptr);
+  ASSERT_EQ(q.counts->round.rays[0], int(npix));
+  launch(ClosestHitStage<SampleIntegrator<BvhTracer>>{c, 0}, int(npix), nullptr);
+  const SceneView& sc = small.scene.view();
+  std::set<int> seen;
+  int queued = q.counts->round.escaped;
+  for (int kind = 0; kind < kShadeKinds; ++kind)
+    for (int i = 0; i < q.counts->round.kinds[kind]; ++i) {
+      const int slot = q.kindQueue(kind)[i];
+      EXPECT_EQ(shadeKindOf(sc.bsdfs[sc.bsdfIndexAt(q.hit[slot])]), kind);
+      seen.insert(kind);
+      ++queued;
+    }
+  EXPECT_EQ(queued, int(npix)) << "every ray is queued once";
+  EXPECT_GE(seen.size(), 2u) << "teapot-glass's glass and its floor are of two kinds";
+}
