@@ -69,30 +69,23 @@ done
 "$nvcc" -DENVGI_HAS_CUDA=1 -I"$root/src" -O3 -DNDEBUG --generate-code=arch=compute_90,code=sm_90 \
   --expt-relaxed-constexpr -std=c++17 -Xptxas -v -x cu -c "$work/stages.cu" -o "$work/stages.o" \
   >"$work/stages.txt" 2>&1 || { cat "$work/stages.txt" >&2; exit 1; }
-# A row a kernel, then a row a function ptxas kept out of the kernels, named with the material
-# kind it was made for where it has one.
+# A row a kernel: its own figures, then its spills with those of the functions ptxas kept out of
+# it (each kernel has its own copies).
 echo "stage kernels (launch bounds 128 threads x 8 blocks an SM: at most 64 registers):"
-echo "| kernel | registers | stack frame (B) | spill stores / loads (B) |"
-echo "| --- | --- | --- | --- |"
+echo "| kernel | registers | stack frame (B) | spill stores / loads (B) | with out-of-line calls (B) |"
+echo "| --- | --- | --- | --- | --- |"
 c++filt <"$work/stages.txt" | awk '
   BEGIN { split("diffuse conductor roughconductor dielectric thindielectric roughdielectric plastic roughplastic principled blend", kind, " ") }
-  function kindOf(s) {
-    if (match(s, /ShadeStage<envgi::SampleIntegrator<envgi::BvhTracer>, [0-9]/)) return kind[substr(s, RSTART + RLENGTH - 1, 1) + 1]
-    if (match(s, /BsdfType\)[0-9]/)) return kind[substr(s, RSTART + RLENGTH - 1, 1) + 1]
-    return ""
+  /Compiling entry function/ {
+    n = $0
+    if (match(n, /ShadeStage<envgi::SampleIntegrator<envgi::BvhTracer>, [0-9]/)) n = "shade " kind[substr(n, RSTART + RLENGTH - 1, 1) + 1]
+    else { sub(/Stage.*/, "", n); sub(/.*stageKernel<envgi::/, "", n); n = tolower(n) }
+    order[++m] = n; cur = n
   }
-  /Function properties for/ {
-    n = $0; sub(/.*Function properties for /, "", n)
-    isKernel = n ~ /stageKernel/
-    k = kindOf(n)
-    if (isKernel) {
-      if (n ~ /ShadeStage/) n = "shade " k
-      else { sub(/Stage.*/, "", n); sub(/.*stageKernel<envgi::/, "", n); n = tolower(n) }
-    } else {
-      sub(/\(.*/, "", n); while (n ~ /<[^<>]*>/) gsub(/<[^<>]*>/, "", n); sub(/.* /, "", n); sub(/.*::/, "", n)
-      if (k != "") n = n " (" k ")"
-    }
+  /Function properties for/ { isKernel = $0 ~ /stageKernel/ }
+  /stack frame/ {
+    if (isKernel) { stack[cur] = $1; st[cur] = $5; ld[cur] = $9 }
+    allSt[cur] += $5; allLd[cur] += $9
   }
-  /stack frame/ { stack = $1; stores = $5; loads = $9; if (!isKernel) other[++m] = sprintf("| %s, out of line | | %d | %d / %d |", n, stack, stores, loads) }
-  /Used [0-9]+ registers/ && isKernel { printf "| %s | %d | %d | %d / %d |\n", n, $5, stack, stores, loads }
-  END { for (i = 1; i <= m; ++i) print other[i] }'
+  /Used [0-9]+ registers/ { regs[cur] = $5 }
+  END { for (i = 1; i <= m; ++i) { n = order[i]; printf "| %s | %d | %d | %d / %d | %d / %d |\n", n, regs[n], stack[n], st[n], ld[n], allSt[n], allLd[n] } }'

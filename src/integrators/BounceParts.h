@@ -1,9 +1,9 @@
 // Where the parts of a bounce come from. The integrators ask a Parts for each part once: the
-// hit's interaction, where an escaped ray meets the map and the radiance there, the bounce's
-// two pairs of draws, the light sample, the BSDF's value in the light's direction and the
-// BSDF's sample. SampledParts works each out from the scene and the sampler. Another Parts may
-// hand a path parts worked out elsewhere (for many paths at once, say), and must give exactly
-// what SampledParts gives, to the bit.
+// hit's interaction and a blend's other material, where an escaped ray meets the map and the
+// radiance there, the bounce's two pairs of draws, the light sample, the BSDF's value in the
+// light's direction and the BSDF's sample. SampledParts works each out from the scene and the
+// sampler. Another Parts may hand a path parts worked out elsewhere (for many paths at once,
+// say), and must give exactly what SampledParts gives, to the bit.
 #pragma once
 
 #include "lights/LightSampling.h"
@@ -19,6 +19,10 @@ struct SampledParts {
   const SceneView& sc;
 
   ENVGI_HD SurfaceInteraction interaction(const Ray& ray, const Hit& h) const { return sc.interaction(ray, h); }
+  // A blend's other material at si (textured into *scratch where it has textures), or none.
+  ENVGI_HD const Bsdf* partner(const SurfaceInteraction& si, BsdfScratch* scratch) const {
+    return sc.partnerAt(si, scratch);
+  }
   // Where a ray that escaped meets the map (what eval and evalWithPdf find), and the map's
   // radiance there.
   ENVGI_HD Vec2f mapUV(const Ray& ray) const { return sc.env.uvOf(ray.d); }
@@ -45,6 +49,7 @@ struct SampledParts {
 // BSDF's value and sample then hold type T's code alone, the same to the bit.
 template <BsdfType T>
 struct TypedParts : SampledParts {
+  ENVGI_HD const Bsdf* partner(const SurfaceInteraction&, BsdfScratch*) const { return nullptr; }
   ENVGI_HD Color bsdfValue(const Bsdf& bsdf, const Bsdf*, const SurfaceInteraction&, Vec3f wo, Vec3f wi,
                            float* pdf) const {
     return bsdfEvalPdfAs(bsdf, T, wo, wi, pdf);

@@ -141,7 +141,7 @@ ENVGI_HD bool pathShade(const SceneView& sc, PathState* st, bool found, const Hi
   BsdfScratch textured, texturedPartner;
   const Bsdf& bsdf = sc.bsdfAt(si, &textured);
   // A blend's other material: the two are evaluated as their mix (materials/BsdfMix.h).
-  const Bsdf* partner = sc.partnerAt(si, &texturedPartner);
+  const Bsdf* partner = parts.partner(si, &texturedPartner);
   Vec3f woLocal = si.shading.toLocal(wo);
   Vec3f axis = envSamplingAxis(si, wo, bsdf);
 

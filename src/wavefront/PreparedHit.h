@@ -42,6 +42,7 @@ struct PreparedParts {
   const PreparedHit& hit;
 
   SurfaceInteraction interaction(const Ray&, const Hit&) const { return hit.si; }
+  const Bsdf* partner(const SurfaceInteraction& si, BsdfScratch* scratch) const { return sc.partnerAt(si, scratch); }
   Vec2f mapUV(const Ray&) const { return hit.uv; }
   Color mapRadiance(Vec2f uv) const { return sc.env.lookupUV(uv); }
   Vec2f pair(Sampler& smp, BouncePair which) const {

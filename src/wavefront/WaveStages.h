@@ -116,9 +116,8 @@ struct EscapeStage {
   ENVGI_HD void operator()(int i) const {
     const WaveQueues& q = c.q;
     const int slot = q.escaped[i];
-    PathState st = q.state[slot];
-    Sampler smp = q.sampler[slot];
-    c.integ.shade(&st, false, Hit{}, smp, ShadowToQueue::of(q, slot), SampledParts{*c.integ.scene});
+    PathState& st = q.state[slot];
+    c.integ.shade(&st, false, Hit{}, q.sampler[slot], ShadowToQueue::of(q, slot), SampledParts{*c.integ.scene});
     addWaveSample(q, c.sums, slot, st.L);
   }
 };
@@ -142,14 +141,12 @@ struct ShadeStage {
   ENVGI_HD void operator()(int i) const {
     const WaveQueues& q = c.q;
     const int slot = q.kindQueue(Kind)[i];
-    PathState st = q.state[slot];
-    Sampler smp = q.sampler[slot];
+    // The path and its sampler shaded where they lie: copies of them spilled on the GPU.
+    PathState& st = q.state[slot];
     q.ld[slot].needsRay = false;
     using Parts = typename ShadeKindParts<Kind>::type;
-    const bool going =
-        c.integ.shade(&st, true, q.hit[slot], smp, ShadowToQueue::of(q, slot), Parts{{*c.integ.scene}});
-    q.state[slot] = st;
-    q.sampler[slot] = smp;
+    const bool going = c.integ.shade(&st, true, q.hit[slot], q.sampler[slot], ShadowToQueue::of(q, slot),
+                                     Parts{{*c.integ.scene}});
     q.going[slot] = going;
     if (going) WaveQueues::push(q.rayQueue(parity ^ 1), &q.counts->round.rays[parity ^ 1], slot);
     else if (!q.ld[slot].needsRay) addWaveSample(q, c.sums, slot, st.L);

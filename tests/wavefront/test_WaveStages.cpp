@@ -50,10 +50,10 @@ void expectRenderPixelsSums(const SmallScene& small, int capacity, const std::st
 }  // namespace
 
 // path and direct (as the one-bounce path it is with a light and a BSDF sample) on the bundled
-// scenes; a wave of the whole film, waves of 100 paths (576 pixels: partial waves, and a pixel's
+// scenes (blend: the blend kind, whose hits have a partner); a wave of the whole film, waves of 100 paths (576 pixels: partial waves, and a pixel's
 // samples in different waves), and room for 1000 paths (a wave still takes 576).
 TEST(WaveStages, AddsTheSameSamplesAsRenderPixel) {
-  for (std::string name : {"teapot-glass", "buddha", "cornell-box", "bunny-sunrise", "sun-and-sky"})
+  for (std::string name : {"teapot-glass", "buddha", "cornell-box", "bunny-sunrise", "sun-and-sky", "blend"})
     for (IntegratorType type : {IntegratorType::Path, IntegratorType::Direct}) {
       SmallScene small(name, type);
       for (int capacity : {24 * 24, 100, 1000})
