@@ -58,7 +58,7 @@ done
   echo '#include "wavefront/CudaStageLaunch.cuh"'
   echo 'namespace envgi {'
   echo 'using I = SampleIntegrator<BvhTracer>;'
-  for st in 'CameraStage<I>' 'ClosestHitStage<I>' 'EscapeStage<I>' 'ShadowStage<I>' 'FilmStage'; do
+  for st in 'CameraStage<I>' 'ClosestHitStage<I>' 'EscapeStage<I>' 'ShadowStage<I>' 'DirectSampleStage<I>' 'FilmStage'; do
     echo "template __global__ void stageKernel<$st>($st, int, const int*);"
   done
   for k in 0 1 2 3 4 5 6 7 8 9; do

@@ -45,6 +45,14 @@ ENVGI_INLINE void atomicAddRelaxed(uint32_t* p, uint32_t v) {
 #endif
 }
 
+ENVGI_INLINE void atomicAddRelaxed(uint64_t* p, uint64_t v) {
+#if defined(__CUDA_ARCH__)
+  atomicAdd(reinterpret_cast<unsigned long long*>(p), static_cast<unsigned long long>(v));
+#else
+  __atomic_fetch_add(p, v, __ATOMIC_RELAXED);
+#endif
+}
+
 // Adds v to *p and returns what *p held before: a place claimed in a queue by many threads.
 ENVGI_INLINE int atomicFetchAddRelaxed(int* p, int v) {
 #if defined(__CUDA_ARCH__)

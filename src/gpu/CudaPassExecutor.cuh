@@ -1,6 +1,6 @@
 // The render loop's passes on a CUDA GPU for any per-sample integrator: path and direct by
 // path regeneration (regeneratePaths), or, with ENVGI_GPU_STAGES=1, a kernel a stage
-// (wavefront/WavePass.h) where the integrator shades after the trace; others (the grid integrator's camera samples) one thread
+// (wavefront/WavePass.h); others (the grid integrator's camera samples) one thread
 // a pixel running renderPixel, the CPU executor's body, over its samples of the pass. The
 // device scene and whatever else the integrator reads live in the DeviceScene's arena, which
 // this executor owns. CUDA-only.
@@ -89,7 +89,7 @@ class CudaPassExecutor final : public PassExecutor {
     check(cudaMemset(counters_, 0, 3 * sizeof(unsigned long long)), "clearing counters");
     if constexpr (RunsByBounce<Integrator>::value) {
       const char* st = std::getenv("ENVGI_GPU_STAGES");
-      if (st && std::strcmp(st, "1") == 0 && integ_.shadesAfterTrace()) {
+      if (st && std::strcmp(st, "1") == 0) {
         // As many paths as pixels, up to 2^20 (pbrt-v4's wavefront holds 2^20 too).
         const int capacity = int(std::min<size_t>(px, size_t(1) << 20));
         const size_t bytes = layOutWave(0, capacity, px, &waveQueues_, &waveSums_);

@@ -41,11 +41,16 @@ void runWavePass(Launch& launch, const WaveContext<I>& c, const ShadeKindSet& ki
   launch.zero(c.sums.accSq, npix * sizeof(double));
   launch.zero(c.sums.accW, npix * sizeof(float));
   launch.write(&c.q.counts->dropped, 0u);
+  launch.write(&c.q.counts->rays, uint64_t(0));
   const uint64_t waveSize = std::min<uint64_t>(uint64_t(c.q.capacity), npix);
   for (uint64_t base = 0; base < total; base += waveSize) {
     launch.write(&c.q.counts->round, WaveRound{});
     launch(CameraStage<I>{c, base, s0}, int(std::min(waveSize, total - base)), nullptr);
     WaveRound r = launch.read(&c.q.counts->round);
+    if (!c.integ.shadesAfterTrace()) {
+      launch(DirectSampleStage<I>{c}, r.rays[0], nullptr);
+      continue;
+    }
     for (int parity = 0; r.rays[parity] > 0; parity ^= 1) {
       const int live = r.rays[parity];
       counters->rays += uint64_t(live);
@@ -62,6 +67,7 @@ void runWavePass(Launch& launch, const WaveContext<I>& c, const ShadeKindSet& ki
   }
   launch(FilmStage{c.film, c.sums}, int(npix), nullptr);
   counters->dropped += launch.read(&c.q.counts->dropped);
+  counters->rays += launch.read(&c.q.counts->rays);
 }
 
 }  // namespace envgi

@@ -23,6 +23,7 @@ struct WaveRound {
 struct WaveCounts {
   WaveRound round;
   uint32_t dropped;  // samples left out of the sums (acceptedSample), over the pass
+  uint64_t rays;     // rays traced inside a stage (DirectSampleStage), over the pass
 };
 
 struct WaveQueues {

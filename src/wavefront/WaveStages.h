@@ -3,7 +3,8 @@
 // thread an index (CudaStageLaunch.cuh). Camera samples → closest hits, queued as escaped rays
 // or by the shade kind of the material hit → escaped rays see the map → hits shaded, a stage per
 // kind (emission, the next-event sample queued as a shadow ray, the BSDF's next ray) → shadow
-// rays → the pass's sums added to the film. pathShade is the physics; a stage only says where
+// rays → the pass's sums added to the film (direct that is no one-bounce path: camera samples →
+// DirectSampleStage → the film). pathShade is the physics; a stage only says where
 // its inputs come from and where its outputs go, and a shade stage's Parts hold only its kind's
 // BSDF code (TypedParts), so a GPU kernel per kind holds no other material's code.
 //
@@ -165,6 +166,22 @@ struct ShadowStage {
     const bool blocked = c.integ.tracer.occluded(ld.o, ld.d, ld.tMax);
     q.state[slot].L += q.ldBeta[slot] * resolvedLd(ld, blocked);
     if (!q.going[slot]) addWaveSample(q, c.sums, slot, q.state[slot].L);
+  }
+};
+
+// direct where it is no one-bounce path (several light or BSDF samples, or every light of the
+// collapsed map at each point): its whole estimate for the camera ray, with the shadow rays it
+// traces, for each path of the camera round.
+template <class I>
+struct DirectSampleStage {
+  WaveContext<I> c;
+  ENVGI_HD void operator()(int i) const {
+    const WaveQueues& q = c.q;
+    const int slot = q.rayQueue(0)[i];
+    uint64_t rays = 0;
+    c.integ.step(&q.state[slot], q.sampler[slot], &rays);
+    atomicAddRelaxed(&q.counts->rays, rays);
+    addWaveSample(q, c.sums, slot, q.state[slot].L);
   }
 };
 
