@@ -4,9 +4,9 @@
 // or by the shade kind of the material hit → escaped rays see the map → hits shaded, a stage per
 // kind (emission, the next-event sample queued as a shadow ray, the BSDF's next ray) → shadow
 // rays → the pass's sums added to the film (direct that is no one-bounce path: camera samples →
-// DirectSampleStage → the film). pathShade is the physics; a stage only says where
-// its inputs come from and where its outputs go, and a shade stage's Parts hold only its kind's
-// BSDF code (TypedParts), so a GPU kernel per kind holds no other material's code.
+// DirectSampleStage → the film). pathShade is the physics; a stage only says where its inputs
+// come from and where its outputs go, and a shade stage's Parts hold only its kind's BSDF code
+// (TypedParts), so a GPU kernel per kind holds no other material's code.
 //
 // A wave takes (pixel, sample) items [base, base + n) of the pass, numbered sample-major, with n
 // at most the film's pixels: a wave then holds at most one sample of a pixel, whose sums take
@@ -20,8 +20,8 @@
 
 namespace envgi {
 
-// What every stage reads: the integrator (path, or direct as a one-bounce path), the camera and
-// sample sequence, the film, the wave's queues and the pass's sums.
+// What every stage reads: the integrator (path or direct), the camera and sample sequence, the
+// film, the wave's queues and the pass's sums.
 template <class I>
 struct WaveContext {
   I integ;
