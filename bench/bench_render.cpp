@@ -8,9 +8,7 @@
 // ENVGI_BENCH_ENVMAP=/path/to/map.hdr Grace Cathedral for another map, ENVGI_BENCH_STRATEGY=S the
 // map's sampling strategy (product, the scene's, for alias, importance, ...). ENVGI_BENCH_DEPTH=N cuts the
 // paths at depth N instead of 4 (1: camera rays and the map they see; 2: one shading point), which
-// splits the cost by depth. BM_WaveStagesOnTheCpu renders the same samples through the wave
-// stages (wavefront/WavePass.h) on the CPU's launcher, for comparison with BM_EnvgiPathTracer
-// (the CPU's tile wavefront).
+// splits the cost by depth.
 #include <benchmark/benchmark.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -25,8 +23,6 @@
 #include "integrators/PathIntegrator.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
-#include "wavefront/HostStageLaunch.h"
-#include "wavefront/WavePass.h"
 
 using namespace envgi;
 
@@ -190,40 +186,6 @@ static void BM_EnvgiPathTracer(benchmark::State& state) {
   state.counters["rays/s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_EnvgiPathTracer)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
-
-// The fixture's render (its 4 spp in one pass) through the wave stages, a wave of the whole
-// film, over Embree's one-ray calls.
-static void BM_WaveStagesOnTheCpu(benchmark::State& state) {
-  Fixture& f = fixture();
-  tbb::task_arena arena(int(state.range(0)));
-  RenderOptions o;
-  o.spp = 4;
-  const KernelSettings k = kernelSettings(f.scene, o);
-  const Camera& cam = f.scene.view().camera;
-  const size_t npix = size_t(cam.width) * cam.height;
-  std::vector<Color> sum(npix);
-  std::vector<double> sumSq(npix);
-  HostWave wave(int(npix), npix);
-  const WaveContext<SampleIntegrator<EmbreeTracer>> c{{k.type, k.path, k.direct, &f.scene.view(), EmbreeTracer{f.accel.get()}},
-                                                      cam,
-                                                      k.sequence,
-                                                      FilmView{sum.data(), sumSq.data(), cam.width, cam.height},
-                                                      wave.queues,
-                                                      wave.sums};
-  const ShadeKindSet kinds = ShadeKindSet::of(f.scene.bsdfs);
-  uint64_t rays = 0;
-  for (auto _ : state) {
-    PixelCounters pc;
-    arena.execute([&] {
-      HostStageLaunch launch;
-      runWavePass(launch, c, kinds, 0, 4, &pc);
-    });
-    rays += pc.rays;
-  }
-  benchmark::DoNotOptimize(sum.data());
-  state.counters["rays/s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
-}
-BENCHMARK(BM_WaveStagesOnTheCpu)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 static void BM_PlainEmbreeSameRays(benchmark::State& state) {
   Fixture& f = fixture();

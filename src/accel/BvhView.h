@@ -237,7 +237,7 @@ struct BvhTracer {
   ENVGI_HD bool intersect(const Ray& r, Hit* h) const { return bvh.intersect(r, h); }
   ENVGI_HD bool occluded(Vec3f o, Vec3f d, float tMax) const { return bvh.occluded(o, d, tMax); }
   ENVGI_HD bool intersectSurface(const Ray& r, Hit* h) const { return bvh.intersectSurface(r, h); }
-  // A round of coherent rays (the tile wavefront's camera rays), one at a time here.
+  // A queue of coherent rays (the camera's, in the CPU's waves), one at a time here.
   template <class Rays, class Out>
   void intersectCoherent(int n, Rays rays, Out out) const {
     for (int i = 0; i < n; ++i) {
@@ -246,7 +246,7 @@ struct BvhTracer {
       out(i, found, h);
     }
   }
-  // A round's bounce rays and shadow rays (the tile wavefront), one at a time here too.
+  // A queue of bounce rays or shadow rays, one at a time here too.
   template <class Rays, class Out>
   void intersectMany(int n, Rays rays, Out out) const { intersectCoherent(n, rays, out); }
   template <class Rays, class Out>

@@ -121,7 +121,8 @@ class CudaPassExecutor final : public PassExecutor {
       if (waveQueues_.capacity > 0) {
         PixelCounters pc;
         CudaStageLaunch launch;
-        runWavePass(launch, WaveContext<Integrator>{integ_, cam_, seq_, film_, waveQueues_, waveSums_}, kinds_, s0, s1,
+        runWavePass(launch, WaveContext<Integrator>{integ_, cam_, seq_, film_, WaveRegion{0, 0, cam_.width, cam_.height},
+                                                          waveQueues_, waveSums_}, kinds_, s0, s1,
                     &pc);
         counters->rays += pc.rays;
         counters->dropped += pc.dropped;

@@ -1,8 +1,8 @@
-// Runs render passes on the CPU: oneTBB over image tiles, each tile a bounce at a time
-// (renderTileWavefront) for the path tracer and for direct with at most one light and one BSDF
-// sample (a one-bounce path), each pixel through renderPixel for the others; both
-// run the integrator bodies the CUDA kernels run. Deterministic whatever the thread count (no
-// shared sums), and the same sums either way up to Embree's packets' rounding of camera hits.
+// Runs render passes on the CPU: oneTBB over image tiles, each tile a wave through the wave
+// stages (wavefront/WavePass.h, in their batch forms: HostStages.h) for path and direct, each
+// pixel through renderPixel for the other integrators; both run the integrator bodies the CUDA
+// kernels run. Deterministic whatever the thread count (no shared sums), and the same sums
+// either way up to Embree's packets' rounding of camera hits.
 #pragma once
 
 #include <tbb/blocked_range.h>
@@ -18,7 +18,8 @@
 
 #include "render/PassExecutor.h"
 #include "render/PixelKernel.h"
-#include "wavefront/TileWavefront.h"
+#include "wavefront/HostStageLaunch.h"
+#include "wavefront/WavePass.h"
 #include "render/WorkerThreads.h"
 
 namespace envgi {
@@ -30,22 +31,23 @@ class CpuExecutor final : public PassExecutor {
               std::string name, int tileSize = 16)
       : cam_(cam), seq_(seq), integrate_(std::move(integrate)),
         arena_(arenaConcurrency(threads)), name_(std::move(name)),
-        tile_(tileSize) {
+        tile_(tileSize), waves_(tileSize * tileSize, size_t(tileSize) * size_t(tileSize)) {
     film_.sum.assign(size_t(cam.width) * cam.height, Color(0.f));
     if (keepVariance) film_.sumSqLum.assign(film_.sum.size(), 0.0);
     if (cam.filter.hasNegativeLobes()) film_.weightSum.assign(film_.sum.size(), 0.f);
     if constexpr (RunsByBounce<Integrator>::value) {
-      // A bounce at a time unless ENVGI_CPU_BY_BOUNCE=0 asks for renderPixel (for A/B timings); the film is the same either way but for the last bits of the
-      // camera rays' hit distances, which Embree's packets compute in their own way.
+      // Waves unless ENVGI_CPU_BY_BOUNCE=0 asks for renderPixel (for A/B timings); the film is
+      // the same either way but for the last bits of the camera rays' hit distances, which
+      // Embree's packets compute in their own way.
       const char* e = std::getenv("ENVGI_CPU_BY_BOUNCE");
-      byBounce_ = integrate_.shadesAfterTrace() && !(e && std::strcmp(e, "0") == 0);
+      inWaves_ = !(e && std::strcmp(e, "0") == 0);
     }
   }
 
   // The device alone: the study's results and report group runs by it, whichever body ran.
   std::string deviceName() const override { return name_; }
-  // Whether passes run a tile as a wavefront (renderTileWavefront) rather than per pixel.
-  bool runsByBounce() const { return byBounce_; }
+  // Whether passes run a tile as a wave of the wave stages rather than per pixel.
+  bool runsInWaves() const { return inWaves_; }
 
   void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
     int W = cam_.width, H = cam_.height;
@@ -75,8 +77,12 @@ class CpuExecutor final : public PassExecutor {
           for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) pixels += fv.takesSamples(size_t(y) * size_t(W) + size_t(x));
           if constexpr (RunsByBounce<Integrator>::value) {
-            if (byBounce_) {
-              renderTileWavefront(cam_, seq_, integrate_, x0, y0, x1, y1, s0, s1, fv, &batch_.local(), &pc);
+            if (inWaves_) {
+              HostWave& wave = waves_.local();
+              HostStageLaunch launch = wave.launch();
+              const WaveContext<Integrator> c{integrate_, cam_, seq_, fv, WaveRegion{x0, y0, x1 - x0, y1 - y0},
+                                              wave.queues, wave.sums};
+              runWavePass(launch, c, kinds_, s0, s1, &pc);
               progress.add(pixels * size_t(s1 - s0));
               continue;
             }
@@ -134,15 +140,17 @@ class CpuExecutor final : public PassExecutor {
   tbb::task_arena arena_;
   std::string name_;
   int tile_;
-  bool byBounce_ = false;
+  bool inWaves_ = false;
   FilmSums film_;
   std::vector<unsigned char> active_;  // empty: every pixel takes samples
   const std::atomic<bool>* cancel_ = nullptr;  // watchCancel's
   std::vector<unsigned char> took_;  // the last pass's pixels where Ctrl-C cut it; else empty
-  // renderTileWavefront's room, one per thread. In memory from the standard allocator, not TBB's
-  // scalable one (mmap'd, unseen by LeakSanitizer, which then took each batch's arrays for leaks
-  // while the executor lived: a false report in the viewer's fuzzer).
-  tbb::enumerable_thread_specific<TileQueues, std::allocator<TileQueues>> batch_;
+  // Every shade kind: on the CPU a kind no hit needs costs a call on an empty queue.
+  ShadeKindSet kinds_ = ShadeKindSet::all();
+  // A wave of a tile, one per thread. In memory from the standard allocator, not TBB's scalable
+  // one (mmap'd, unseen by LeakSanitizer, which then took each wave's arrays for leaks while the
+  // executor lived: a false report in the viewer's fuzzer).
+  tbb::enumerable_thread_specific<HostWave, std::allocator<HostWave>> waves_;
 };
 
 }  // namespace envgi

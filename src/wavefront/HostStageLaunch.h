@@ -1,25 +1,26 @@
-// The wave stages' launcher on the CPU (WavePass.h's Launch): a stage over chunks of its queue
-// under oneTBB, the queues in host memory.
+// The wave stages' launcher on the CPU (WavePass.h's Launch): a stage over its queue on the
+// calling thread, through the stage's batch form where it has one (HostStages.h), else its
+// function of one index in a loop. A CPU executor runs a wave a tile on each of its threads, so
+// that the wave's slots and queues stay in the thread's caches.
 #pragma once
-
-#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cstring>
 #include <vector>
 
-#include "wavefront/WaveStages.h"
+#include "wavefront/HostStages.h"
 
 namespace envgi {
 
 struct HostStageLaunch {
-  int grain = 256;  // indices a task
+  HostLanes* lanes;
   template <class Stage>
   void operator()(const Stage& stage, int n, const int* count) const {
     const int m = count ? std::min(n, *count) : n;
-    tbb::parallel_for(tbb::blocked_range<int>(0, m, size_t(grain)), [&](const tbb::blocked_range<int>& r) {
-      for (int i = r.begin(); i != r.end(); ++i) stage(i);
-    });
+    if (m == 0) return;
+    if constexpr (requires { runOnHost(stage, m, lanes); }) runOnHost(stage, m, lanes);
+    else
+      for (int i = 0; i < m; ++i) stage(i);
   }
   template <class T>
   void write(T* to, const T& v) const {
@@ -32,16 +33,21 @@ struct HostStageLaunch {
   void zero(void* p, size_t bytes) const { std::memset(p, 0, bytes); }
 };
 
-// A wave's slots, queues and sums in host memory.
+// A wave's slots, queues and sums in host memory, and the lanes' room for its batch forms.
 class HostWave {
  public:
   HostWave(int capacity, size_t pixels) {
     const size_t bytes = layOutWave(0, capacity, pixels, &queues, &sums);
     block_.resize((bytes + 15) / 16);
     layOutWave(reinterpret_cast<uintptr_t>(block_.data()), capacity, pixels, &queues, &sums);
+    lanes.resize(size_t(capacity));
   }
+  HostWave(const HostWave&) = delete;  // queues point into block_
+  HostWave& operator=(const HostWave&) = delete;
   WaveQueues queues;
   WaveSums sums;
+  HostLanes lanes;
+  HostStageLaunch launch() { return {&lanes}; }
 
  private:
   struct alignas(16) Chunk {

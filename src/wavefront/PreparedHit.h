@@ -1,5 +1,5 @@
-// What the tile wavefront works out for a round's paths before shading them, a stage at a time
-// across the round (TileStages.h), and the Parts (integrators/BounceParts.h) that hands each
+// What the CPU's batch forms of the wave stages work out for a queue's paths before shading them
+// (HostStages.h), and the Parts (integrators/BounceParts.h) that hands each
 // path its own when pathShade asks: the parts are SampledParts' to the bit, so the images are
 // renderPixel's.
 #pragma once
@@ -34,7 +34,6 @@ struct PreparedHit {
   bool valued = false;
   BsdfEvaluation value;
   DescendedDraw product;
-  Vec2f uv;  // a ray that escaped: where it meets the map
 };
 
 struct PreparedParts {
@@ -43,7 +42,7 @@ struct PreparedParts {
 
   SurfaceInteraction interaction(const Ray&, const Hit&) const { return hit.si; }
   const Bsdf* partner(const SurfaceInteraction& si, BsdfScratch* scratch) const { return sc.partnerAt(si, scratch); }
-  Vec2f mapUV(const Ray&) const { return hit.uv; }
+  Vec2f mapUV(const Ray& ray) const { return sc.env.uvOf(ray.d); }
   Color mapRadiance(Vec2f uv) const { return sc.env.lookupUV(uv); }
   Vec2f pair(Sampler& smp, BouncePair which) const {
     const bool drawn = which == BouncePair::Light ? hit.lightDrawn : hit.bsdfDrawn;
@@ -80,13 +79,14 @@ struct PreparedParts {
   }
 };
 
-// A camera ray that escaped, where the round's lanes found the map's radiance: pathAddEscape's
-// parts.
-struct LaneEscapeParts {
+// A ray that escaped, where lanes found where it meets the map (uv) and, for the camera's rays,
+// the radiance there: pathAddEscape's parts.
+struct FoundEscapeParts {
+  const EnvironmentMapView& env;
   Vec2f uv;
-  Color radiance;
+  const Color* radiance;  // else looked up at uv
   Vec2f mapUV(const Ray&) const { return uv; }
-  Color mapRadiance(Vec2f) const { return radiance; }
+  Color mapRadiance(Vec2f at) const { return radiance ? *radiance : env.lookupUV(at); }
 };
 
 }  // namespace envgi

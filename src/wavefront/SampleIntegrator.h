@@ -1,6 +1,6 @@
 // path or direct over any tracer, as every executor runs them: whole per sample (renderPixel),
 // a bounce a call (path regeneration on the GPU), or with the trace taken out of the bounce
-// (the CPU's tile wavefront, TileWavefront.h). The integrators themselves are the shared
+// (the wave stages, wavefront/WaveStages.h). The integrators themselves are the shared
 // templates of integrators/.
 #pragma once
 
@@ -56,7 +56,7 @@ struct SampleIntegrator {
     return pathStep(*scene, tracer, st, smp, path, rays);
   }
   // step() with the trace taken out, for an executor that traces many paths' rays together
-  // (the tile wavefront): path, and direct where it is a one-bounce path (directAsPath);
+  // (the wave stages): path, and direct where it is a one-bounce path (directAsPath);
   // direct with more samples traces several rays inside its one step.
   ENVGI_HD bool shadesAfterTrace() const {
     return type == SampleIntegratorType::Path || directIsOneBouncePath(direct);
@@ -71,7 +71,7 @@ struct SampleIntegrator {
   }
 };
 
-// Integrators that run one bounce a call, so path regeneration and the tile wavefront can
+// Integrators that run one bounce a call, so path regeneration and the wave stages can
 // drive them.
 template <class T>
 struct RunsByBounce {

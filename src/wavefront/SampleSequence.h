@@ -1,6 +1,6 @@
 // Which sample a pass takes where: the sequence, its seed and spp, and the camera sample that
 // starts sample s of a pixel. The same (pixel, sample) gives the same sample on any device and
-// in any executor (per pixel, by regeneration or a tile's wavefront).
+// in any executor (per pixel, by regeneration or in waves).
 #pragma once
 
 #include "sampling/Sampler.h"

@@ -21,6 +21,11 @@ struct ShadeKindSet {
     for (const Bsdf& b : bsdfs) s.used[shadeKindOf(b)] = true;
     return s;
   }
+  static ShadeKindSet all() {
+    ShadeKindSet s;
+    for (bool& u : s.used) u = true;
+    return s;
+  }
 };
 
 namespace detail {
@@ -36,7 +41,7 @@ void shadeEachKind(Launch& launch, const WaveContext<I>& c, const ShadeKindSet& 
 template <class I, class Launch>
 void runWavePass(Launch& launch, const WaveContext<I>& c, const ShadeKindSet& kinds, int s0, int s1,
                  PixelCounters* counters) {
-  const uint64_t npix = uint64_t(c.cam.width) * uint64_t(c.cam.height), total = npix * uint64_t(s1 - s0);
+  const uint64_t npix = c.region.pixels(), total = npix * uint64_t(s1 - s0);
   launch.zero(c.sums.acc, npix * sizeof(Color));
   launch.zero(c.sums.accSq, npix * sizeof(double));
   launch.zero(c.sums.accW, npix * sizeof(float));
@@ -51,21 +56,21 @@ void runWavePass(Launch& launch, const WaveContext<I>& c, const ShadeKindSet& ki
       launch(DirectSampleStage<I>{c}, r.rays[0], nullptr);
       continue;
     }
-    for (int parity = 0; r.rays[parity] > 0; parity ^= 1) {
+    for (int parity = 0, round = 0; r.rays[parity] > 0; parity ^= 1, ++round) {
       const int live = r.rays[parity];
       counters->rays += uint64_t(live);
       WaveRound next{};
       next.rays[parity] = live;
       launch.write(&c.q.counts->round, next);
-      launch(ClosestHitStage<I>{c, parity}, live, nullptr);
-      launch(EscapeStage<I>{c}, live, &c.q.counts->round.escaped);
+      launch(ClosestHitStage<I>{c, parity, round == 0}, live, nullptr);
+      launch(EscapeStage<I>{c, round == 0}, live, &c.q.counts->round.escaped);
       detail::shadeEachKind(launch, c, kinds, parity, live, std::make_integer_sequence<int, kShadeKinds>{});
       launch(ShadowStage<I>{c}, live, &c.q.counts->round.shadows);
       r = launch.read(&c.q.counts->round);
       counters->rays += uint64_t(r.shadows);
     }
   }
-  launch(FilmStage{c.film, c.sums}, int(npix), nullptr);
+  launch(FilmStage{c.film, c.region, c.sums}, int(npix), nullptr);
   counters->dropped += launch.read(&c.q.counts->dropped);
   counters->rays += launch.read(&c.q.counts->rays);
 }

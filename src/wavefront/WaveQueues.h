@@ -47,8 +47,15 @@ struct WaveQueues {
 
   ENVGI_HD int* rayQueue(int parity) const { return rays + size_t(parity) * size_t(capacity); }
   ENVGI_HD int* kindQueue(int kind) const { return kinds + size_t(kind) * size_t(capacity); }
-  // Appends slot to the queue q whose count is *count.
-  ENVGI_HD static void push(int* q, int* count, int slot) { q[atomicFetchAddRelaxed(count, 1)] = slot; }
+  // Appends slot to the queue q whose count is *count. On the host a wave is one thread's
+  // (HostStageLaunch.h), and a locked add would wait for the stores before it to drain.
+  ENVGI_HD static void push(int* q, int* count, int slot) {
+#if defined(__CUDA_ARCH__)
+    q[atomicFetchAddRelaxed(count, 1)] = slot;
+#else
+    q[(*count)++] = slot;
+#endif
+  }
 };
 
 // The pass's own sums per pixel, added to the film once at its end (as renderPixel adds a

@@ -222,7 +222,7 @@ TEST(CosineProduct, SamplingAxisFollowsTheViewerAndTransmission) {
 }
 
 
-// The prefetch before a round's escapes (TileStages' meetMap) reads the product's small tables
+// The prefetch before a round's escapes (the CPU's escape stage, HostStages.h) reads the product's small tables
 // to find its addresses: at the poles, across the seam and for a zero axis it stays inside
 // them (the sanitizer build checks the reads), and the lookup after it is the same to the bit.
 TEST(CosineProduct, PrefetchingAnEscapeReadsInsideTheTables) {

@@ -1,6 +1,6 @@
 // drawBounce takes a bounce's draws at bounceLayout's offsets past the sampler's position, with
 // every sampler, with and without a light sample, before and after roulette begins: the offsets
-// a batch of the same draws reads (the tile wavefront's lanes) are drawBounce's own.
+// a batch of the same draws reads (the CPU's shade stages' lanes) are drawBounce's own.
 #include <gtest/gtest.h>
 
 #include "integrators/PathIntegrator.h"

@@ -172,7 +172,7 @@ TEST(CpuExecutor, ALeakCheckDuringARenderFindsNothing) {
   o.threads = 2;
   PreparedRender pr = prepareRender(s, accel, o);
   auto* cpu = dynamic_cast<CpuExecutor<SampleIntegrator<EmbreeTracer>>*>(pr.executor.get());
-  ASSERT_TRUE(cpu && cpu->runsByBounce()) << "the path that keeps tile batches";
+  ASSERT_TRUE(cpu && cpu->runsInWaves()) << "the path that keeps a wave a thread";
   Progress quiet(1, false);
   PassCounters counters;
   pr.executor->runPass(0, 4, quiet, &counters);
@@ -248,11 +248,11 @@ TEST(CpuExecutor, CtrlCCutsAPassBetweenTiles) {
   EXPECT_EQ(ex.cutPass(), nullptr);
 }
 
-// The executor a render gets runs direct by bounce where it is a one-bounce path (at most one
-// light and one BSDF sample) and per pixel with more, and names the device alone either way.
-TEST(CpuExecutor, DirectRunsByBounceWithAtMostOneSampleOfEach) {
-  for (auto [nE, nB, byBounce] : {std::tuple{1, 1, true}, std::tuple{1, 0, true}, std::tuple{0, 1, true},
-                                  std::tuple{2, 1, false}, std::tuple{1, 3, false}}) {
+// The executor a render gets runs direct in waves with any count of samples (as a one-bounce
+// path with at most one light and one BSDF sample, whole in one stage with more; renderPixel
+// only where ENVGI_CPU_BY_BOUNCE=0 asks), and names the device alone either way.
+TEST(CpuExecutor, DirectRunsInWavesWithAnyCountOfSamples) {
+  for (auto [nE, nB] : {std::pair{1, 1}, std::pair{1, 0}, std::pair{0, 1}, std::pair{2, 1}, std::pair{1, 3}}) {
     Scene s;
     loadSmall("buddha", IntegratorType::Direct, &s);
     s.integrator.direct.emitterSamples = nE;
@@ -265,7 +265,7 @@ TEST(CpuExecutor, DirectRunsByBounceWithAtMostOneSampleOfEach) {
     PreparedRender pr = prepareRender(s, accel, o);
     auto* cpu = dynamic_cast<CpuExecutor<SampleIntegrator<EmbreeTracer>>*>(pr.executor.get());
     ASSERT_NE(cpu, nullptr);
-    EXPECT_EQ(cpu->runsByBounce(), byBounce) << nE << " + " << nB;
+    EXPECT_TRUE(cpu->runsInWaves()) << nE << " + " << nB;
     EXPECT_EQ(cpu->deviceName(), "cpu");
   }
 }

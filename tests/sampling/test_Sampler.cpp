@@ -81,7 +81,7 @@ TEST_P(SamplerTypes, SkippedDrawsLeaveTheLaterOnesAsTheyWere) {
   }
 }
 
-// start() in its two halves, as the tile wavefront runs it (setIndex once for sample s, then a
+// start() in its two halves, as the CPU's camera stage runs it (setIndex once for sample s, then a
 // copy per pixel and startPixel), draws what start() draws, at a power of two and not.
 TEST_P(SamplerTypes, StartInTwoHalvesDrawsAsStart) {
   for (uint32_t spp : {16u, 19u}) {

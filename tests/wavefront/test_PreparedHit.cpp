@@ -1,4 +1,4 @@
-// pathShade given a hit prepared as the tile wavefront prepares it (prepareHit: the interaction
+// pathShade given a hit prepared as the CPU's shade stages prepare it (prepareHit: the interaction
 // and the light's pair; the product draw taken level by level to its end, and placed as the
 // lanes place it; with Sobol's draws, the light's and the BSDF's pairs at bounceLayout's offsets)
 // through PreparedParts, against pathShade working each part out itself (SampledParts): the same
@@ -13,7 +13,7 @@
 #include "accel/Bvh.h"
 #include "render/Renderer.h"
 #include "scene/SceneLoader.h"
-#include "wavefront/TileStages.h"
+#include "wavefront/HostStages.h"
 
 using namespace envgi;
 
@@ -103,8 +103,6 @@ TEST(PreparedHit, ShadingAPreparedHitIsTheSame) {
                 endDescent(sc.env, &descent, productDraws % 2 == 1, &prepared.product);
                 ++productDraws;
               }
-            } else {
-              prepared.uv = EnvironmentMapView::dirToUV(sc.env.toLocalUnnormalized(st.ray.d));
             }
             if (found && sobol) {
               // A pair that is not the draw, where the BSDF's should be: taken, it moves the path.

@@ -6,7 +6,7 @@
 #include <cstring>
 
 #include "wavefront/SampleLanes.h"
-#include "wavefront/TileWavefront.h"
+#include "wavefront/HostStages.h"
 
 using namespace envgi;
 

@@ -1,10 +1,14 @@
 // The wave stages (WaveStages.h, run by WavePass.h) against the per-pixel body (renderPixel):
 // a wave holds at most one sample of a pixel and a pass adds its sums at its end, so over the
-// GPU's BVH the film's sums agree to the bit, on the CPU's launcher, whose chunks run on many
-// threads as a GPU's threads would.
+// GPU's BVH the film's sums agree to the bit, whether the CPU's launcher runs each stage's batch
+// form or each stage's function of one index over its queue in any order, as a GPU's threads
+// would.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
+#include <numeric>
+#include <random>
 #include <set>
 #include <string>
 #include <utility>
@@ -20,9 +24,24 @@ using test::SmallScene;
 
 namespace {
 
+// The whole film, a wave of `capacity` paths at a time.
 WaveContext<SampleIntegrator<BvhTracer>> waveContext(const SmallScene& small, HostWave* wave, FilmView film) {
-  return {small.integrator(), small.scene.view().camera, small.k.sequence, film, wave->queues, wave->sums};
+  const Camera& cam = small.scene.view().camera;
+  return {small.integrator(),           cam,         small.k.sequence, film, WaveRegion{0, 0, cam.width, cam.height},
+          wave->queues,                 wave->sums};
 }
+
+// Each stage's function of one index over its queue, in a shuffled order.
+struct ShuffledStageLaunch : HostStageLaunch {
+  mutable std::mt19937 rng{7};
+  template <class Stage>
+  void operator()(const Stage& stage, int n, const int* count) const {
+    std::vector<int> order(size_t(count ? std::min(n, *count) : n));
+    std::iota(order.begin(), order.end(), 0);
+    std::shuffle(order.begin(), order.end(), rng);
+    for (int i : order) stage(i);
+  }
+};
 
 // Passes (0, 3) and (3, 8) of every pixel through renderPixel and through the wave stages with
 // `capacity` paths a wave: the same sums to the bit (expectSameSums).
@@ -31,17 +50,21 @@ void expectRenderPixelsSums(const SmallScene& small, int capacity, const std::st
   const Camera& cam = small.scene.view().camera;
   const size_t npix = size_t(cam.width) * cam.height;
   Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
-  PixelCounters ca, cb;
+  Film c = a;
+  PixelCounters ca, cb, cc;
   HostWave wave(capacity, npix);
-  HostStageLaunch launch;
+  HostStageLaunch batches = wave.launch();
+  ShuffledStageLaunch shuffled{{nullptr}};
   const ShadeKindSet kinds = ShadeKindSet::of(small.scene.bsdfs);
   for (auto [s0, s1] : {std::pair{0, 3}, std::pair{3, 8}}) {
     for (int y = 0; y < cam.height; ++y)
       for (int x = 0; x < cam.width; ++x) renderPixel(cam, small.k.sequence, integ, x, y, s0, s1, a.view(cam), &ca);
-    runWavePass(launch, waveContext(small, &wave, b.view(cam)), kinds, s0, s1, &cb);
+    runWavePass(batches, waveContext(small, &wave, b.view(cam)), kinds, s0, s1, &cb);
+    runWavePass(shuffled, waveContext(small, &wave, c.view(cam)), kinds, s0, s1, &cc);
     // direct shaded as a path may leave out a ray (expectSameSums); whole, it traces renderPixel's.
-    test::expectSameSums(a, b, ca, cb, integ.type == SampleIntegratorType::Path || !integ.shadesAfterTrace(),
-                         what + " pass " + std::to_string(s0));
+    const bool sameRays = integ.type == SampleIntegratorType::Path || !integ.shadesAfterTrace();
+    test::expectSameSums(a, b, ca, cb, sameRays, what + " pass " + std::to_string(s0) + ", batch forms");
+    test::expectSameSums(a, c, ca, cc, sameRays, what + " pass " + std::to_string(s0) + ", one index at a time");
   }
   double mean = 0.0;
   for (const Color& c : a.sum) mean += c.x + c.y + c.z;
@@ -89,13 +112,13 @@ TEST(WaveStages, HitsAreQueuedByTheirMaterialsShadeKind) {
   const size_t npix = size_t(cam.width) * cam.height;
   Film film{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)};
   HostWave wave(int(npix), npix);
-  HostStageLaunch launch;
+  HostStageLaunch launch = wave.launch();
   const auto c = waveContext(small, &wave, film.view(cam));
   const WaveQueues& q = wave.queues;
   launch.write(&q.counts->round, WaveRound{});
   launch(CameraStage<SampleIntegrator<BvhTracer>>{c, 0, 0}, int(npix), nullptr);
   ASSERT_EQ(q.counts->round.rays[0], int(npix));
-  launch(ClosestHitStage<SampleIntegrator<BvhTracer>>{c, 0}, int(npix), nullptr);
+  launch(ClosestHitStage<SampleIntegrator<BvhTracer>>{c, 0, true}, int(npix), nullptr);
   const SceneView& sc = small.scene.view();
   std::set<int> seen;
   int queued = q.counts->round.escaped;

@@ -1,6 +1,6 @@
-// The CPU's tile wavefront (renderTileWavefront) against the per-pixel body (renderPixel): each
-// pixel adds the same samples in the same order, so over the GPU's BVH the sums agree to the
-// bit; over Embree's packets, to float rounding.
+// The wave stages as the CPU runs them, a wave a tile through their batch forms (HostStages.h),
+// against the per-pixel body (renderPixel): each pixel adds the same samples in the same order,
+// so over the GPU's BVH the sums agree to the bit; over Embree's packets, to float rounding.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,7 +10,8 @@
 
 #include "accel/EmbreeAccel.h"
 #include "support/SmallKernelScene.h"
-#include "wavefront/TileWavefront.h"
+#include "wavefront/HostStageLaunch.h"
+#include "wavefront/WavePass.h"
 
 using namespace envgi;
 using test::Film;
@@ -18,26 +19,38 @@ using test::SmallScene;
 
 namespace {
 
-// Samples [s0, s1) of every pixel twice: through renderPixel into a, and through
-// renderTileWavefront in tiles of 16 (partial at the right and bottom) into b.
+// Samples [s0, s1) of every pixel as the CPU executor takes them: a wave a tile of 16 (partial
+// at the right and bottom), through the stages' batch forms.
+template <class Integrator>
+void renderTiles(const Camera& cam, const SampleSequence& seq, const Integrator& integ, int s0, int s1, FilmView film,
+                 PixelCounters* counters) {
+  HostWave wave(16 * 16, 16 * 16);
+  HostStageLaunch launch = wave.launch();
+  for (int y0 = 0; y0 < cam.height; y0 += 16)
+    for (int x0 = 0; x0 < cam.width; x0 += 16) {
+      const WaveRegion region{x0, y0, std::min(16, cam.width - x0), std::min(16, cam.height - y0)};
+      runWavePass(launch, WaveContext<Integrator>{integ, cam, seq, film, region, wave.queues, wave.sums},
+                  ShadeKindSet::all(), s0, s1, counters);
+    }
+}
+
+// Samples [s0, s1) of every pixel twice: through renderPixel into a, and through renderTiles
+// into b.
 template <class Integrator>
 void renderBothWays(const Camera& cam, const SampleSequence& seq, const Integrator& integ, int s0, int s1, Film* a,
-                    Film* b, PixelCounters* ca, PixelCounters* cb, TileQueues* batch) {
+                    Film* b, PixelCounters* ca, PixelCounters* cb) {
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) renderPixel(cam, seq, integ, x, y, s0, s1, a->view(cam), ca);
-  for (int y0 = 0; y0 < cam.height; y0 += 16)
-    for (int x0 = 0; x0 < cam.width; x0 += 16)
-      renderTileWavefront(cam, seq, integ, x0, y0, std::min(x0 + 16, cam.width), std::min(y0 + 16, cam.height), s0, s1,
-                         b->view(cam), batch, cb);
+  renderTiles(cam, seq, integ, s0, s1, b->view(cam), cb);
 }
 
 }  // namespace
 
-// The CPU's tile-a-bounce-at-a-time body (renderTileWavefront) against renderPixel: each pixel
+// A wave a tile through the stages' batch forms against renderPixel: each pixel
 // adds the same samples in the same order, so the sums agree to the bit, over whole and partial
 // tiles (24 pixels in tiles of 16) and over two passes; for path, and for direct as the
 // one-bounce path it is with one light and one BSDF sample (directAsPath).
-TEST(TileWavefront, AddsTheSameSamplesAsRenderPixel) {
+TEST(HostStages, AddsTheSameSamplesAsRenderPixel) {
   for (std::string name : {"teapot-glass", "buddha", "cornell-box", "bunny-sunrise", "sun-and-sky"})
     for (IntegratorType type : {IntegratorType::Path, IntegratorType::Direct}) {
       SmallScene small(name, type);
@@ -48,9 +61,8 @@ TEST(TileWavefront, AddsTheSameSamplesAsRenderPixel) {
       size_t npix = size_t(cam.width) * cam.height;
       Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
       PixelCounters ca, cb;
-      TileQueues batch;
       for (auto [s0, s1] : {std::pair{0, 3}, std::pair{3, 8}}) {
-        renderBothWays(cam, k.sequence, integ, s0, s1, &a, &b, &ca, &cb, &batch);
+        renderBothWays(cam, k.sequence, integ, s0, s1, &a, &b, &ca, &cb);
         test::expectSameSums(a, b, ca, cb, type == IntegratorType::Path, name + " pass " + std::to_string(s0));
       }
       double mean = 0.0;
@@ -62,7 +74,7 @@ TEST(TileWavefront, AddsTheSameSamplesAsRenderPixel) {
 // With the map hidden from the camera (hide_emitters), the camera rays that escape add nothing,
 // whether they end in the camera round's lanes (pathAddEscape) or in renderPixel's pathShade;
 // what the rays that hit see of the map is there, and the same to the bit.
-TEST(TileWavefront, HiddenEmittersEscapeTheSameWayByBounce) {
+TEST(HostStages, HiddenEmittersEscapeTheSameWayByBounce) {
   SmallScene small("buddha", IntegratorType::Path);
   small.k.path.hideEmitters = true;
   SampleIntegrator<BvhTracer> integ = small.integrator();
@@ -71,8 +83,7 @@ TEST(TileWavefront, HiddenEmittersEscapeTheSameWayByBounce) {
   const size_t npix = size_t(cam.width) * cam.height;
   Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
   PixelCounters ca, cb;
-  TileQueues batch;
-  renderBothWays(cam, small.k.sequence, integ, 0, 4, &a, &b, &ca, &cb, &batch);
+  renderBothWays(cam, small.k.sequence, integ, 0, 4, &a, &b, &ca, &cb);
   EXPECT_EQ(ca.rays, cb.rays);
   EXPECT_EQ(std::memcmp(a.sum.data(), b.sum.data(), npix * sizeof(Color)), 0);
   EXPECT_EQ(std::memcmp(a.sumSq.data(), b.sumSq.data(), npix * sizeof(double)), 0);
@@ -85,7 +96,7 @@ TEST(TileWavefront, HiddenEmittersEscapeTheSameWayByBounce) {
 // direct runs by bounce where it is a one-bounce path (at most one light and one BSDF sample:
 // the bundled scenes', the paper's and the study's settings), and per pixel with more, which
 // trace several rays from one shading point.
-TEST(TileWavefront, DirectRunsByBounceWithOneSampleOfEach) {
+TEST(HostStages, DirectRunsByBounceWithOneSampleOfEach) {
   SmallScene small("buddha", IntegratorType::Direct);
   SampleIntegrator<BvhTracer> integ = small.integrator();
   integ.direct.emitterSamples = integ.direct.bsdfSamples = 1;
@@ -109,7 +120,7 @@ TEST(TileWavefront, DirectRunsByBounceWithOneSampleOfEach) {
 
 // The same sums as renderPixel's directTrace, to the bit over the GPU's BVH, with light samples
 // only (the study's uniform, adaptive, importance, points) and with BSDF samples only (bsdf).
-TEST(TileWavefront, DirectWithOneKindOfSampleByBounceAddsTheSameSamples) {
+TEST(HostStages, DirectWithOneKindOfSampleByBounceAddsTheSameSamples) {
   for (std::string name : {"buddha", "cornell-box", "sun-and-sky", "teapot-glass"})
     for (auto [nE, nB] : {std::pair{1, 0}, std::pair{0, 1}}) {
       SmallScene small(name, IntegratorType::Direct);
@@ -121,8 +132,7 @@ TEST(TileWavefront, DirectWithOneKindOfSampleByBounceAddsTheSameSamples) {
       const size_t npix = size_t(cam.width) * cam.height;
       Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
       PixelCounters ca, cb;
-      TileQueues batch;
-      renderBothWays(cam, k.sequence, integ, 0, 8, &a, &b, &ca, &cb, &batch);
+      renderBothWays(cam, k.sequence, integ, 0, 8, &a, &b, &ca, &cb);
       const std::string what = name + " " + std::to_string(nE) + "+" + std::to_string(nB);
       EXPECT_LE(cb.rays, ca.rays) << what;
       EXPECT_GE(double(cb.rays), 0.99 * double(ca.rays)) << what;
@@ -139,7 +149,7 @@ TEST(TileWavefront, DirectWithOneKindOfSampleByBounceAddsTheSameSamples) {
 // packets and streams find the same hits with t to an ulp or two, so the sums
 // match renderPixel's to float rounding, except where a path's later choices turn on those
 // bits (a mask's stochastic pass-through): there a pixel's samples differ, not its mean.
-TEST(TileWavefront, OverEmbreePacketsAddsTheSameSamplesAsRenderPixel) {
+TEST(HostStages, OverEmbreePacketsAddsTheSameSamplesAsRenderPixel) {
   for (std::string name : {"buddha", "mask", "cornell-box"})
     for (int res : {24, 22}) {
       Scene scene;
@@ -156,8 +166,7 @@ TEST(TileWavefront, OverEmbreePacketsAddsTheSameSamplesAsRenderPixel) {
       size_t npix = size_t(cam.width) * cam.height;
       Film a{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)}, b = a;
       PixelCounters ca, cb;
-      TileQueues batch;
-      renderBothWays(cam, k.sequence, integ, 0, 4, &a, &b, &ca, &cb, &batch);
+      renderBothWays(cam, k.sequence, integ, 0, 4, &a, &b, &ca, &cb);
       // The mask's pass-through may turn a path another way, and with it its count of rays.
       EXPECT_NEAR(double(ca.rays), double(cb.rays), (name == "mask" ? 5e-3 : 1e-3) * double(ca.rays)) << name << " " << res;
       size_t same = 0;
@@ -176,22 +185,23 @@ TEST(TileWavefront, OverEmbreePacketsAddsTheSameSamplesAsRenderPixel) {
     }
 }
 
-// The 4 x 4 block order visits each pixel of a tile once, and its first 16 are a 4 x 4 block.
-// Every pixel of a tile once, with its place; with both sides multiples of 4, each 16 in a row
-// are a 4 x 4 square, else the tile goes row by row.
-TEST(TileWavefront, TilePixelsGoInBlocksOfFourByFour) {
+// A region's pixel order (WaveRegion::at) visits each pixel once; with both sides multiples of
+// 4, each 16 in a row are a 4 x 4 square (the camera's packets), else it goes row by row.
+TEST(HostStages, RegionPixelsGoInBlocksOfFourByFour) {
   for (int tw : {4, 8, 16, 6})
     for (int th : {12, 4, 7}) {
+      const WaveRegion region{0, 0, tw, th};
       const int n = tw * th;
       const bool blocks = tw % 4 == 0 && th % 4 == 0;
+      EXPECT_EQ(region.inBlocks(), blocks);
       std::vector<int> count(size_t(n), 0), order;
-      forEachTilePixel(tw, th, [&](int k, int dx, int dy) {
-        ASSERT_EQ(k, dy * tw + dx);
-        ASSERT_GE(k, 0);
-        ASSERT_LT(k, n);
-        ++count[size_t(k)];
-        order.push_back(k);
-      });
+      for (int k = 0; k < n; ++k) {
+        int dx, dy;
+        region.at(k, &dx, &dy);
+        ASSERT_TRUE(dx >= 0 && dx < tw && dy >= 0 && dy < th) << tw << " x " << th << ", " << k;
+        ++count[size_t(dy * tw + dx)];
+        order.push_back(dy * tw + dx);
+      }
       for (int k = 0; k < n; ++k) EXPECT_EQ(count[size_t(k)], 1) << tw << " x " << th << ", pixel " << k;
       for (size_t i = 0; i < order.size(); ++i) {
         if (blocks) {
@@ -208,7 +218,7 @@ TEST(TileWavefront, TilePixelsGoInBlocksOfFourByFour) {
 // With a filter with negative lobes (Lanczos), the three bodies add the same weighted sums and
 // the same sums of weights to the bit; the weights are not all one, some are negative, and the
 // film's weighted mean of a pixel lies near its plain mean.
-TEST(TileWavefront, EveryBodyAddsTheFiltersWeights) {
+TEST(HostStages, EveryBodyAddsTheFiltersWeights) {
   SmallScene small("buddha", IntegratorType::Path);
   small.scene.camera.filter = makeFilter(FilterType::Lanczos);
   small.scene.finalize();
@@ -233,11 +243,7 @@ TEST(TileWavefront, EveryBodyAddsTheFiltersWeights) {
     for (int x = 0; x < cam.width; ++x) renderPixel(cam, k.sequence, integ, x, y, 0, 8, a.view(cam), &ca);
   uint64_t next = 0;
   regeneratePaths(cam, k.sequence, integ, 0, 8, b.view(cam), [&] { return next++; }, &cb);
-  TileQueues batch;
-  for (int y0 = 0; y0 < cam.height; y0 += 16)
-    for (int x0 = 0; x0 < cam.width; x0 += 16)
-      renderTileWavefront(cam, k.sequence, integ, x0, y0, std::min(x0 + 16, cam.width), std::min(y0 + 16, cam.height), 0,
-                         8, c.view(cam), &batch, &cc);
+  renderTiles(cam, k.sequence, integ, 0, 8, c.view(cam), &cc);
   EXPECT_EQ(std::memcmp(a.w.data(), b.w.data(), npix * sizeof(float)), 0);
   EXPECT_EQ(std::memcmp(a.w.data(), c.w.data(), npix * sizeof(float)), 0);
   EXPECT_EQ(std::memcmp(a.f.sum.data(), b.f.sum.data(), npix * sizeof(Color)), 0);
@@ -256,9 +262,9 @@ TEST(TileWavefront, EveryBodyAddsTheFiltersWeights) {
   }
 }
 
-// Adaptive sampling's mask: renderPixel, renderTileWavefront and regeneratePaths leave a masked
+// Adaptive sampling's mask: renderPixel, the CPU's waves and regeneratePaths leave a masked
 // pixel's sums alone and give every other pixel the same sums to the bit as an unmasked pass.
-TEST(TileWavefront, MaskedPixelsTakeNoSamplesAndTheRestTheSame) {
+TEST(HostStages, MaskedPixelsTakeNoSamplesAndTheRestTheSame) {
   SmallScene small("buddha", IntegratorType::Path);
   const KernelSettings& k = small.k;
   SampleIntegrator<BvhTracer> integ = small.integrator();
@@ -291,12 +297,8 @@ TEST(TileWavefront, MaskedPixelsTakeNoSamplesAndTheRestTheSame) {
   for (int y = 0; y < cam.height; ++y)
     for (int x = 0; x < cam.width; ++x) renderPixel(cam, k.sequence, integ, x, y, 0, 4, masked(a), &ca);
   check(a, "renderPixel");
-  TileQueues batch;
-  for (int y0 = 0; y0 < cam.height; y0 += 16)
-    for (int x0 = 0; x0 < cam.width; x0 += 16)
-      renderTileWavefront(cam, k.sequence, integ, x0, y0, std::min(x0 + 16, cam.width), std::min(y0 + 16, cam.height),
-                         0, 4, masked(b), &batch, &cb);
-  check(b, "renderTileWavefront");
+  renderTiles(cam, k.sequence, integ, 0, 4, masked(b), &cb);
+  check(b, "renderTiles");
   EXPECT_EQ(ca.rays, cb.rays);
   EXPECT_LT(ca.rays, cf.rays);
   uint64_t next = 0;
