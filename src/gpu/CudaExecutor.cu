@@ -84,7 +84,7 @@ std::unique_ptr<PassExecutor> makeCudaExecutor(const Scene& scene, const Bvh& bv
   integ.tracer = BvhTracer{ds->bvh};
   auto ex = std::make_unique<CudaPassExecutor<SampleIntegrator<BvhTracer>>>(std::move(ds), integ, scene.view().camera,
                                                                             k.sequence, gpu, keepVariance,
-                                                                            ShadeKindSet::of(scene.bsdfs));
+                                                                            ShadeKindSet::of(scene.view()));
   if (deviceBytes) *deviceBytes = ex->deviceBytes();
   return ex;
 }

@@ -12,13 +12,14 @@
 
 namespace envgi {
 
-// The shade kinds a scene's materials need a stage for (shadeKindOf of each material).
+// The shade kinds a scene's hits need a stage for: the kind (shadeKindOf) of each shape's
+// material. A blend's members are shaded in the blend's stage, so they launch none of their own.
 struct ShadeKindSet {
   bool used[kShadeKinds] = {};
-  template <class Bsdfs>
-  static ShadeKindSet of(const Bsdfs& bsdfs) {
+  static ShadeKindSet of(const SceneView& sc) {
     ShadeKindSet s;
-    for (const Bsdf& b : bsdfs) s.used[shadeKindOf(b)] = true;
+    for (int i = 0; i < sc.meshCount; ++i) s.used[shadeKindOf(sc.bsdfs[sc.meshes[i].bsdf])] = true;
+    for (int i = 0; i < sc.sphereCount; ++i) s.used[shadeKindOf(sc.bsdfs[sc.spheres[i].bsdf])] = true;
     return s;
   }
   static ShadeKindSet all() {

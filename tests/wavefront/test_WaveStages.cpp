@@ -55,7 +55,7 @@ void expectRenderPixelsSums(const SmallScene& small, int capacity, const std::st
   HostWave wave(capacity, npix);
   HostStageLaunch batches = wave.launch();
   ShuffledStageLaunch shuffled{{nullptr}};
-  const ShadeKindSet kinds = ShadeKindSet::of(small.scene.bsdfs);
+  const ShadeKindSet kinds = ShadeKindSet::of(small.scene.view());
   for (auto [s0, s1] : {std::pair{0, 3}, std::pair{3, 8}}) {
     for (int y = 0; y < cam.height; ++y)
       for (int x = 0; x < cam.width; ++x) renderPixel(cam, small.k.sequence, integ, x, y, s0, s1, a.view(cam), &ca);
@@ -69,6 +69,19 @@ void expectRenderPixelsSums(const SmallScene& small, int capacity, const std::st
   double mean = 0.0;
   for (const Color& c : a.sum) mean += c.x + c.y + c.z;
   EXPECT_GT(mean, 0.0) << what << ": an image, not a black film";
+}
+
+// The camera round of sample 0 over the whole film (a wave of it): its rays queued, then traced
+// and each queued as escaped or by its hit's shade kind.
+void traceCameraRound(const SmallScene& small, HostWave* wave) {
+  const Camera& cam = small.scene.view().camera;
+  const int npix = cam.width * cam.height;
+  const auto c = waveContext(small, wave, FilmView{});
+  HostStageLaunch launch = wave->launch();
+  launch.write(&wave->queues.counts->round, WaveRound{});
+  launch(CameraStage<SampleIntegrator<BvhTracer>>{c, 0, 0}, npix, nullptr);
+  ASSERT_EQ(wave->queues.counts->round.rays[0], npix);
+  launch(ClosestHitStage<SampleIntegrator<BvhTracer>>{c, 0, true}, npix, nullptr);
 }
 
 }  // namespace
@@ -110,15 +123,9 @@ TEST(WaveStages, HitsAreQueuedByTheirMaterialsShadeKind) {
   SmallScene small("teapot-glass", IntegratorType::Path);
   const Camera& cam = small.scene.view().camera;
   const size_t npix = size_t(cam.width) * cam.height;
-  Film film{std::vector<Color>(npix, Color(0.f)), std::vector<double>(npix, 0.0)};
   HostWave wave(int(npix), npix);
-  HostStageLaunch launch = wave.launch();
-  const auto c = waveContext(small, &wave, film.view(cam));
+  traceCameraRound(small, &wave);
   const WaveQueues& q = wave.queues;
-  launch.write(&q.counts->round, WaveRound{});
-  launch(CameraStage<SampleIntegrator<BvhTracer>>{c, 0, 0}, int(npix), nullptr);
-  ASSERT_EQ(q.counts->round.rays[0], int(npix));
-  launch(ClosestHitStage<SampleIntegrator<BvhTracer>>{c, 0, true}, int(npix), nullptr);
   const SceneView& sc = small.scene.view();
   std::set<int> seen;
   int queued = q.counts->round.escaped;
@@ -131,4 +138,34 @@ TEST(WaveStages, HitsAreQueuedByTheirMaterialsShadeKind) {
     }
   EXPECT_EQ(queued, int(npix)) << "every ray is queued once";
   EXPECT_GE(seen.size(), 2u) << "teapot-glass's glass and its floor are of two kinds";
+}
+
+// The kinds a scene launches a shade stage for: every kind its camera rays' hits are queued
+// under (else those hits would go unshaded), and on the blend scene not the kinds of the blends'
+// members alone (a GPU kernel launched on an empty queue each round).
+TEST(WaveStages, AShadeStageRunsForEachKindAHitNeeds) {
+  for (std::string name : {"blend", "teapot-glass", "buddha", "cornell-box"}) {
+    SmallScene small(name, IntegratorType::Path);
+    const ShadeKindSet kinds = ShadeKindSet::of(small.scene.view());
+    const Camera& cam = small.scene.view().camera;
+    const size_t npix = size_t(cam.width) * cam.height;
+    HostWave wave(int(npix), npix);
+    traceCameraRound(small, &wave);
+    int used = 0, hitKinds = 0;
+    for (int k = 0; k < kShadeKinds; ++k) {
+      used += kinds.used[k];
+      if (wave.queues.counts->round.kinds[k] == 0) continue;
+      ++hitKinds;
+      EXPECT_TRUE(kinds.used[k]) << name << ": kind " << k << " has hits and no stage";
+    }
+    EXPECT_GE(hitKinds, 1) << name;
+    bool ofMaterials[kShadeKinds] = {};
+    int materials = 0;
+    for (const Bsdf& b : small.scene.bsdfs) ofMaterials[shadeKindOf(b)] = true;
+    for (bool m : ofMaterials) materials += m;
+    if (name == "blend") {
+      EXPECT_TRUE(kinds.used[kBlendShadeKind]);
+      EXPECT_LT(used, materials) << "the blends' members' own kinds launch nothing";
+    }
+  }
 }
