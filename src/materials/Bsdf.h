@@ -438,6 +438,86 @@ ENVGI_INLINE bool bsdfReadsUcBesideU(const Bsdf& b) {
 }
 
 namespace detail {
+// The sampling of the types with several lobes or a refraction, each apart: sampleInFrame's.
+// A smooth interface's mirror lobe, drawn with probability R.
+ENVGI_INLINE bool sampleSmoothReflection(const Bsdf& b, Vec3f wo, float R, BsdfSample* s) {
+  s->wi = Vec3f(-wo.x, -wo.y, wo.z);
+  s->pdf = R;
+  s->weight = b.specularReflectance;
+  s->delta = true;
+  return true;
+}
+ENVGI_INLINE bool sampleDielectric(const Bsdf& b, Vec3f wo, float uc, BsdfSample* s) {
+  float R = fresnelDielectric(wo.z, b.ior), T = 1.f - R;
+  if (uc < R) return sampleSmoothReflection(b, wo, R, s);
+  float etap = wo.z > 0.f ? b.ior : 1.f / b.ior;
+  Vec3f n = wo.z > 0.f ? Vec3f(0.f, 0.f, 1.f) : Vec3f(0.f, 0.f, -1.f);
+  if (!refractDir(wo, n, etap, &s->wi)) return false;
+  s->pdf = T;
+  s->weight = b.specularTransmittance / (etap * etap);
+  s->delta = true;
+  return true;
+}
+ENVGI_INLINE bool sampleThinDielectric(const Bsdf& b, Vec3f wo, float uc, BsdfSample* s) {
+  float R = fresnelDielectric(std::fabs(wo.z), b.ior), T = 1.f - R;
+  if (R < 1.f) {  // inter-reflections inside the sheet
+    R += T * T * R / (1.f - R * R);
+    T = 1.f - R;
+  }
+  if (uc < R) return sampleSmoothReflection(b, wo, R, s);
+  s->wi = -wo;
+  s->pdf = T;
+  s->weight = b.specularTransmittance;
+  s->delta = true;
+  return true;
+}
+ENVGI_INLINE bool sampleRoughDielectric(const Bsdf& b, Vec3f wo, float uc, Vec2f u, BsdfSample* s) {
+  if (wo.z == 0.f) return false;
+  MicrofacetDistribution d = microfacet(b);
+  Vec3f m = d.sampleVisible(wo, u);
+  float R = fresnelDielectric(dot(wo, m), b.ior);
+  if (uc < R) {
+    s->wi = reflect(wo, m);
+    if (s->wi.z * wo.z <= 0.f) return false;
+  } else {
+    float c = dot(wo, m), e = b.ior;
+    Vec3f n = m;
+    if (c < 0.f) {
+      e = 1.f / b.ior;
+      n = -m;
+    }
+    if (!refractDir(wo, n, e, &s->wi) || s->wi.z * wo.z >= 0.f) return false;
+  }
+  return finishSample(b, BsdfType::RoughDielectric, wo, s);
+}
+// Plastic and rough plastic: the coat (a mirror, or rough) or the diffuse base, by the coat's
+// sampling probability.
+ENVGI_INLINE bool samplePlastic(const Bsdf& b, BsdfType type, Vec3f wo, float uc, Vec2f u, BsdfSample* s,
+                                bool lobeFromU) {
+  if (wo.z <= 0.f) return false;
+  float fo = type == BsdfType::Plastic ? fresnelDielectric(wo.z, b.ior)
+                                         : detail::roughCoatReflectance(b, detail::roughCoat(b), wo.z);
+  float ps = detail::plasticSpecularProb(b, fo);
+  if (lobeFromU) {  // bsdfLobeFromU: the coat below ps, the base above
+    uc = u.x;
+    u.x = plasticLobeDraw(ps, u.x);
+  }
+  if (type == BsdfType::Plastic && uc < ps) {
+    s->wi = Vec3f(-wo.x, -wo.y, wo.z);
+    s->pdf = ps;
+    s->delta = true;
+    s->weight = b.specularReflectance * (fo / ps);
+    return true;
+  }
+  if (type == BsdfType::RoughPlastic && uc < ps) {
+    s->wi = reflect(wo, microfacet(b).sampleVisible(wo, u));
+  } else {
+    s->wi = sampleCosineHemisphere(u);
+  }
+  if (s->wi.z <= 0.f) return false;
+  return finishSample(b, type, wo, s);
+}
+
 ENVGI_INLINE bool sampleInFrame(const Bsdf& b, BsdfType type, Vec3f wo, float uc, Vec2f u, BsdfSample* s,
                                 bool lobeFromU) {
   bool flip = b.twoSided && wo.z < 0.f;
@@ -470,89 +550,11 @@ ENVGI_INLINE bool sampleInFrame(const Bsdf& b, BsdfType type, Vec3f wo, float uc
       ok = detail::finishSample(b, type, wo, s);
       break;
     }
-    case BsdfType::Dielectric: {
-      float R = fresnelDielectric(wo.z, b.ior), T = 1.f - R;
-      s->delta = true;
-      if (uc < R) {
-        s->wi = Vec3f(-wo.x, -wo.y, wo.z);
-        s->pdf = R;
-        s->weight = b.specularReflectance;
-      } else {
-        float etap = wo.z > 0.f ? b.ior : 1.f / b.ior;
-        Vec3f n = wo.z > 0.f ? Vec3f(0.f, 0.f, 1.f) : Vec3f(0.f, 0.f, -1.f);
-        if (!refractDir(wo, n, etap, &s->wi)) return false;
-        s->pdf = T;
-        s->weight = b.specularTransmittance / (etap * etap);
-      }
-      ok = true;
-      break;
-    }
-    case BsdfType::ThinDielectric: {
-      float R = fresnelDielectric(std::fabs(wo.z), b.ior), T = 1.f - R;
-      if (R < 1.f) {  // inter-reflections inside the sheet
-        R += T * T * R / (1.f - R * R);
-        T = 1.f - R;
-      }
-      s->delta = true;
-      if (uc < R) {
-        s->wi = Vec3f(-wo.x, -wo.y, wo.z);
-        s->pdf = R;
-        s->weight = b.specularReflectance;
-      } else {
-        s->wi = -wo;
-        s->pdf = T;
-        s->weight = b.specularTransmittance;
-      }
-      ok = true;
-      break;
-    }
-    case BsdfType::RoughDielectric: {
-      if (wo.z == 0.f) return false;
-      MicrofacetDistribution d = microfacet(b);
-      Vec3f m = d.sampleVisible(wo, u);
-      float R = fresnelDielectric(dot(wo, m), b.ior);
-      if (uc < R) {
-        s->wi = reflect(wo, m);
-        if (s->wi.z * wo.z <= 0.f) return false;
-      } else {
-        float c = dot(wo, m), e = b.ior;
-        Vec3f n = m;
-        if (c < 0.f) {
-          e = 1.f / b.ior;
-          n = -m;
-        }
-        if (!refractDir(wo, n, e, &s->wi) || s->wi.z * wo.z >= 0.f) return false;
-      }
-      ok = detail::finishSample(b, type, wo, s);
-      break;
-    }
+    case BsdfType::Dielectric: ok = sampleDielectric(b, wo, uc, s); break;
+    case BsdfType::ThinDielectric: ok = sampleThinDielectric(b, wo, uc, s); break;
+    case BsdfType::RoughDielectric: ok = sampleRoughDielectric(b, wo, uc, u, s); break;
     case BsdfType::Plastic:
-    case BsdfType::RoughPlastic: {
-      if (wo.z <= 0.f) return false;
-      float fo = type == BsdfType::Plastic ? fresnelDielectric(wo.z, b.ior)
-                                             : detail::roughCoatReflectance(b, detail::roughCoat(b), wo.z);
-      float ps = detail::plasticSpecularProb(b, fo);
-      if (lobeFromU) {  // bsdfLobeFromU: the coat below ps, the base above
-        uc = u.x;
-        u.x = plasticLobeDraw(ps, u.x);
-      }
-      if (type == BsdfType::Plastic && uc < ps) {
-        s->wi = Vec3f(-wo.x, -wo.y, wo.z);
-        s->pdf = ps;
-        s->delta = true;
-        s->weight = b.specularReflectance * (fo / ps);
-        ok = true;
-        break;
-      }
-      if (type == BsdfType::RoughPlastic && uc < ps) {
-        s->wi = reflect(wo, microfacet(b).sampleVisible(wo, u));
-      } else {
-        s->wi = sampleCosineHemisphere(u);
-      }
-      if (s->wi.z <= 0.f) return false;
-      ok = detail::finishSample(b, type, wo, s);
-      break;
-    }
+    case BsdfType::RoughPlastic: ok = samplePlastic(b, type, wo, uc, u, s, lobeFromU); break;
     case BsdfType::Principled:
       if (!principled::sampleDirection(b.principled, b.ior, wo, uc, u, &s->wi, lobeFromU)) return false;
       ok = detail::finishSample(b, type, wo, s);
