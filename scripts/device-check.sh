@@ -6,15 +6,15 @@
 # step's whole log) and device-check-images.tar (the renders).
 #   bash scripts/device-check.sh build-package/envgi-*-cuda.tar.xz [DRAGON.ply]
 # LOGDIR defaults to $OUT (the device tool's folder) or out/device-check. STEPS picks steps by
-# name (default: "check render view interrupt tests bench bench_stages study"; also
-# bench_perpixel, the path kernel without path regeneration); a failed step is followed by a compute-sanitizer
+# name (default: "check render view interrupt tests bench bench_stages bench_stages_wide study";
+# also bench_perpixel, the path kernel without path regeneration); a failed step is followed by a compute-sanitizer
 # run of a tiny render when `compute-sanitizer` is on the PATH.
 set -uo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 pkg=${1:?usage: device-check.sh PACKAGE.tar.xz [DRAGON.ply]}
 dragon=${2:-}
 logdir=${LOGDIR:-${OUT:-out/device-check}}
-steps=${STEPS:-check render view interrupt tests bench bench_stages study}
+steps=${STEPS:-check render view interrupt tests bench bench_stages bench_stages_wide study}
 mkdir -p "$logdir"
 rm -f "$logdir/device-check.log"
 work=$(mktemp -d)
@@ -107,6 +107,8 @@ for s in $steps; do
       ENVGI_GPU_REGEN=0 step bench_perpixel 120 "$bin/envgi_bench_gpu" --no-cpu ${dragon:+--dragon "$dragon"} ;;
     bench_stages)  # the path and direct kernels as wave stages (a kernel a stage and material kind)
       ENVGI_GPU_STAGES=1 step bench_stages 120 "$bin/envgi_bench_gpu" --no-cpu ${dragon:+--dragon "$dragon"} ;;
+    bench_stages_wide)  # the same with the shade kernels at up to 128 registers (4 blocks an SM)
+      ENVGI_GPU_STAGES=wide step bench_stages_wide 120 "$bin/envgi_bench_gpu" --no-cpu ${dragon:+--dragon "$dragon"} ;;
     *) echo "device-check: unknown step $s"; exit 2 ;;
   esac
 done

@@ -63,6 +63,7 @@ done
   done
   for k in 0 1 2 3 4 5 6 7 8 9; do
     echo "template __global__ void stageKernel<ShadeStage<I, $k>>(ShadeStage<I, $k>, int, const int*);"
+    echo "template __global__ void wideStageKernel<ShadeStage<I, $k>>(ShadeStage<I, $k>, int, const int*);"
   done
   echo '}  // namespace envgi'
 } >"$work/stages.cu"
@@ -71,18 +72,20 @@ done
   >"$work/stages.txt" 2>&1 || { cat "$work/stages.txt" >&2; exit 1; }
 # A row a kernel: its own figures, then its spills with those of the functions ptxas kept out of
 # it (each kernel has its own copies).
-echo "stage kernels (launch bounds 128 threads x 8 blocks an SM: at most 64 registers):"
+echo "stage kernels (launch bounds 128 threads x 8 blocks an SM: at most 64 registers; rows"
+echo "', 4 blocks': the shade kernels of ENVGI_GPU_STAGES=wide, at most 128 registers):"
 echo "| kernel | registers | stack frame (B) | spill stores / loads (B) | with out-of-line calls (B) |"
 echo "| --- | --- | --- | --- | --- |"
 c++filt <"$work/stages.txt" | awk '
   BEGIN { split("diffuse conductor roughconductor dielectric thindielectric roughdielectric plastic roughplastic principled blend", kind, " ") }
   /Compiling entry function/ {
     n = $0
-    if (match(n, /ShadeStage<envgi::SampleIntegrator<envgi::BvhTracer>, [0-9]/)) n = "shade " kind[substr(n, RSTART + RLENGTH - 1, 1) + 1]
-    else { sub(/Stage.*/, "", n); sub(/.*stageKernel<envgi::/, "", n); n = tolower(n) }
+    wide = n ~ /wideStageKernel/
+    if (match(n, /ShadeStage<envgi::SampleIntegrator<envgi::BvhTracer>, [0-9]/)) n = "shade " kind[substr(n, RSTART + RLENGTH - 1, 1) + 1] (wide ? ", 4 blocks" : "")
+    else { sub(/Stage.*/, "", n); sub(/.*[sS]tageKernel<envgi::/, "", n); n = tolower(n) }
     order[++m] = n; cur = n
   }
-  /Function properties for/ { isKernel = $0 ~ /stageKernel/ }
+  /Function properties for/ { isKernel = $0 ~ /[sS]tageKernel/ }
   /stack frame/ {
     if (isKernel) { stack[cur] = $1; st[cur] = $5; ld[cur] = $9 }
     allSt[cur] += $5; allLd[cur] += $9

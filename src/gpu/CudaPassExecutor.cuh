@@ -88,8 +88,10 @@ class CudaPassExecutor final : public PassExecutor {
     counters_ = a.allocate<unsigned long long>(3, "counters");
     check(cudaMemset(counters_, 0, 3 * sizeof(unsigned long long)), "clearing counters");
     if constexpr (RunsByBounce<Integrator>::value) {
+      // ENVGI_GPU_STAGES=wide: the shade stages' kernels at up to 128 registers (CudaStageLaunch.cuh).
       const char* st = std::getenv("ENVGI_GPU_STAGES");
-      if (st && std::strcmp(st, "1") == 0) {
+      wideShade_ = st && std::strcmp(st, "wide") == 0;
+      if (st && (std::strcmp(st, "1") == 0 || wideShade_)) {
         // As many paths as pixels, up to 2^20 (pbrt-v4's wavefront holds 2^20 too).
         const int capacity = int(std::min<size_t>(px, size_t(1) << 20));
         const size_t bytes = layOutWave(0, capacity, px, &waveQueues_, &waveSums_);
@@ -113,14 +115,16 @@ class CudaPassExecutor final : public PassExecutor {
 
   std::string deviceName() const override {
     return "cuda:" + std::to_string(gpu_) + " (" + gpu::deviceName(gpu_) +
-           (regenBlocks_ > 0 ? ", regeneration)" : waveQueues_.capacity > 0 ? ", stages)" : ")");
+           (regenBlocks_ > 0                ? ", regeneration)"
+            : waveQueues_.capacity > 0 ? (wideShade_ ? ", stages, wide shading)" : ", stages)")
+                                       : ")");
   }
 
   void runPass(int s0, int s1, Progress& progress, PassCounters* counters) override {
     if constexpr (RunsByBounce<Integrator>::value) {
       if (waveQueues_.capacity > 0) {
         PixelCounters pc;
-        CudaStageLaunch launch;
+        CudaStageLaunch launch{wideShade_};
         runWavePass(launch, WaveContext<Integrator>{integ_, cam_, seq_, film_, WaveRegion{0, 0, cam_.width, cam_.height},
                                                           waveQueues_, waveSums_}, kinds_, s0, s1,
                     &pc);
@@ -213,6 +217,7 @@ class CudaPassExecutor final : public PassExecutor {
   int regenBlocks_ = 0;  // > 0: passes by path regeneration, this many blocks
   ShadeKindSet kinds_;
   WaveQueues waveQueues_;  // capacity > 0: passes by the stages
+  bool wideShade_ = false;  // ENVGI_GPU_STAGES=wide
   WaveSums waveSums_;
 };
 

@@ -14,19 +14,47 @@ namespace envgi {
 constexpr int kStageBlock = 128;
 // 8 blocks of 128 threads an SM: at most 64 registers a thread in every stage kernel.
 constexpr int kStageBlocksPerSM = 8;
+// 4 for the shade stages where asked (wideShade): up to 128 registers, where no material's code
+// spills (docs/gpu.md), at half the resident threads. Which wins is a device's to measure.
+constexpr int kWideStageBlocksPerSM = 4;
 
 template <class Stage>
-__global__ void __launch_bounds__(kStageBlock, kStageBlocksPerSM) stageKernel(Stage stage, int n, const int* count) {
+__device__ inline void runStageAt(const Stage& stage, int n, const int* count) {
   const int i = int(blockIdx.x * blockDim.x + threadIdx.x);
   if (i >= n || (count && i >= *count)) return;
   stage(i);
 }
+template <class Stage>
+__global__ void __launch_bounds__(kStageBlock, kStageBlocksPerSM) stageKernel(Stage stage, int n, const int* count) {
+  runStageAt(stage, n, count);
+}
+template <class Stage>
+__global__ void __launch_bounds__(kStageBlock, kWideStageBlocksPerSM)
+    wideStageKernel(Stage stage, int n, const int* count) {
+  runStageAt(stage, n, count);
+}
+
+template <class Stage>
+struct IsShadeStage {
+  static constexpr bool value = false;
+};
+template <class I, int K>
+struct IsShadeStage<ShadeStage<I, K>> {
+  static constexpr bool value = true;
+};
 
 struct CudaStageLaunch {
+  bool wideShade = false;  // the shade stages at kWideStageBlocksPerSM
   template <class Stage>
   void operator()(const Stage& stage, int n, const int* count) const {
     if (n <= 0) return;
-    stageKernel<<<(n + kStageBlock - 1) / kStageBlock, kStageBlock>>>(stage, n, count);
+    const int blocks = (n + kStageBlock - 1) / kStageBlock;
+    bool wide = false;
+    if constexpr (IsShadeStage<Stage>::value) {
+      wide = wideShade;
+      if (wide) wideStageKernel<<<blocks, kStageBlock>>>(stage, n, count);
+    }
+    if (!wide) stageKernel<<<blocks, kStageBlock>>>(stage, n, count);
     ok(cudaGetLastError(), "launching a wave stage");
   }
   template <class T>

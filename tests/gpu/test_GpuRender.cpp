@@ -306,15 +306,17 @@ TEST(GpuRender, RegenerationMatchesOneThreadAPixel) {
     }
 }
 
-// The stages (ENVGI_GPU_STAGES=1: a kernel a stage, hits shaded by material kind) draw the same
-// samples as path regeneration: the same rays, and the same image up to the order of
-// regeneration's atomic adds.
+// The stages (ENVGI_GPU_STAGES=1: a kernel a stage, hits shaded by material kind; =wide: the
+// shade kernels at up to 128 registers) draw the same samples as path regeneration: the same
+// rays, and the same image up to the order of regeneration's atomic adds.
 TEST(GpuRender, StagesMatchRegeneration) {
   for (std::string name : {"buddha", "teapot-glass", "cornell-box", "bunny-sunrise"})
-    for (IntegratorType type : {IntegratorType::Path, IntegratorType::Direct}) {
-      auto [a, b] = expectSameSamples(name, type, "", "ENVGI_GPU_STAGES=1", "stages against regeneration");
-      EXPECT_NE(b.find("stages"), std::string::npos) << b;
-    }
+    for (IntegratorType type : {IntegratorType::Path, IntegratorType::Direct})
+      for (std::string stages : {"1", "wide"}) {
+        const std::string set = "ENVGI_GPU_STAGES=" + stages;
+        auto [a, b] = expectSameSamples(name, type, "", set.c_str(), "stages against regeneration");
+        EXPECT_NE(b.find(stages == "wide" ? "stages, wide shading" : "stages)"), std::string::npos) << b;
+      }
 }
 
 // Adaptive sampling on the GPU: the mask reaches the regeneration kernel, so pixels stop at pass
